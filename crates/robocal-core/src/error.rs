@@ -1,0 +1,112 @@
+//! The library's error type: one enum whose variants carry the context a user needs to fix the
+//! input (file, line, field, value).
+
+use std::path::PathBuf;
+
+/// Everything that can go wrong in robocal-core.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+    /// A file's content is malformed. `line` is 1-based where known.
+    #[error("{}", fmt_parse(.path, *.line, .field, .message))]
+    Parse {
+        /// The file (or a description such as `<robot preset>`).
+        path: PathBuf,
+        /// The 1-based line, where known.
+        line: Option<usize>,
+        /// The field or column, where known.
+        field: Option<String>,
+        /// What is wrong.
+        message: String,
+    },
+    /// An argument or a value of the model is invalid.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// The offending field or argument.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A preset name that does not exist.
+    #[error("unknown robot preset `{name}` (known presets: {known}); or give a path to a TOML robot file")]
+    UnknownPreset {
+        /// The name asked for.
+        name: String,
+        /// The known presets, comma-separated.
+        known: String,
+    },
+    /// A parameter name that does not exist for this robot.
+    #[error("unknown parameter `{name}` (this robot has: {known})")]
+    UnknownParameter {
+        /// The name asked for.
+        name: String,
+        /// The robot's parameter names.
+        known: String,
+    },
+    /// A joint vector whose length does not match the robot.
+    #[error("{context}: expected {expected} joint values, got {got}")]
+    JointCount {
+        /// Where the joint vector came from.
+        context: String,
+        /// The robot's joint count.
+        expected: usize,
+        /// What was given.
+        got: usize,
+    },
+    /// A numerical procedure failed.
+    #[error("{0}")]
+    Numerical(String),
+}
+
+fn fmt_parse(
+    path: &std::path::Path,
+    line: Option<usize>,
+    field: &Option<String>,
+    message: &str,
+) -> String {
+    let mut s = path.display().to_string();
+    if let Some(l) = line {
+        s.push_str(&format!(":{l}"));
+    }
+    if let Some(f) = field {
+        s.push_str(&format!(": field `{f}`"));
+    }
+    s.push_str(": ");
+    s.push_str(message);
+    s
+}
+
+impl Error {
+    /// Shorthand for [`Error::Invalid`].
+    pub fn invalid(field: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Invalid {
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    /// Shorthand for [`Error::Parse`].
+    pub fn parse(
+        path: impl Into<PathBuf>,
+        line: Option<usize>,
+        field: Option<&str>,
+        message: impl Into<String>,
+    ) -> Self {
+        Error::Parse {
+            path: path.into(),
+            line,
+            field: field.map(str::to_owned),
+            message: message.into(),
+        }
+    }
+}
+
+/// The library's result type.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,70 @@
+//! Screw-theory forward kinematics, the paper's eq. 6:
+//! `g(q) = exp(xi_1 q_1) ... exp(xi_n q_n) g(0)`.
+//!
+//! The twists `xi_i = (v_i, w_i)` and `g(0)` are derived from the parameter table: `w_i` is joint
+//! i's unit axis and `v_i = -w_i x o_i` for a point `o_i` on it, both at q = 0, in the ACS (the
+//! base frame B is part of the chain); `g(0)` is the tool frame at q = 0.
+
+use crate::frame::{frame, Frame};
+use crate::model::Robot;
+use nalgebra::{Matrix3, Vector3};
+
+/// A unit twist of a revolute joint: `v = -w x o`, `|w| = 1`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Twist {
+    /// Linear part v (mm).
+    pub v: Vector3<f64>,
+    /// Angular part w (unit vector).
+    pub w: Vector3<f64>,
+}
+
+impl Twist {
+    /// The rigid motion `exp(xi^ theta)` (Rodrigues' formula for the rotation and
+    /// `(I - R)(w x v) + w w^T v theta` for the translation; Murray, Li & Sastry eq. 2.36).
+    pub fn exp(&self, theta: f64) -> Frame {
+        let w = self.w;
+        let (s, c) = theta.sin_cos();
+        let k = Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0);
+        let r = Matrix3::identity() + k * s + k * k * (1.0 - c);
+        let p = (Matrix3::identity() - r) * w.cross(&self.v) + w * w.dot(&self.v) * theta;
+        frame(r, p)
+    }
+}
+
+/// The product-of-exponentials form of a robot (eq. 6).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Poe {
+    /// One twist per joint, in the ACS.
+    pub twists: Vec<Twist>,
+    /// The tool frame at q = 0, `g_bt(0)`.
+    pub g0: Frame,
+}
+
+impl Poe {
+    /// Derives the twists and `g(0)` from the robot's parameter table.
+    pub fn from_robot(robot: &Robot) -> Poe {
+        let zero = vec![0.0; robot.dof()];
+        let twists = robot
+            .joint_axes(&zero)
+            .iter()
+            .map(|(w, o)| Twist {
+                v: -w.cross(o),
+                w: *w,
+            })
+            .collect();
+        Poe {
+            twists,
+            g0: robot.tool_pose(&zero),
+        }
+    }
+
+    /// The tool frame at joint values `q` (rad).
+    pub fn tool_pose(&self, q: &[f64]) -> Frame {
+        assert_eq!(q.len(), self.twists.len(), "joint vector length");
+        let mut g = Frame::identity();
+        for (t, &qi) in self.twists.iter().zip(q) {
+            g *= t.exp(qi);
+        }
+        g * self.g0
+    }
+}

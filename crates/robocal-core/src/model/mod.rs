@@ -1,0 +1,470 @@
+//! Robot models: a serial chain of revolute joints described by a modified (Craig) or standard
+//! Denavit–Hartenberg parameter table, joint limits, a base frame and a tool (paper, section II.B).
+//!
+//! Every geometric quantity that calibration may change is a [`Param`], addressable by its
+//! DESIGN.md name (`alpha1`, `d3`, `base_z`, `tool_c`, ...). Values are stored in millimetres and
+//! radians; [`Param::unit`] tells how a value is shown at the interfaces (mm or degrees).
+//!
+//! The per-joint constant part of each link transform is cached, so forward kinematics costs one
+//! `sin_cos` per joint; every mutation goes through [`Robot::set`] which keeps the cache valid.
+
+mod params;
+pub mod presets;
+pub mod robot_file;
+
+pub use params::{Param, Unit};
+
+use crate::error::{Error, Result};
+use crate::frame::{self, Frame};
+use nalgebra::{Matrix3, Vector3};
+
+/// Largest number of joints a chain may have (forward kinematics keeps its frames on the stack).
+pub const MAX_JOINTS: usize = 16;
+
+/// The Denavit–Hartenberg convention of a parameter table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Convention {
+    /// Modified DH (Craig), the paper's Table I:
+    /// `T(i-1 -> i) = Rx(alpha_i) Tx(a_i) Ry(beta_i) Rz(q_i + phi_i) Tz(d_i)`.
+    Mdh,
+    /// Standard DH: `T(i-1 -> i) = Rz(q_i + phi_i) Tz(d_i) Tx(a_i) Rx(alpha_i) Ry(beta_i)`.
+    Dh,
+}
+
+impl Convention {
+    /// `"mdh"` or `"dh"`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Convention::Mdh => "mdh",
+            Convention::Dh => "dh",
+        }
+    }
+}
+
+/// The geometric parameters of one link (mm and radians).
+///
+/// `beta` is Hayati's tilt about the link's y axis, the parameter MDH lacks between parallel axes;
+/// it is zero and not part of the parameter list unless enabled with [`Robot::enable_beta`].
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Link {
+    /// Twist angle alpha_i (rad).
+    pub alpha: f64,
+    /// Offset d_i along the joint axis (mm).
+    pub d: f64,
+    /// Length a_i along the common normal (mm).
+    pub a: f64,
+    /// Joint angle offset phi_i (rad), added to the joint value.
+    pub phi: f64,
+    /// Hayati tilt beta_i (rad); zero unless enabled.
+    pub beta: f64,
+}
+
+/// The range a joint may move in (radians, model joint values).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct JointLimit {
+    /// Lower bound (rad).
+    pub min: f64,
+    /// Upper bound (rad).
+    pub max: f64,
+}
+
+impl JointLimit {
+    /// Whether `q` (rad) lies within the limit (inclusive).
+    pub fn contains(&self, q: f64) -> bool {
+        q >= self.min && q <= self.max
+    }
+}
+
+/// A serial robot with revolute joints: parameter table, limits, base frame and tool.
+///
+/// The tool point is `pose(B) * T1 * ... * Tn * pose(T0 + T)` applied to the origin, where `B` is
+/// the base frame vector, `T0` the nominal tool vector (paper eq. 7) and `T` its correction (the
+/// paper's column T). All three are stored in mm and radians.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Robot {
+    name: String,
+    convention: Convention,
+    links: Vec<Link>,
+    beta_enabled: Vec<bool>,
+    limits: Vec<JointLimit>,
+    base: [f64; 6],
+    tool0: [f64; 6],
+    tool: [f64; 6],
+    // Caches derived from the above (kept valid by every mutator).
+    link_const: Vec<Frame>,
+    base_frame: Frame,
+    tool_frame: Frame,
+}
+
+impl Robot {
+    /// Builds a robot. Angles in radians, lengths in mm. Checks that every value is finite, that
+    /// limits are ordered, and that the chain has 1..=[`MAX_JOINTS`] joints.
+    pub fn new(
+        name: impl Into<String>,
+        convention: Convention,
+        links: Vec<Link>,
+        limits: Vec<JointLimit>,
+        base: [f64; 6],
+        tool0: [f64; 6],
+    ) -> Result<Self> {
+        let n = links.len();
+        if n == 0 || n > MAX_JOINTS {
+            return Err(Error::invalid(
+                "joints",
+                format!("a robot needs 1 to {MAX_JOINTS} joints, got {n}"),
+            ));
+        }
+        if limits.len() != n {
+            return Err(Error::invalid(
+                "limits",
+                format!("{} joint limits for {n} joints", limits.len()),
+            ));
+        }
+        for (i, l) in links.iter().enumerate() {
+            for (field, v) in [
+                ("alpha", l.alpha),
+                ("d", l.d),
+                ("a", l.a),
+                ("phi", l.phi),
+                ("beta", l.beta),
+            ] {
+                if !v.is_finite() {
+                    return Err(Error::invalid(
+                        format!("{field}{}", i + 1),
+                        "not a finite number",
+                    ));
+                }
+            }
+        }
+        for (i, l) in limits.iter().enumerate() {
+            if !l.min.is_finite() || !l.max.is_finite() {
+                return Err(Error::invalid(
+                    format!("limits of joint {}", i + 1),
+                    "not a finite number",
+                ));
+            }
+            if l.min > l.max {
+                return Err(Error::invalid(
+                    format!("limits of joint {}", i + 1),
+                    format!(
+                        "min {:.4} deg is greater than max {:.4} deg",
+                        l.min.to_degrees(),
+                        l.max.to_degrees()
+                    ),
+                ));
+            }
+        }
+        for (what, v) in [("base", &base), ("tool", &tool0)] {
+            if v.iter().any(|x| !x.is_finite()) {
+                return Err(Error::invalid(what, "not a finite number"));
+            }
+        }
+        let mut r = Robot {
+            name: name.into(),
+            convention,
+            beta_enabled: vec![false; n],
+            links,
+            limits,
+            base,
+            tool0,
+            tool: [0.0; 6],
+            link_const: Vec::new(),
+            base_frame: Frame::identity(),
+            tool_frame: Frame::identity(),
+        };
+        r.refresh();
+        Ok(r)
+    }
+
+    fn refresh(&mut self) {
+        self.link_const = self.links.iter().map(link_constant).collect();
+        self.base_frame = frame::pose(&self.base);
+        let mut t = self.tool0;
+        for (k, v) in t.iter_mut().enumerate() {
+            *v += self.tool[k];
+        }
+        self.tool_frame = frame::pose(&t);
+    }
+
+    /// The robot's name (preset name or the `name` of its file).
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Renames the robot.
+    pub fn set_name(&mut self, name: impl Into<String>) {
+        self.name = name.into();
+    }
+
+    /// The parameter-table convention.
+    pub fn convention(&self) -> Convention {
+        self.convention
+    }
+
+    /// Number of joints.
+    pub fn dof(&self) -> usize {
+        self.links.len()
+    }
+
+    /// The link parameters (mm, rad).
+    pub fn links(&self) -> &[Link] {
+        &self.links
+    }
+
+    /// The joint limits (rad).
+    pub fn limits(&self) -> &[JointLimit] {
+        &self.limits
+    }
+
+    /// Replaces the joint limits.
+    pub fn set_limits(&mut self, limits: Vec<JointLimit>) -> Result<()> {
+        if limits.len() != self.dof() {
+            return Err(Error::invalid(
+                "limits",
+                format!("{} joint limits for {} joints", limits.len(), self.dof()),
+            ));
+        }
+        self.limits = limits;
+        Ok(())
+    }
+
+    /// The base frame vector B (mm, rad).
+    pub fn base(&self) -> &[f64; 6] {
+        &self.base
+    }
+
+    /// The nominal tool vector T0 (mm, rad).
+    pub fn tool0(&self) -> &[f64; 6] {
+        &self.tool0
+    }
+
+    /// The tool correction T (mm, rad).
+    pub fn tool_correction(&self) -> &[f64; 6] {
+        &self.tool
+    }
+
+    /// The base frame `pose(B)`.
+    pub fn base_frame(&self) -> &Frame {
+        &self.base_frame
+    }
+
+    /// The tool frame relative to the flange, `pose(T0 + T)`.
+    pub fn tool_frame(&self) -> &Frame {
+        &self.tool_frame
+    }
+
+    /// The constant part of link i's transform: `Rx(alpha) Tx(a) Ry(beta)` (MDH, applied before
+    /// the joint rotation) or `Tx(a) Rx(alpha) Ry(beta)` (DH, applied after it).
+    pub(crate) fn link_constant(&self, i: usize) -> &Frame {
+        &self.link_const[i]
+    }
+
+    /// Whether the Hayati tilt of joint `i` (0-based) is a parameter.
+    pub fn beta_enabled(&self, i: usize) -> bool {
+        self.beta_enabled[i]
+    }
+
+    /// Makes the Hayati tilt `beta_{i+1}` a model parameter (it then appears in [`Robot::params`]
+    /// and can be identified). Use it for a joint whose axis is nominally parallel to the previous
+    /// one, where the tilt cannot be expressed by alpha/a/d/phi.
+    pub fn enable_beta(&mut self, i: usize) -> Result<()> {
+        if i >= self.dof() {
+            return Err(Error::invalid(
+                "beta",
+                format!("joint {} does not exist (robot has {})", i + 1, self.dof()),
+            ));
+        }
+        self.beta_enabled[i] = true;
+        Ok(())
+    }
+
+    /// Enables beta on every joint whose axis is nominally parallel to the previous joint's axis
+    /// (|alpha| below 1 degree for MDH; the previous link's |alpha| for DH). Returns the joints
+    /// (0-based) it enabled.
+    pub fn enable_beta_for_parallel_axes(&mut self) -> Vec<usize> {
+        let mut out = Vec::new();
+        for i in 1..self.dof() {
+            let alpha = match self.convention {
+                Convention::Mdh => self.links[i].alpha,
+                Convention::Dh => self.links[i - 1].alpha,
+            };
+            if alpha.sin().abs() < 1f64.to_radians().sin() {
+                let idx = match self.convention {
+                    Convention::Mdh => i,
+                    Convention::Dh => i - 1,
+                };
+                if !self.beta_enabled[idx] {
+                    self.beta_enabled[idx] = true;
+                    out.push(idx);
+                }
+            }
+        }
+        out
+    }
+
+    /// Every parameter of the model, in the DESIGN.md order: `alpha1..n, d1..n, a1..n, phi1..n`,
+    /// then enabled `beta`s, then `base_x..base_c`, `tool_x..tool_c` (36 for six joints without
+    /// beta, as in the paper).
+    pub fn params(&self) -> Vec<Param> {
+        let n = self.dof();
+        let mut v = Vec::with_capacity(4 * n + 12);
+        v.extend((0..n).map(Param::Alpha));
+        v.extend((0..n).map(Param::D));
+        v.extend((0..n).map(Param::A));
+        v.extend((0..n).map(Param::Phi));
+        v.extend((0..n).filter(|&i| self.beta_enabled[i]).map(Param::Beta));
+        v.extend((0..6).map(Param::Base));
+        v.extend((0..6).map(Param::Tool));
+        v
+    }
+
+    /// Number of parameters ([`Robot::params`]`.len()`).
+    pub fn param_count(&self) -> usize {
+        4 * self.dof() + self.beta_enabled.iter().filter(|b| **b).count() + 12
+    }
+
+    /// Looks a parameter up by its name (`alpha1`, `d2`, `beta3`, `base_x`, `tool_c`, ...).
+    pub fn param_by_name(&self, name: &str) -> Result<Param> {
+        match Param::parse(name) {
+            Some(p) if self.has_param(p) => Ok(p),
+            _ => Err(Error::UnknownParameter {
+                name: name.to_owned(),
+                known: self
+                    .params()
+                    .iter()
+                    .map(|p| p.name())
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }),
+        }
+    }
+
+    /// Whether the parameter exists in this model.
+    pub fn has_param(&self, p: Param) -> bool {
+        match p {
+            Param::Alpha(i) | Param::D(i) | Param::A(i) | Param::Phi(i) => i < self.dof(),
+            Param::Beta(i) => i < self.dof() && self.beta_enabled[i],
+            Param::Base(k) | Param::Tool(k) => k < 6,
+        }
+    }
+
+    /// A parameter's value in internal units (mm or radians). For `tool_*` this is the correction
+    /// T, not T0 + T.
+    pub fn get(&self, p: Param) -> f64 {
+        match p {
+            Param::Alpha(i) => self.links[i].alpha,
+            Param::D(i) => self.links[i].d,
+            Param::A(i) => self.links[i].a,
+            Param::Phi(i) => self.links[i].phi,
+            Param::Beta(i) => self.links[i].beta,
+            Param::Base(k) => self.base[k],
+            Param::Tool(k) => self.tool[k],
+        }
+    }
+
+    /// Sets a parameter in internal units (mm or radians). Panics if `p` is not a parameter of
+    /// this robot (a programming error; names from users go through [`Robot::param_by_name`]).
+    pub fn set(&mut self, p: Param, value: f64) {
+        match p {
+            Param::Alpha(i) => self.links[i].alpha = value,
+            Param::D(i) => self.links[i].d = value,
+            Param::A(i) => self.links[i].a = value,
+            Param::Phi(i) => self.links[i].phi = value,
+            Param::Beta(i) => self.links[i].beta = value,
+            Param::Base(k) => self.base[k] = value,
+            Param::Tool(k) => self.tool[k] = value,
+        }
+        match p {
+            Param::Alpha(i) | Param::D(i) | Param::A(i) | Param::Phi(i) | Param::Beta(i) => {
+                self.link_const[i] = link_constant(&self.links[i])
+            }
+            Param::Base(_) => self.base_frame = frame::pose(&self.base),
+            Param::Tool(_) => {
+                let mut t = self.tool0;
+                for (k, v) in t.iter_mut().enumerate() {
+                    *v += self.tool[k];
+                }
+                self.tool_frame = frame::pose(&t);
+            }
+        }
+    }
+
+    /// A parameter's value in display units (mm or degrees).
+    pub fn get_display(&self, p: Param) -> f64 {
+        p.unit().from_internal(self.get(p))
+    }
+
+    /// Sets a parameter from display units (mm or degrees).
+    pub fn set_display(&mut self, p: Param, value: f64) {
+        self.set(p, p.unit().to_internal(value))
+    }
+
+    /// All parameter values in internal units, in [`Robot::params`] order.
+    pub fn values(&self) -> Vec<f64> {
+        self.params().into_iter().map(|p| self.get(p)).collect()
+    }
+
+    /// Sets all parameters from `values` (internal units, [`Robot::params`] order).
+    pub fn set_values(&mut self, values: &[f64]) -> Result<()> {
+        let ps = self.params();
+        if ps.len() != values.len() {
+            return Err(Error::invalid(
+                "parameters",
+                format!("{} values for {} parameters", values.len(), ps.len()),
+            ));
+        }
+        for (p, v) in ps.into_iter().zip(values) {
+            self.set(p, *v);
+        }
+        Ok(())
+    }
+
+    /// Checks a joint vector (rad): length and finiteness. `context` names its origin in errors.
+    pub fn check_joints(&self, q: &[f64], context: &str) -> Result<()> {
+        if q.len() != self.dof() {
+            return Err(Error::JointCount {
+                context: context.to_owned(),
+                expected: self.dof(),
+                got: q.len(),
+            });
+        }
+        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+            return Err(Error::invalid(
+                format!("{context}: q{}", i + 1),
+                "not a finite number",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The joints (0-based) whose value in `q` (rad) lies outside the limits.
+    pub fn joints_outside_limits(&self, q: &[f64]) -> Vec<usize> {
+        q.iter()
+            .zip(&self.limits)
+            .enumerate()
+            .filter(|(_, (v, l))| !l.contains(**v))
+            .map(|(i, _)| i)
+            .collect()
+    }
+}
+
+/// The constant part of a link transform (see [`Robot::link_constant`]).
+///
+/// Both conventions give the same frame: `Rx(alpha) Tx(a) Ry(beta)` (MDH) and
+/// `Tx(a) Rx(alpha) Ry(beta)` (DH) are equal because Rx leaves the x translation unchanged; the
+/// conventions differ in whether it stands before or after the joint rotation.
+fn link_constant(l: &Link) -> Frame {
+    frame::frame(
+        frame::rot_x(l.alpha) * frame::rot_y(l.beta),
+        Vector3::new(l.a, 0.0, 0.0),
+    )
+}
+
+/// Rotation matrix helper used by kinematics: `m * Rz(c, s)` computed by columns.
+#[inline]
+pub(crate) fn mul_rot_z(m: &Matrix3<f64>, s: f64, c: f64) -> Matrix3<f64> {
+    let c0 = m.column(0);
+    let c1 = m.column(1);
+    Matrix3::from_columns(&[c0 * c + c1 * s, c1 * c - c0 * s, m.column(2).into()])
+}
