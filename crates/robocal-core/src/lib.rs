@@ -12,8 +12,11 @@
 
 pub mod error;
 pub mod frame;
+pub mod io;
 pub mod kinematics;
 pub mod model;
+pub mod simulation;
+pub mod stats;
 
 pub use error::{Error, Result};
 pub use frame::{frame_vector, pose, Frame};
@@ -21,3 +24,4 @@ pub use kinematics::poe::{Poe, Twist};
 pub use model::presets::{preset, PRESETS};
 pub use model::robot_file::{load_robot, load_robot_file, parse_robot_toml};
 pub use model::{Convention, JointLimit, Link, Param, Robot, Unit, MAX_JOINTS};
+pub use stats::ErrorStats;

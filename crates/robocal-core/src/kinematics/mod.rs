@@ -115,8 +115,8 @@ impl Robot {
         let org = |f: &Frame| -> Vector3<f64> { f.translation.vector };
         if let Some(jq) = jq {
             assert_eq!(jq.len(), n, "joint Jacobian length");
-            for i in 0..n {
-                jq[i] = col(&ch.axis[i], 2).cross(&(p - org(&ch.axis[i])));
+            for (j, f) in jq.iter_mut().zip(&ch.axis[..n]) {
+                *j = col(f, 2).cross(&(p - org(f)));
             }
         }
         let Some(jp) = jp else { return p };

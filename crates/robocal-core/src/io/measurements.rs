@@ -1,0 +1,394 @@
+//! Measurement CSV files (DESIGN.md): a header row, columns `q1..qn` (joint values, degrees) and
+//! `x,y,z` (mm, tracker frame); other columns (`id`, `set`, ...) are carried through.
+//!
+//! The same reader serves joint-only files (desired or commanded joints) with
+//! [`Positions::Forbidden`] or [`Positions::Optional`]. CRLF line endings and a UTF-8 byte-order
+//! mark are accepted. Every rejection names the file, the line and the column.
+
+use crate::error::{Error, Result};
+use crate::io::atomic::AtomicFile;
+use nalgebra::Vector3;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+/// Whether a file must, may or must not have `x,y,z` columns.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Positions {
+    /// `x,y,z` are required (measurement files).
+    Required,
+    /// `x,y,z` are read when present.
+    Optional,
+    /// `x,y,z` are ignored: carried through as extra columns (joint files).
+    Ignored,
+}
+
+/// One row of a measurement file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measurement {
+    /// 1-based line of the row in the file.
+    pub line: usize,
+    /// Joint values (model values, radians).
+    pub q: Vec<f64>,
+    /// Measured tool point (mm, tracker frame), when the file has positions.
+    pub p: Option<Vector3<f64>>,
+    /// The row's values of the extra columns, in [`MeasurementSet::extra_columns`] order.
+    pub extra: Vec<String>,
+}
+
+/// A whole measurement (or joint) file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeasurementSet {
+    /// The file it was read from (for messages).
+    pub path: PathBuf,
+    /// Number of joints.
+    pub dof: usize,
+    /// Names of the columns other than `q1..qn` and `x,y,z`, in file order.
+    pub extra_columns: Vec<String>,
+    /// The rows, in file order.
+    pub rows: Vec<Measurement>,
+    /// Things worth telling the user that do not stop the run (e.g. values that look like radians).
+    pub warnings: Vec<String>,
+}
+
+impl MeasurementSet {
+    /// Whether every row has a position.
+    pub fn has_positions(&self) -> bool {
+        !self.rows.is_empty() && self.rows.iter().all(|r| r.p.is_some())
+    }
+
+    /// Pairs of lines `(first, repeat)` whose joint values are identical.
+    pub fn duplicate_poses(&self) -> Vec<(usize, usize)> {
+        let mut idx: Vec<usize> = (0..self.rows.len()).collect();
+        let key = |i: usize| -> Vec<u64> { self.rows[i].q.iter().map(|v| v.to_bits()).collect() };
+        idx.sort_by_key(|&i| key(i));
+        let mut out = Vec::new();
+        for w in idx.windows(2) {
+            if key(w[0]) == key(w[1]) {
+                let (a, b) = (self.rows[w[0]].line, self.rows[w[1]].line);
+                out.push((a.min(b), a.max(b)));
+            }
+        }
+        out.sort();
+        out
+    }
+
+    /// The column value of an extra column for a row, by name.
+    pub fn extra_value<'a>(&self, row: &'a Measurement, column: &str) -> Option<&'a str> {
+        self.extra_columns
+            .iter()
+            .position(|c| c == column)
+            .map(|k| row.extra[k].as_str())
+    }
+}
+
+/// Reads a measurement CSV for a robot with `dof` joints.
+pub fn read_measurements(path: &Path, dof: usize, positions: Positions) -> Result<MeasurementSet> {
+    let file = std::fs::File::open(path).map_err(|e| Error::Io {
+        path: path.to_owned(),
+        source: e,
+    })?;
+    parse_measurements(std::io::BufReader::new(file), path, dof, positions)
+}
+
+fn is_joint_column(name: &str) -> Option<usize> {
+    let num = name.strip_prefix('q')?;
+    if num.is_empty() || !num.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    num.parse().ok()
+}
+
+/// Parses measurement CSV text from any reader; `path` is used in messages.
+pub fn parse_measurements<R: Read>(
+    reader: R,
+    path: &Path,
+    dof: usize,
+    positions: Positions,
+) -> Result<MeasurementSet> {
+    let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
+        Error::parse(path, line, field, msg)
+    };
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .flexible(false)
+        .from_reader(reader);
+    let headers = rdr
+        .headers()
+        .map_err(|e| csv_error(path, e))?
+        .iter()
+        .map(|h| h.trim_start_matches('\u{feff}').to_owned())
+        .collect::<Vec<_>>();
+    if headers.is_empty() || headers.iter().all(|h| h.is_empty()) {
+        return Err(perr(
+            Some(1),
+            None,
+            format!("empty file: expected a header row with q1..q{dof} and x,y,z"),
+        ));
+    }
+    let mut q_col = vec![None; dof];
+    let mut xyz_col = [None; 3];
+    let mut extra = Vec::new();
+    let mut extra_columns = Vec::new();
+    for (k, h) in headers.iter().enumerate() {
+        if h.is_empty() {
+            return Err(perr(
+                Some(1),
+                None,
+                format!("column {} has an empty name", k + 1),
+            ));
+        }
+        if headers[..k].contains(h) {
+            return Err(perr(Some(1), Some(h), "column appears twice".into()));
+        }
+        if let Some(j) = is_joint_column(h) {
+            if j == 0 || j > dof {
+                return Err(perr(
+                    Some(1),
+                    Some(h),
+                    format!(
+                        "the robot has {dof} joints (q1..q{dof}); this file has a column `{h}`"
+                    ),
+                ));
+            }
+            q_col[j - 1] = Some(k);
+            continue;
+        }
+        let axis = ["x", "y", "z"].iter().position(|a| a == h);
+        match (axis, positions) {
+            (Some(a), Positions::Required | Positions::Optional) => xyz_col[a] = Some(k),
+            _ => {
+                extra.push(k);
+                extra_columns.push(h.clone());
+            }
+        }
+    }
+    if let Some(j) = q_col.iter().position(Option::is_none) {
+        return Err(perr(
+            Some(1),
+            Some(&format!("q{}", j + 1)),
+            format!(
+                "missing column (the robot has {dof} joints: q1..q{dof}; header is `{}`)",
+                headers.join(",")
+            ),
+        ));
+    }
+    let n_xyz = xyz_col.iter().filter(|c| c.is_some()).count();
+    if positions == Positions::Required || n_xyz > 0 {
+        if let Some(a) = xyz_col.iter().position(Option::is_none) {
+            return Err(perr(
+                Some(1),
+                Some(["x", "y", "z"][a]),
+                "missing column (measured positions need x,y,z in mm)".into(),
+            ));
+        }
+    }
+    let has_xyz = n_xyz == 3;
+    let mut rows = Vec::new();
+    let mut record = csv::StringRecord::new();
+    loop {
+        match rdr.read_record(&mut record) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => return Err(csv_error(path, e)),
+        }
+        let line = record.position().map(|p| p.line() as usize).unwrap_or(0);
+        if record.iter().all(|f| f.is_empty()) {
+            continue;
+        }
+        let num = |k: usize| -> Result<f64> {
+            let s = &record[k];
+            let field = Some(headers[k].as_str());
+            if s.is_empty() {
+                return Err(perr(Some(line), field, "empty cell".into()));
+            }
+            let v: f64 = s
+                .parse()
+                .map_err(|_| perr(Some(line), field, format!("`{s}` is not a number")))?;
+            if !v.is_finite() {
+                return Err(perr(
+                    Some(line),
+                    field,
+                    format!("`{s}` is not a finite number"),
+                ));
+            }
+            Ok(v)
+        };
+        let mut q = Vec::with_capacity(dof);
+        for c in &q_col {
+            q.push(num(c.expect("checked"))?.to_radians());
+        }
+        let p = if has_xyz {
+            Some(Vector3::new(
+                num(xyz_col[0].expect("checked"))?,
+                num(xyz_col[1].expect("checked"))?,
+                num(xyz_col[2].expect("checked"))?,
+            ))
+        } else {
+            None
+        };
+        rows.push(Measurement {
+            line,
+            q,
+            p,
+            extra: extra.iter().map(|&k| record[k].to_owned()).collect(),
+        });
+    }
+    if rows.is_empty() {
+        return Err(perr(
+            None,
+            None,
+            "no data rows after the header".to_string(),
+        ));
+    }
+    let mut warnings = Vec::new();
+    let max_abs_deg = rows
+        .iter()
+        .flat_map(|r| r.q.iter())
+        .fold(0.0f64, |m, v| m.max(v.to_degrees().abs()));
+    if rows.len() >= 3 && max_abs_deg > 0.0 && max_abs_deg <= std::f64::consts::PI + 1e-9 {
+        warnings.push(format!(
+            "{}: every joint value is within ±{:.3}; they look like radians, but files hold degrees",
+            path.display(),
+            max_abs_deg
+        ));
+    }
+    Ok(MeasurementSet {
+        path: path.to_owned(),
+        dof,
+        extra_columns,
+        rows,
+        warnings,
+    })
+}
+
+fn csv_error(path: &Path, e: csv::Error) -> Error {
+    let line = e.position().map(|p| p.line() as usize);
+    let msg = match e.kind() {
+        csv::ErrorKind::UnequalLengths {
+            expected_len, len, ..
+        } => format!("{len} fields, but the header has {expected_len}"),
+        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_owned(),
+        csv::ErrorKind::Io(io) => io.to_string(),
+        _ => e.to_string(),
+    };
+    Error::parse(path, line, None, msg)
+}
+
+/// Writes a measurement (or joint) CSV atomically: `q1..qn` in degrees, then `x,y,z` in mm if
+/// every row has a position, then the extra columns.
+pub fn write_measurements(path: &Path, set: &MeasurementSet) -> Result<()> {
+    let mut out = AtomicFile::create(path)?;
+    let io = |e: std::io::Error| Error::Io {
+        path: path.to_owned(),
+        source: e,
+    };
+    let with_p = set.has_positions();
+    let mut header: Vec<String> = (1..=set.dof).map(|i| format!("q{i}")).collect();
+    if with_p {
+        header.extend(["x", "y", "z"].map(String::from));
+    }
+    header.extend(set.extra_columns.iter().cloned());
+    {
+        let mut w = csv::Writer::from_writer(&mut out);
+        w.write_record(&header)
+            .map_err(|e| io(std::io::Error::other(e)))?;
+        let mut fields = Vec::with_capacity(header.len());
+        for r in &set.rows {
+            fields.clear();
+            fields.extend(r.q.iter().map(|v| format!("{:.9}", v.to_degrees())));
+            if let (true, Some(p)) = (with_p, r.p) {
+                fields.extend([p.x, p.y, p.z].iter().map(|v| format!("{v:.6}")));
+            }
+            fields.extend(r.extra.iter().cloned());
+            w.write_record(&fields)
+                .map_err(|e| io(std::io::Error::other(e)))?;
+        }
+        w.flush().map_err(io)?;
+    }
+    out.flush().map_err(io)?;
+    out.commit()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(s: &str, pos: Positions) -> Result<MeasurementSet> {
+        parse_measurements(s.as_bytes(), Path::new("m.csv"), 2, pos)
+    }
+
+    #[test]
+    fn reads_and_carries_extra_columns() {
+        let s = parse(
+            "id,q1,q2,x,y,z\na,10,20,1,2,3\nb,30,-40,4,5,6\n",
+            Positions::Required,
+        )
+        .unwrap();
+        assert_eq!(s.rows.len(), 2);
+        assert_eq!(s.extra_columns, vec!["id"]);
+        assert_eq!(s.rows[1].extra, vec!["b"]);
+        assert_eq!(s.rows[1].line, 3);
+        assert!((s.rows[1].q[1] + 40f64.to_radians()).abs() < 1e-15);
+        assert_eq!(s.rows[0].p, Some(Vector3::new(1.0, 2.0, 3.0)));
+    }
+
+    #[test]
+    fn crlf_and_bom_accepted() {
+        let s = parse(
+            "\u{feff}q1,q2,x,y,z\r\n10,20,1,2,3\r\n",
+            Positions::Required,
+        )
+        .unwrap();
+        assert_eq!(s.rows.len(), 1);
+        assert_eq!(s.rows[0].p.unwrap().z, 3.0);
+    }
+
+    fn err(s: &str, pos: Positions) -> String {
+        parse(s, pos).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn rejections_name_line_and_column() {
+        let e = err("q1,q2,x,y,z\n1,2,3,4,abc\n", Positions::Required);
+        assert!(
+            e.contains("m.csv:2: field `z`: `abc` is not a number"),
+            "{e}"
+        );
+        let e = err("q1,q2,x,y,z\n1,2,3,4,5\n1,NaN,3,4,5\n", Positions::Required);
+        assert!(e.contains("m.csv:3: field `q2`"), "{e}");
+        let e = err("q1,x,y,z\n1,3,4,5\n", Positions::Required);
+        assert!(e.contains("field `q2`: missing column"), "{e}");
+        let e = err("q1,q2,q3,x,y,z\n1,2,3,3,4,5\n", Positions::Required);
+        assert!(e.contains("field `q3`") && e.contains("2 joints"), "{e}");
+        let e = err("q1,q2,x,y\n1,2,3,4\n", Positions::Required);
+        assert!(e.contains("field `z`: missing column"), "{e}");
+        let e = err("q1,q2,x,y,z\n", Positions::Required);
+        assert!(e.contains("no data rows"), "{e}");
+        let e = err("", Positions::Required);
+        assert!(e.contains("empty file"), "{e}");
+        let e = err("q1,q2,x,y,z\n1,2,3,4\n", Positions::Required);
+        assert!(e.contains("m.csv:2") && e.contains("4 fields"), "{e}");
+    }
+
+    #[test]
+    fn joint_files_and_warnings() {
+        let s = parse("q1,q2\n0.1,0.2\n0.3,-1\n1.2,0.5\n", Positions::Ignored).unwrap();
+        assert!(!s.has_positions());
+        assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+        let s = parse("q1,q2\n10,20\n10,20\n", Positions::Optional).unwrap();
+        assert_eq!(s.duplicate_poses(), vec![(2, 3)]);
+    }
+
+    #[test]
+    fn write_then_read_roundtrip() {
+        let s = parse("id,q1,q2,x,y,z\na,10,20,1,2,3\n", Positions::Required).unwrap();
+        let p = std::env::temp_dir().join(format!("robocal-m-{}.csv", std::process::id()));
+        write_measurements(&p, &s).unwrap();
+        let t = read_measurements(&p, 2, Positions::Required).unwrap();
+        std::fs::remove_file(&p).unwrap();
+        assert_eq!(t.rows[0].extra, s.rows[0].extra);
+        assert!((t.rows[0].q[0] - s.rows[0].q[0]).abs() < 1e-12);
+        assert_eq!(t.rows[0].p, s.rows[0].p);
+    }
+}

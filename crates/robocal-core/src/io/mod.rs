@@ -1,0 +1,12 @@
+//! File formats: measurement CSV, atomic output, calibration results.
+
+pub mod atomic;
+pub mod measurements;
+pub mod result;
+
+pub use atomic::{write_all_atomic, write_atomic, AtomicFile};
+pub use measurements::{
+    parse_measurements, read_measurements, write_measurements, Measurement, MeasurementSet,
+    Positions,
+};
+pub use result::CalibrationResult;

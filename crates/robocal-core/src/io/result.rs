@@ -1,0 +1,262 @@
+//! The calibration result JSON (DESIGN.md "Result JSON"): what `robocal calibrate --out` writes
+//! and `fk`, `evaluate`, `compensate` and `report` read.
+//!
+//! The contract keys (`parameters`, `tracker_frame`, `errors`) are typed; other keys are kept in
+//! [`CalibrationResult::extra`] so that a file written by a newer robocal still reads.
+
+use crate::error::{Error, Result};
+use crate::frame::{self, Frame};
+use crate::model::{Param, Robot, Unit};
+use crate::stats::ErrorStats;
+use indexmap::IndexMap;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Which robot a result belongs to.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RobotInfo {
+    /// The robot's name.
+    pub name: String,
+    /// Number of joints.
+    pub dof: usize,
+    /// `"mdh"` or `"dh"`.
+    pub convention: String,
+}
+
+/// One parameter's entry: nominal and calibrated value in display units.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ParamEntry {
+    /// Nominal value (mm or deg).
+    pub nominal: f64,
+    /// Calibrated value (mm or deg).
+    pub calibrated: f64,
+    /// `"mm"` or `"deg"`.
+    pub unit: Unit,
+    /// Whether the parameter was held at its nominal value.
+    pub fixed: bool,
+    /// Standard deviation of the estimate (same unit), for identified parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub std: Option<f64>,
+    /// Why a fixed parameter was fixed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+}
+
+/// A frame vector in mm and degrees, as a JSON object.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FrameVec {
+    /// x (mm).
+    pub x: f64,
+    /// y (mm).
+    pub y: f64,
+    /// z (mm).
+    pub z: f64,
+    /// A, rotation about z (deg).
+    pub a: f64,
+    /// B, rotation about y (deg).
+    pub b: f64,
+    /// C, rotation about x (deg).
+    pub c: f64,
+}
+
+impl FrameVec {
+    /// From a frame.
+    pub fn from_frame(f: &Frame) -> FrameVec {
+        let v = frame::vec_rad_to_deg(&frame::frame_vector(f));
+        FrameVec {
+            x: v[0],
+            y: v[1],
+            z: v[2],
+            a: v[3],
+            b: v[4],
+            c: v[5],
+        }
+    }
+
+    /// To a frame.
+    pub fn to_frame(&self) -> Frame {
+        frame::pose(&frame::vec_deg_to_rad(&[
+            self.x, self.y, self.z, self.a, self.b, self.c,
+        ]))
+    }
+}
+
+/// Error statistics before (nominal model, fitted frame) and after calibration.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct BeforeAfter {
+    /// Nominal model after the measurement frame is fitted (Table II).
+    pub before: ErrorStats,
+    /// Calibrated model (Table IV).
+    pub after: ErrorStats,
+}
+
+/// The `errors` object.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ErrorTables {
+    /// On the calibration points.
+    pub calibration: BeforeAfter,
+    /// On the validation points (only with `--validate`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub validation: Option<BeforeAfter>,
+}
+
+/// A calibration result file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CalibrationResult {
+    /// The robot the result was made for.
+    pub robot: RobotInfo,
+    /// Every model parameter, in model order.
+    pub parameters: IndexMap<String, ParamEntry>,
+    /// Pose of the tracker frame in the base frame: a measured point p maps to
+    /// `pose(tracker_frame) * p`.
+    pub tracker_frame: FrameVec,
+    /// Error tables.
+    pub errors: ErrorTables,
+    /// Any further keys (identifiability, solver report, settings, ...).
+    #[serde(flatten)]
+    pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+impl CalibrationResult {
+    /// Reads a result file, naming the file and line on malformed JSON or missing keys.
+    pub fn read(path: &Path) -> Result<CalibrationResult> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
+            path: path.to_owned(),
+            source: e,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses result JSON; `path` is used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<CalibrationResult> {
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let r: CalibrationResult = serde_json::from_str(text).map_err(|e| {
+            let line = (e.line() > 0).then_some(e.line());
+            let msg = e.to_string();
+            // serde_json appends " at line L column C"; the line is reported separately.
+            let msg = msg.split(" at line ").next().unwrap_or(&msg).to_owned();
+            Error::parse(path, line, None, format!("not a robocal result: {msg}"))
+        })?;
+        for (name, p) in &r.parameters {
+            if !p.nominal.is_finite() || !p.calibrated.is_finite() {
+                return Err(Error::parse(
+                    path,
+                    None,
+                    Some(&format!("parameters.{name}")),
+                    "not a finite number",
+                ));
+            }
+        }
+        let t = &r.tracker_frame;
+        if [t.x, t.y, t.z, t.a, t.b, t.c]
+            .iter()
+            .any(|v| !v.is_finite())
+        {
+            return Err(Error::parse(
+                path,
+                None,
+                Some("tracker_frame"),
+                "not a finite number",
+            ));
+        }
+        Ok(r)
+    }
+
+    /// Writes the result atomically as pretty JSON.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let mut s = serde_json::to_string_pretty(self)
+            .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
+        s.push('\n');
+        crate::io::atomic::write_atomic(path, s.as_bytes())
+    }
+
+    /// The tracker frame as a rigid transform.
+    pub fn tracker_frame(&self) -> Frame {
+        self.tracker_frame.to_frame()
+    }
+
+    /// Applies the calibrated values to `nominal` (the robot given on the command line), checking
+    /// that the result was made for a robot of the same shape. `path` names the result file in
+    /// errors. Parameters like `beta2` that the result has and the robot lacks are enabled.
+    pub fn calibrated_robot(&self, nominal: &Robot, path: &Path) -> Result<Robot> {
+        let bad = |field: &str, msg: String| Error::parse(path, None, Some(field), msg);
+        if self.robot.dof != nominal.dof() {
+            return Err(bad(
+                "robot.dof",
+                format!(
+                    "result is for a {}-joint robot ({}), the robot given has {} joints",
+                    self.robot.dof,
+                    self.robot.name,
+                    nominal.dof()
+                ),
+            ));
+        }
+        if self.robot.convention != nominal.convention().as_str() {
+            return Err(bad(
+                "robot.convention",
+                format!(
+                    "result uses {} parameters, the robot given uses {}",
+                    self.robot.convention,
+                    nominal.convention().as_str()
+                ),
+            ));
+        }
+        let mut r = nominal.clone();
+        for name in self.parameters.keys() {
+            if let Some(Param::Beta(i)) = Param::parse(name) {
+                if i < r.dof() {
+                    r.enable_beta(i)?;
+                }
+            }
+        }
+        for p in r.params() {
+            let name = p.name();
+            let Some(e) = self.parameters.get(&name) else {
+                return Err(bad("parameters", format!("parameter `{name}` is missing")));
+            };
+            if e.unit != p.unit() {
+                return Err(bad(
+                    &format!("parameters.{name}.unit"),
+                    format!("expected {}", p.unit().as_str()),
+                ));
+            }
+            r.set_display(p, e.calibrated);
+        }
+        for name in self.parameters.keys() {
+            if r.param_by_name(name).is_err() {
+                return Err(bad(
+                    &format!("parameters.{name}"),
+                    format!("not a parameter of robot `{}`", nominal.name()),
+                ));
+            }
+        }
+        Ok(r)
+    }
+
+    /// The parameter table of a robot as result entries (nominal from `nominal`, calibrated from
+    /// `calibrated`); `fixed`, `std` and `reason` are left for the caller.
+    pub fn parameter_entries(nominal: &Robot, calibrated: &Robot) -> IndexMap<String, ParamEntry> {
+        calibrated
+            .params()
+            .into_iter()
+            .map(|p| {
+                let nom = if nominal.has_param(p) {
+                    nominal.get_display(p)
+                } else {
+                    0.0
+                };
+                (
+                    p.name(),
+                    ParamEntry {
+                        nominal: nom,
+                        calibrated: calibrated.get_display(p),
+                        unit: p.unit(),
+                        fixed: false,
+                        std: None,
+                        reason: None,
+                    },
+                )
+            })
+            .collect()
+    }
+}

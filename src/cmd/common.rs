@@ -1,0 +1,73 @@
+//! Helpers shared by the subcommands.
+
+use anyhow::Context;
+use robocal_core::io::CalibrationResult;
+use robocal_core::{load_robot, Robot};
+use std::path::Path;
+
+/// The robot of `--robot NAME|FILE`.
+pub fn robot(arg: &str) -> anyhow::Result<Robot> {
+    load_robot(arg).with_context(|| format!("--robot {arg}"))
+}
+
+/// A nominal robot and, with `--params RESULT.json`, the calibrated one and its result.
+pub struct Model {
+    /// The nominal robot.
+    pub nominal: Robot,
+    /// The calibrated robot and the result it came from.
+    pub calibrated: Option<(Robot, CalibrationResult)>,
+}
+
+impl Model {
+    /// The calibrated robot if there is one, else the nominal.
+    pub fn active(&self) -> &Robot {
+        self.calibrated.as_ref().map_or(&self.nominal, |c| &c.0)
+    }
+}
+
+/// Loads `--robot` and optional `--params`.
+pub fn model(robot_arg: &str, params: Option<&Path>) -> anyhow::Result<Model> {
+    let nominal = robot(robot_arg)?;
+    let calibrated = match params {
+        None => None,
+        Some(p) => {
+            let res = CalibrationResult::read(p)?;
+            let cal = res.calibrated_robot(&nominal, p)?;
+            Some((cal, res))
+        }
+    };
+    Ok(Model {
+        nominal,
+        calibrated,
+    })
+}
+
+/// Parses `--joints q1,...,qn` (degrees) into radians, checking count and finiteness.
+pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
+    let mut q = Vec::new();
+    for (i, part) in s.split(',').enumerate() {
+        let part = part.trim();
+        let v: f64 = part.parse().map_err(|_| {
+            crate::exit::usage(format!(
+                "--joints: value {} `{part}` is not a number",
+                i + 1
+            ))
+        })?;
+        if !v.is_finite() {
+            return Err(crate::exit::usage(format!(
+                "--joints: value {} `{part}` is not a finite number",
+                i + 1
+            )));
+        }
+        q.push(v.to_radians());
+    }
+    if q.len() != robot.dof() {
+        return Err(crate::exit::usage(format!(
+            "--joints: robot `{}` has {} joints, got {} values",
+            robot.name(),
+            robot.dof(),
+            q.len()
+        )));
+    }
+    Ok(q)
+}

@@ -1,0 +1,53 @@
+//! `robocal fk`: forward kinematics.
+
+use super::common;
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct FkArgs {
+    /// A preset name or a TOML robot file.
+    #[arg(long)]
+    robot: String,
+    /// Joint values q1,...,qn in degrees (model joint values).
+    #[arg(long, allow_hyphen_values = true)]
+    joints: String,
+    /// Use the calibrated model of a result file (`robocal calibrate --out`).
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Print JSON: {"x":..,"y":..,"z":..} in mm.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(a: FkArgs) -> anyhow::Result<()> {
+    let m = common::model(&a.robot, a.params.as_deref())?;
+    let r = m.active();
+    let q = common::joints_arg(&a.joints, r)?;
+    let pose = r.tool_pose(&q);
+    let p = pose.translation.vector;
+    if a.json {
+        println!("{}", serde_json::json!({ "x": p.x, "y": p.y, "z": p.z }));
+    } else {
+        let v = robocal_core::frame::vec_rad_to_deg(&robocal_core::frame_vector(&pose));
+        println!(
+            "tool position (mm, base frame): x = {:.4}  y = {:.4}  z = {:.4}",
+            p.x, p.y, p.z
+        );
+        println!(
+            "tool orientation (deg, A B C):     A = {:.4}  B = {:.4}  C = {:.4}",
+            v[3], v[4], v[5]
+        );
+        let out = r.joints_outside_limits(&q);
+        if !out.is_empty() {
+            eprintln!(
+                "warning: joint(s) {} outside the robot's limits",
+                out.iter()
+                    .map(|i| format!("q{}", i + 1))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+    }
+    Ok(())
+}

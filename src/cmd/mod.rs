@@ -1,0 +1,34 @@
+//! Command-line interface: one module per subcommand.
+
+mod common;
+mod fk;
+mod robot;
+
+use clap::{Parser, Subcommand};
+
+/// Kinematic calibration of industrial robots from laser-tracker measurements.
+///
+/// Units everywhere: millimetres and degrees. Joint values are model joint values.
+#[derive(Parser, Debug)]
+#[command(name = "robocal", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Robot models: show a preset or a robot file.
+    #[command(subcommand)]
+    Robot(robot::RobotCmd),
+    /// Forward kinematics: the tool position for given joint values.
+    Fk(fk::FkArgs),
+}
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Robot(c) => robot::run(c),
+        Command::Fk(a) => fk::run(a),
+    }
+}

@@ -1,0 +1,66 @@
+//! `robocal robot show`.
+
+use super::common;
+use clap::{Args, Subcommand};
+use std::path::PathBuf;
+
+#[derive(Subcommand, Debug)]
+pub enum RobotCmd {
+    /// Print a robot's parameter table (the layout of the paper's Table I), tool and limits.
+    Show(ShowArgs),
+    /// List the built-in presets.
+    List,
+}
+
+#[derive(Args, Debug)]
+pub struct ShowArgs {
+    /// A preset name (see `robocal robot list`) or a TOML robot file.
+    robot: String,
+    /// Show the calibrated parameters of a result file instead of the nominal ones.
+    #[arg(long)]
+    params: Option<PathBuf>,
+}
+
+pub fn run(c: RobotCmd) -> anyhow::Result<()> {
+    match c {
+        RobotCmd::List => {
+            for p in robocal_core::PRESETS {
+                println!("{p}");
+            }
+            Ok(())
+        }
+        RobotCmd::Show(a) => {
+            let m = common::model(&a.robot, a.params.as_deref())?;
+            let r = m.active();
+            let label = if m.calibrated.is_some() {
+                "calibrated parameters"
+            } else {
+                "parameters"
+            };
+            println!(
+                "{} ({} joints, {}), {label}:",
+                r.name(),
+                r.dof(),
+                match r.convention() {
+                    robocal_core::Convention::Mdh => "modified DH (Craig)",
+                    robocal_core::Convention::Dh => "standard DH",
+                }
+            );
+            print!("{}", crate::tables::parameter_table(r, 4));
+            let t0 = robocal_core::frame::vec_rad_to_deg(r.tool0());
+            println!(
+                "T0 (nominal tool, mm/deg): [{}]",
+                t0.iter()
+                    .map(|v| format!("{v}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+            println!("Joint limits (deg, model joint values):");
+            for (i, l) in r.limits().iter().enumerate() {
+                let r6 = |v: f64| (v.to_degrees() * 1e6).round() / 1e6;
+                println!("  q{}: {} .. {}", i + 1, r6(l.min), r6(l.max));
+            }
+            Ok(())
+        }
+    }
+}

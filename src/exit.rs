@@ -1,0 +1,86 @@
+//! Exit codes (documented in README.md).
+
+/// Success.
+#[allow(dead_code)]
+pub const OK: i32 = 0;
+/// An unexpected internal failure.
+pub const INTERNAL: i32 = 1;
+/// Bad command-line usage (clap uses this code too).
+pub const USAGE: i32 = 2;
+/// Bad input data: a malformed or inconsistent file or value.
+pub const INPUT: i32 = 3;
+/// A file could not be read or written.
+pub const IO: i32 = 4;
+/// A numerical failure: no convergence, too few points, unidentifiable model.
+pub const NUMERICAL: i32 = 5;
+
+/// An error raised by the CLI itself with an explicit exit code.
+#[derive(Debug)]
+pub struct CliError {
+    /// The exit code.
+    pub code: i32,
+    /// The message.
+    pub message: String,
+}
+
+impl std::fmt::Display for CliError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.message)
+    }
+}
+
+impl std::error::Error for CliError {}
+
+/// A usage error (exit code 2).
+pub fn usage(message: impl Into<String>) -> anyhow::Error {
+    CliError {
+        code: USAGE,
+        message: message.into(),
+    }
+    .into()
+}
+
+/// A bad-input error (exit code 3).
+#[allow(dead_code)]
+pub fn input(message: impl Into<String>) -> anyhow::Error {
+    CliError {
+        code: INPUT,
+        message: message.into(),
+    }
+    .into()
+}
+
+/// A numerical failure (exit code 5).
+#[allow(dead_code)]
+pub fn numerical(message: impl Into<String>) -> anyhow::Error {
+    CliError {
+        code: NUMERICAL,
+        message: message.into(),
+    }
+    .into()
+}
+
+/// The exit code for an error: the first robocal error in its chain decides.
+pub fn code_for(e: &anyhow::Error) -> i32 {
+    use robocal_core::Error as E;
+    for cause in e.chain() {
+        if let Some(c) = cause.downcast_ref::<CliError>() {
+            return c.code;
+        }
+        if let Some(c) = cause.downcast_ref::<E>() {
+            return match c {
+                E::Io { .. } => IO,
+                E::Parse { .. }
+                | E::Invalid { .. }
+                | E::UnknownParameter { .. }
+                | E::JointCount { .. } => INPUT,
+                E::UnknownPreset { .. } => USAGE,
+                E::Numerical(_) => NUMERICAL,
+            };
+        }
+        if cause.downcast_ref::<std::io::Error>().is_some() {
+            return IO;
+        }
+    }
+    INTERNAL
+}
