@@ -46,9 +46,9 @@ struct JointEntry {
 pub const DEFAULT_LIMIT_DEG: f64 = 360.0;
 
 fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())]
-        .bytes()
-        .filter(|b| *b == b'\n')
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|b| **b == b'\n')
         .count()
         + 1
 }
@@ -80,7 +80,7 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
     let file: RobotFile = toml::from_str(text).map_err(|e| {
         let line = e.span().map(|s| line_of(text, s.start));
         let field = e.span().and_then(|s| {
-            let start = text[..s.start].rfind('\n').map_or(0, |p| p + 1);
+            let start = text.get(..s.start)?.rfind('\n').map_or(0, |p| p + 1);
             let end = text[s.start..]
                 .find('\n')
                 .map_or(text.len(), |p| s.start + p);
