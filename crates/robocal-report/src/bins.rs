@@ -9,8 +9,8 @@ const TARGET_BINS: f64 = 25.0;
 /// Bins of several series over the same edges.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Binning {
-    /// Edges of the regular bins, ascending: bin `i` is `[edges[i], edges[i+1])`, the last one
-    /// closed on the right.
+    /// Edges of the regular bins, ascending: bin `i` is `[edges[i], edges[i+1])`. Without
+    /// overflow the last edge lies above the largest value.
     pub edges: Vec<f64>,
     /// Whether an extra last bin gathers the values above `edges.last()` (very large errors
     /// that would otherwise squeeze every other bin into one).
@@ -94,7 +94,12 @@ pub fn bin_series(series: &[&[f64]]) -> Option<Binning> {
         lo.abs()
     };
     let width = nice_step(span / TARGET_BINS);
-    let nbins = ((span / width) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+    // Half-open bins up to and including the one holding the largest value (or the cap).
+    let nbins = if overflow {
+        ((span / width) * (1.0 - 1e-12)).ceil().max(1.0) as usize
+    } else {
+        (span / width + 1e-9).floor() as usize + 1
+    };
     let edges: Vec<f64> = (0..=nbins).map(|i| lo + i as f64 * width).collect();
     let cap = edges[nbins];
     let total_bins = nbins + usize::from(overflow);

@@ -57,11 +57,6 @@ impl HistogramFigure {
     }
 }
 
-/// A mean in mm as in the tables: three decimals.
-fn fixed3(v: f64) -> String {
-    crate::numfmt::fixed(v, 3)
-}
-
 fn plural(n: usize) -> &'static str {
     if n == 1 {
         ""
@@ -101,7 +96,7 @@ pub fn histogram_svg(series: &[HistogramSeries], title: &str) -> Result<Histogra
                 format!(
                     "{}: {n} points, mean {} mm",
                     clean_label(&s.label),
-                    fixed3(*m)
+                    crate::numfmt::mm(*m)
                 )
             })
             .collect::<Vec<_>>()
@@ -132,8 +127,8 @@ where
     let (w, h) = SIZE;
     root.draw(&Text::new(
         title_or_default(title),
-        (24, 18),
-        bold(17.0).pos(Pos::new(HPos::Left, VPos::Top)),
+        (w as i32 / 2, 14),
+        bold(17.0).pos(Pos::new(HPos::Center, VPos::Top)),
     ))
     .map_err(draw_err("histogram"))?;
     root.draw(&Text::new(
@@ -151,7 +146,7 @@ where
 fn legend_text(ser: &HistogramSeries, b: &Binning, s: usize) -> String {
     let mut label = format!("{}  (n = {}", clean_label(&ser.label), b.n[s]);
     if b.n[s] > 0 {
-        label.push_str(&format!(", mean {} mm", fixed3(b.mean[s])));
+        label.push_str(&format!(", mean {} mm", crate::numfmt::mm(b.mean[s])));
     }
     label.push(')');
     label
@@ -228,7 +223,8 @@ where
     let cap = b.cap();
     let overflow = b.overflow;
     let x_fmt = move |v: &f64| {
-        if overflow && *v > cap + 1e-9 * tick_step {
+        // The overflow bin is labelled "> cap" below it; no numbers at or beyond the cap.
+        if overflow && *v > cap - 1e-9 * tick_step {
             String::new()
         } else {
             axis_number(*v, x_dec + 1)
@@ -289,13 +285,18 @@ where
                 let (l, r) = b.bin_range(i);
                 let w = r - l;
                 let xc = l + w * (gap + (s as f64 + 0.5) * slot);
-                Text::new(
-                    counts[i].to_string(),
-                    (xc, counts[i] as u32),
-                    font(11.0)
-                        .color(&MUTED)
-                        .pos(Pos::new(HPos::Center, VPos::Bottom)),
-                )
+                let text = counts[i].to_string();
+                // A white box behind the count keeps it readable where a mean line passes.
+                let hw = (text.len() as f64 * 3.6 + 2.0).round() as i32;
+                EmptyElement::at((xc, counts[i] as u32))
+                    + Rectangle::new([(-hw, -15), (hw, -2)], WHITE.filled())
+                    + Text::new(
+                        text,
+                        (0, -2),
+                        font(11.0)
+                            .color(&MUTED)
+                            .pos(Pos::new(HPos::Center, VPos::Bottom)),
+                    )
             });
             chart.draw_series(texts).map_err(&e)?;
         }
@@ -314,7 +315,7 @@ where
         };
         chart
             .draw_series(std::iter::once(Text::new(
-                format!("mean {}", fixed3(m)),
+                format!("mean {}", crate::numfmt::mm(m)),
                 (m + dx, y),
                 font(12.0)
                     .color(&series_color(s))

@@ -4,7 +4,7 @@
 use crate::data::{finite, Note, NoteLevel, PointSet, ReportData};
 use crate::escape::xml as esc;
 use crate::histogram::HistogramFigure;
-use crate::numfmt::{fixed, magnitude};
+use crate::numfmt::{fixed, magnitude, mm};
 use crate::scatter::ScatterFigure;
 use crate::tables;
 use std::fmt::Write;
@@ -116,10 +116,10 @@ fn card(h: &mut String, set: &PointSet) {
                  <div class=\"big\"><span class=\"before\">{}</span><span class=\"arrow\">→</span>\
                  <span class=\"after\">{}</span> <span class=\"small\">mm{change}</span></div>\
                  <div class=\"small\">max {} → {} mm · {n}</div></div>",
-                fixed(mb, 3),
-                fixed(ma, 3),
-                fixed(xb, 3),
-                fixed(xa, 3),
+                mm(mb),
+                mm(ma),
+                mm(xb),
+                mm(xa),
             );
         }
         (None, Some((m, x, n))) | (Some((m, x, n)), None) => {
@@ -134,8 +134,8 @@ fn card(h: &mut String, set: &PointSet) {
                 "<div class=\"card\"><div class=\"label\">{name} points – mean error {what}</div>\
                  <div class=\"big\"><span class=\"{class}\">{}</span> <span class=\"small\">mm</span></div>\
                  <div class=\"small\">max {} mm · n = {n}</div></div>",
-                fixed(m, 3),
-                fixed(x, 3),
+                mm(m),
+                mm(x),
             );
         }
         (None, None) => {}
@@ -160,9 +160,11 @@ fn summary(h: &mut String, data: &ReportData) {
             h,
             "<p>{}: mean error {} mm (n = {}).</p>",
             esc(&r.label),
-            fixed(r.stats.mean_mm, 3),
+            mm(r.stats.mean_mm),
             r.stats.n
         );
+    } else {
+        h.push_str("<p class=\"empty\">No errors were given.</p>\n");
     }
     notes(h, &data.notes);
     h.push_str("</section>\n");

@@ -17,6 +17,16 @@ pub fn fixed(v: f64, d: usize) -> String {
     })
 }
 
+/// An error figure in mm: three decimals, or scientific notation from 1e5 mm on (a gross
+/// error must not blow up a table).
+pub fn mm(v: f64) -> String {
+    if v.is_finite() && v.abs() >= 1e5 {
+        minus(format!("{v:.3e}"))
+    } else {
+        fixed(v, 3)
+    }
+}
+
 /// Like [`fixed`] with an explicit `+` for positive values (differences).
 pub fn signed(v: f64, d: usize) -> String {
     let s = fixed(v, d);
@@ -43,11 +53,6 @@ pub fn sig2(v: f64) -> String {
     let mag = a.log10().floor() as i32;
     let d = (1 - mag).max(0) as usize;
     fixed(v, d)
-}
-
-/// An optional figure with `d` decimals.
-pub fn opt_fixed(v: Option<f64>, d: usize) -> String {
-    v.map_or_else(|| DASH.into(), |x| fixed(x, d))
 }
 
 /// A condition number or other large positive figure: 3 significant digits, scientific above
@@ -97,5 +102,7 @@ mod tests {
         assert_eq!(magnitude(12.345), "12.3");
         assert_eq!(magnitude(2.5e7), "2.50e7");
         assert_eq!(magnitude(f64::INFINITY), "∞");
+        assert_eq!(mm(1.61949), "1.619");
+        assert_eq!(mm(1.0e9), "1.000e9");
     }
 }

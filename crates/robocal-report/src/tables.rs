@@ -3,12 +3,10 @@
 
 use crate::data::{ErrorRow, ErrorTable, FixedParam, ParamRow, ReportData};
 use crate::escape::xml as esc;
-use crate::numfmt::{fixed, opt_fixed, sig2, signed, DASH};
+use crate::numfmt::{fixed, mm, sig2, signed, DASH};
 use robocal_core::Unit;
 use std::fmt::Write;
 
-/// Decimals of error statistics (mm), as in the paper's tables.
-const STAT_DECIMALS: usize = 3;
 /// Decimals of parameter values (mm and degrees).
 const PARAM_DECIMALS: usize = 4;
 
@@ -60,7 +58,6 @@ fn error_table(h: &mut String, t: &ErrorTable) {
 
 fn error_row(h: &mut String, r: &ErrorRow) {
     let s = &r.stats;
-    let d = STAT_DECIMALS;
     let n = if s.n == 0 {
         "0".to_string()
     } else {
@@ -72,11 +69,11 @@ fn error_row(h: &mut String, r: &ErrorRow) {
          <td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>\
          <td class=\"num\">{}</td></tr>",
         esc(&r.label),
-        fixed(s.mean_mm, d),
-        fixed(s.std_mm, d),
-        fixed(s.max_mm, d),
-        fixed(s.rms_mm, d),
-        fixed(s.p95_mm, d),
+        mm(s.mean_mm),
+        mm(s.std_mm),
+        mm(s.max_mm),
+        mm(s.rms_mm),
+        mm(s.p95_mm),
     );
     if let Some(p) = &r.paper {
         let _ = writeln!(
@@ -86,13 +83,17 @@ fn error_row(h: &mut String, r: &ErrorRow) {
              <td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
             esc(&p.source),
             p.n.map_or_else(|| DASH.to_string(), |n| n.to_string()),
-            opt_fixed(p.mean_mm, d),
-            opt_fixed(p.std_mm, d),
-            opt_fixed(p.max_mm, d),
-            opt_fixed(p.rms_mm, d),
-            opt_fixed(p.p95_mm, d),
+            opt_mm(p.mean_mm),
+            opt_mm(p.std_mm),
+            opt_mm(p.max_mm),
+            opt_mm(p.rms_mm),
+            opt_mm(p.p95_mm),
         );
     }
+}
+
+fn opt_mm(v: Option<f64>) -> String {
+    v.map_or_else(|| DASH.to_string(), mm)
 }
 
 fn unit_str(u: Unit) -> &'static str {

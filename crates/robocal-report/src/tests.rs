@@ -124,11 +124,18 @@ fn histogram_counts_sum_to_n_and_match_the_bars() {
         assert_eq!(b.counts[s].iter().sum::<usize>(), finite);
         assert_eq!(b.n[s], finite);
     }
-    // one filled <rect> per non-empty bin and series, besides background, legend and frame
-    let nonempty: usize = b.counts.iter().flatten().filter(|c| **c > 0).count();
-    let rects = fig.svg.matches("<rect").count();
-    assert!(rects >= nonempty, "{rects} rects for {nonempty} bars");
-    assert!(rects <= nonempty + 8, "{rects} rects for {nonempty} bars");
+    // one filled <rect> per non-empty bin in the series' colour, plus its legend swatch
+    for s in 0..data.histogram.len() {
+        let c = crate::plot::series_color(s);
+        let fill = format!("fill=\"#{:02X}{:02X}{:02X}\"", c.0, c.1, c.2);
+        let rects = fig
+            .svg
+            .lines()
+            .filter(|l| l.starts_with("<rect") && l.contains(&fill))
+            .count();
+        let nonempty = b.counts[s].iter().filter(|c| **c > 0).count();
+        assert_eq!(rects, nonempty + 1, "series {s}");
+    }
 }
 
 #[test]
