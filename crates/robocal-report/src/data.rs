@@ -145,7 +145,7 @@ impl HistogramSeries {
 /// The errors of one set of points (calibration, validation, verification...).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PointSet {
-    /// The set's name, e.g. "Calibration".
+    /// The set's name, e.g. "Calibration" (shown as "Calibration points").
     pub name: String,
     /// Its points.
     pub points: Vec<PointError>,
@@ -179,11 +179,27 @@ pub enum ReachKind {
 }
 
 impl ReachKind {
+    /// The reach of a tool point `p` = (x, y, z) in the base frame (mm).
+    pub fn of(self, p: [f64; 3]) -> f64 {
+        match self {
+            ReachKind::Radial => p[0].hypot(p[1]),
+            ReachKind::Spherical => (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt(),
+        }
+    }
+
     /// Axis label, with the unit.
     pub fn axis_label(self) -> &'static str {
         match self {
-            ReachKind::Radial => "Reach: distance of the tool point from the base z axis (mm)",
-            ReachKind::Spherical => "Reach: distance of the tool point from the base origin (mm)",
+            ReachKind::Radial => "Reach from the base z axis (mm)",
+            ReachKind::Spherical => "Distance from the base origin (mm)",
+        }
+    }
+
+    /// What the reach is, in words.
+    pub fn description(self) -> &'static str {
+        match self {
+            ReachKind::Radial => "distance of the tool point from the base z axis",
+            ReachKind::Spherical => "distance of the tool point from the base origin",
         }
     }
 }
@@ -388,6 +404,12 @@ mod tests {
         let back: HistogramSeries = serde_json::from_str(&j).unwrap();
         assert_eq!(back.values_mm[0], 1.0);
         assert!(back.values_mm[1].is_nan());
+    }
+
+    #[test]
+    fn reach() {
+        assert_eq!(ReachKind::Radial.of([3.0, 4.0, 100.0]), 5.0);
+        assert_eq!(ReachKind::Spherical.of([2.0, 3.0, 6.0]), 7.0);
     }
 
     #[test]

@@ -213,10 +213,7 @@ fn scatter_section(h: &mut String, data: &ReportData, fig: &ScatterFigure) {
         "Displacement error of each point against its reach ({}). Left: nominal model with \
          the fitted measurement frame; right: calibrated model (for a verification set: as \
          measured after compensation). The panels have their own error scales.",
-        match data.reach {
-            crate::ReachKind::Radial => "distance of the tool point from the base z axis",
-            crate::ReachKind::Spherical => "distance of the tool point from the base origin",
-        }
+        data.reach.description()
     );
     for (name, c, clip) in [
         ("before", fig.before, fig.clip_mm[0]),

@@ -39,7 +39,7 @@ mod example;
 pub mod histogram;
 mod html;
 mod numfmt;
-pub mod plot;
+mod plot;
 pub mod scatter;
 mod serde_nan;
 mod tables;

@@ -197,10 +197,7 @@ where
         .map_err(&e)?;
     let x_dec = decimals_for(nice_step((x_range.1 - x_range.0) / 6.0));
     let y_dec = decimals_for(nice_step(y_hi / 8.0));
-    let x_desc = match reach {
-        ReachKind::Radial => "Reach from the base z axis (mm)",
-        ReachKind::Spherical => "Distance from the base origin (mm)",
-    };
+    let x_desc = reach.axis_label();
     chart
         .configure_mesh()
         .x_labels(7)
