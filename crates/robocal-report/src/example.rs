@@ -1,0 +1,210 @@
+//! Made-up report data shaped like the paper's experiment, for previews and tests of the report's
+//! layout. The numbers are synthetic: nothing here is a calibration result.
+
+use crate::build::{before_after_histogram, paper_tables};
+use crate::data::*;
+use robocal_core::io::result::BeforeAfter;
+use robocal_core::{ErrorStats, Unit};
+
+/// A small deterministic generator (SplitMix64) so that the example needs no RNG crate.
+struct Mix(u64);
+
+impl Mix {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    /// Approximately normal (sum of uniforms).
+    fn normal(&mut self) -> f64 {
+        (0..12).map(|_| self.next()).sum::<f64>() - 6.0
+    }
+}
+
+fn set(name: &str, n: usize, after_mean: f64, rng: &mut Mix) -> PointSet {
+    let points = (0..n)
+        .map(|_| {
+            let reach = 1200.0 + 2100.0 * rng.next();
+            let before = (0.55 + 0.00045 * reach + 0.22 * rng.normal()).abs();
+            let after = (after_mean * (1.0 + 0.45 * rng.normal())).abs();
+            PointError {
+                reach_mm: reach,
+                before_mm: before,
+                after_mm: after,
+            }
+        })
+        .collect();
+    PointSet {
+        name: name.into(),
+        points,
+    }
+}
+
+fn stats(s: &PointSet, after: bool) -> ErrorStats {
+    let v: Vec<f64> = s
+        .points
+        .iter()
+        .map(|p| if after { p.after_mm } else { p.before_mm })
+        .filter(|x| x.is_finite())
+        .collect();
+    ErrorStats::from_norms(&v)
+}
+
+impl ReportData {
+    /// Synthetic data shaped like the paper's experiment (75 calibration, 73 validation and 75
+    /// verification points; a six-joint MDH model with 36 parameters, 10 of them fixed), with
+    /// the paper's figures beside the tables. For previewing the report's layout and for tests:
+    /// the numbers are made up.
+    pub fn synthetic_example(seed: u64) -> ReportData {
+        let mut rng = Mix(seed);
+        let cal = set("Calibration", 75, 0.17, &mut rng);
+        let val = set("Validation", 73, 0.24, &mut rng);
+        let mut ver = set("Verification", 75, 0.29, &mut rng);
+        for (p, c) in ver.points.iter_mut().zip(&cal.points) {
+            p.reach_mm = c.reach_mm;
+            p.before_mm = f64::NAN;
+        }
+        let error_tables = paper_tables(
+            BeforeAfter {
+                before: stats(&cal, false),
+                after: stats(&cal, true),
+            },
+            Some(BeforeAfter {
+                before: stats(&val, false),
+                after: stats(&val, true),
+            }),
+            Some(stats(&ver, true)),
+            true,
+        );
+        let point_sets = vec![cal, val, ver];
+        let histogram = before_after_histogram(&point_sets, &["Calibration"], &["Calibration"]);
+
+        let nominal = [
+            [0.0, 1045.0, 0.0, 0.0],
+            [-90.0, 0.0, 500.0, 0.0],
+            [0.0, 0.0, 1300.0, -90.0],
+            [-90.0, 1525.0, -55.0, 0.0],
+            [90.0, 0.0, 0.0, 0.0],
+            [-90.0, 290.0, 0.0, 180.0],
+        ];
+        let fixed_reason = |name: &str| -> Option<&'static str> {
+            Some(match name {
+                "alpha1" | "a1" | "d1" | "phi1" => "absorbed by the base frame",
+                "d3" => "interchangeable with d2 (axes 2 and 3 parallel)",
+                "d6" | "phi6" => "absorbed by the tool position",
+                "tool_a" | "tool_b" | "tool_c" => "no effect on a measured point",
+                _ => return None,
+            })
+        };
+        let mut parameters = Vec::new();
+        for (i, row) in nominal.iter().enumerate() {
+            for (k, kind) in ["alpha", "d", "a", "phi"].iter().enumerate() {
+                let name = format!("{kind}{}", i + 1);
+                let unit = if k == 0 || k == 3 {
+                    Unit::Deg
+                } else {
+                    Unit::Mm
+                };
+                parameters.push((name, unit, row[k]));
+            }
+        }
+        for (k, axis) in ["x", "y", "z", "a", "b", "c"].iter().enumerate() {
+            let unit = if k < 3 { Unit::Mm } else { Unit::Deg };
+            parameters.push((format!("base_{axis}"), unit, 0.0));
+        }
+        let tool = [42.4163, -70.9065, 239.5558, -0.038, 0.237, 0.054];
+        for (k, axis) in ["x", "y", "z", "a", "b", "c"].iter().enumerate() {
+            let unit = if k < 3 { Unit::Mm } else { Unit::Deg };
+            parameters.push((format!("tool_{axis}"), unit, tool[k]));
+        }
+        let parameters: Vec<ParamRow> = parameters
+            .into_iter()
+            .map(|(name, unit, nominal)| {
+                let reason = fixed_reason(&name);
+                let scale = if unit == Unit::Mm { 0.6 } else { 0.03 };
+                let delta = if reason.is_some() {
+                    0.0
+                } else {
+                    scale * rng.normal()
+                };
+                ParamRow {
+                    calibrated: nominal + delta,
+                    std: reason.is_none().then(|| scale * 0.02 * (0.5 + rng.next())),
+                    fixed: reason.is_some(),
+                    reason: reason.map(str::to_owned),
+                    name,
+                    unit,
+                    nominal,
+                }
+            })
+            .collect();
+        let fixed: Vec<FixedParam> = parameters
+            .iter()
+            .filter(|p| p.fixed)
+            .map(|p| FixedParam {
+                name: p.name.clone(),
+                reason: p.reason.clone().unwrap_or_default(),
+            })
+            .collect();
+        ReportData {
+            title: "KUKA KR 480 R3330 – calibration report (synthetic example)".into(),
+            subtitle: Some(
+                "Made-up data shaped like the paper's experiment: a preview of the report layout."
+                    .into(),
+            ),
+            settings: vec![
+                Setting::new("Robot", "kuka-kr480-r3330 (Table I, T0 of eq. 7)"),
+                Setting::new("Seed", seed),
+                Setting::new("Points", "3 plane + 75 calibration + 73 validation"),
+                Setting::new("Tracker noise", "0.010 mm + 0.005 mm/m (1σ)"),
+                Setting::new("Objective", "sum of displacement error norms (eq. 4)"),
+            ],
+            error_tables,
+            histogram,
+            point_sets,
+            reach: ReachKind::Radial,
+            parameters,
+            identifiability: Some(Identifiability {
+                condition_number: Some(412.7),
+                identified: Some(26),
+                total: Some(36),
+                correlated_pairs: vec![
+                    CorrelatedPair {
+                        a: "d2".into(),
+                        b: "base_z".into(),
+                        correlation: -0.962,
+                    },
+                    CorrelatedPair {
+                        a: "a2".into(),
+                        b: "base_x".into(),
+                        correlation: 0.918,
+                    },
+                    CorrelatedPair {
+                        a: "phi2".into(),
+                        b: "phi3".into(),
+                        correlation: -0.874,
+                    },
+                ],
+                fixed,
+            }),
+            solver: Some(SolverSummary {
+                method: "Levenberg–Marquardt with IRLS".into(),
+                objective: "sum of displacement error norms (eq. 4)".into(),
+                initial_value: Some(121.4),
+                final_value: Some(12.83),
+                value_unit: Some("mm".into()),
+                termination: "relative reduction of the objective below 1e-12".into(),
+                iterations: Some(14),
+                evaluations: Some(17),
+                extra: vec![],
+            }),
+            notes: vec![Note::warning(
+                "Synthetic example: these numbers are made up to preview the layout.",
+            )],
+        }
+    }
+}

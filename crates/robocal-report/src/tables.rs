@@ -1,0 +1,229 @@
+//! HTML tables: error statistics (the paper's Tables II, IV, V, with its figures beside ours),
+//! model parameters, fixed parameters, run settings.
+
+use crate::data::{ErrorRow, ErrorTable, FixedParam, ParamRow, ReportData};
+use crate::escape::xml as esc;
+use crate::numfmt::{fixed, mm, sig2, signed, DASH};
+use robocal_core::Unit;
+use std::fmt::Write;
+
+/// Decimals of parameter values (mm and degrees).
+const PARAM_DECIMALS: usize = 4;
+
+/// The "Error statistics" section.
+pub fn errors_section(h: &mut String, data: &ReportData) {
+    h.push_str("<section id=\"errors\">\n<h2>Error statistics</h2>\n");
+    if data.error_tables.is_empty() {
+        h.push_str("<p class=\"empty\">No error statistics were given.</p>\n</section>\n");
+        return;
+    }
+    let with_paper = data
+        .error_tables
+        .iter()
+        .any(|t| t.rows.iter().any(|r| r.paper.is_some()));
+    h.push_str("<p class=\"lead\">Norms of the displacement error ‖Eᵢ‖ = ‖P<sub>act</sub> − P<sub>nom</sub>‖ (eq. 3), in mm. Std. dev. is the sample standard deviation.");
+    if with_paper {
+        h.push_str(
+            " Shaded rows give the paper’s figures for the same points (it reports mean, \
+             standard deviation and maximum only).",
+        );
+    }
+    h.push_str(
+        "</p>\n<table class=\"stats\">\n<thead><tr><th>Points</th><th class=\"num\">n</th>\
+         <th class=\"num\">Mean</th><th class=\"num\">Std. dev.</th><th class=\"num\">Max</th>\
+         <th class=\"num\">RMS</th><th class=\"num\">95th pct.</th></tr></thead>\n",
+    );
+    for t in &data.error_tables {
+        error_table(h, t);
+    }
+    h.push_str("</table>\n</section>\n");
+}
+
+/// One table of the paper as a group of rows: a heading row, then one row per point set.
+fn error_table(h: &mut String, t: &ErrorTable) {
+    let _ = write!(
+        h,
+        "<tbody>\n<tr class=\"group\"><th colspan=\"7\">{}",
+        esc(&t.title)
+    );
+    if let Some(c) = &t.caption {
+        let _ = write!(h, "<span class=\"sub\">{}</span>", esc(c));
+    }
+    h.push_str("</th></tr>\n");
+    for r in &t.rows {
+        error_row(h, r);
+    }
+    h.push_str("</tbody>\n");
+}
+
+fn error_row(h: &mut String, r: &ErrorRow) {
+    let s = &r.stats;
+    let n = if s.n == 0 {
+        "0".to_string()
+    } else {
+        s.n.to_string()
+    };
+    let _ = writeln!(
+        h,
+        "<tr><th scope=\"row\">{}</th><td class=\"num\">{n}</td><td class=\"num\">{}</td>\
+         <td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>\
+         <td class=\"num\">{}</td></tr>",
+        esc(&r.label),
+        mm(s.mean_mm),
+        mm(s.std_mm),
+        mm(s.max_mm),
+        mm(s.rms_mm),
+        mm(s.p95_mm),
+    );
+    if let Some(p) = &r.paper {
+        let _ = writeln!(
+            h,
+            "<tr class=\"paper\"><th scope=\"row\">Paper: {}</th><td class=\"num\">{}</td>\
+             <td class=\"num\">{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>\
+             <td class=\"num\">{}</td><td class=\"num\">{}</td></tr>",
+            esc(&p.source),
+            p.n.map_or_else(|| DASH.to_string(), |n| n.to_string()),
+            opt_mm(p.mean_mm),
+            opt_mm(p.std_mm),
+            opt_mm(p.max_mm),
+            opt_mm(p.rms_mm),
+            opt_mm(p.p95_mm),
+        );
+    }
+}
+
+fn opt_mm(v: Option<f64>) -> String {
+    v.map_or_else(|| DASH.to_string(), mm)
+}
+
+fn unit_str(u: Unit) -> &'static str {
+    match u {
+        Unit::Mm => "mm",
+        Unit::Deg => "°",
+    }
+}
+
+/// The fixed parameters to list: the identifiability summary's list if given, else the
+/// parameter rows marked fixed.
+fn fixed_list(data: &ReportData) -> Vec<FixedParam> {
+    if let Some(id) = data
+        .identifiability
+        .as_ref()
+        .filter(|i| !i.fixed.is_empty())
+    {
+        return id.fixed.clone();
+    }
+    data.parameters
+        .iter()
+        .filter(|p| p.fixed)
+        .map(|p| FixedParam {
+            name: p.name.clone(),
+            reason: p.reason.clone().unwrap_or_else(|| DASH.into()),
+        })
+        .collect()
+}
+
+/// The "Model parameters" section: all parameters, and the fixed ones with reasons.
+pub fn parameters_section(h: &mut String, data: &ReportData) {
+    h.push_str("<section id=\"parameters\">\n<h2>Model parameters</h2>\n");
+    if data.parameters.is_empty() {
+        h.push_str("<p class=\"empty\">No parameters were given.</p>\n</section>\n");
+        return;
+    }
+    let identified = data.parameters.iter().filter(|p| !p.fixed).count();
+    let _ = writeln!(
+        h,
+        "<p class=\"lead\">{identified} of {} parameters identified; the others were held at \
+         their nominal values. Lengths in mm, angles in degrees; difference = calibrated − \
+         nominal; std. dev. from the covariance of the fit.</p>",
+        data.parameters.len()
+    );
+    h.push_str("<div class=\"params-layout\">\n<div>\n<table class=\"params\">\n<thead><tr><th>Parameter</th><th>Unit</th><th class=\"num\">Nominal</th><th class=\"num\">Calibrated</th><th class=\"num\">Difference</th><th class=\"num\">Std. dev.</th></tr></thead>\n<tbody>\n");
+    let groups: Vec<String> = data
+        .parameters
+        .iter()
+        .map(|p| param_group(&p.name))
+        .collect();
+    let grouped = groups.windows(2).any(|w| w[0] != w[1]);
+    for (i, p) in data.parameters.iter().enumerate() {
+        if grouped && (i == 0 || groups[i] != groups[i - 1]) {
+            let _ = writeln!(
+                h,
+                "<tr class=\"group\"><th colspan=\"6\">{}</th></tr>",
+                esc(&groups[i])
+            );
+        }
+        param_row(h, p);
+    }
+    h.push_str("</tbody>\n</table>\n</div>\n<div>\n<h3>Fixed parameters</h3>\n");
+    let fixed = fixed_list(data);
+    if fixed.is_empty() {
+        h.push_str("<p class=\"empty\">None: every parameter was identified.</p>\n");
+    } else {
+        h.push_str("<table class=\"fixed-params\">\n<thead><tr><th>Parameter</th><th>Why it is fixed</th></tr></thead>\n<tbody>\n");
+        for f in &fixed {
+            let _ = writeln!(
+                h,
+                "<tr><td class=\"code\">{}</td><td>{}</td></tr>",
+                esc(&f.name),
+                esc(&f.reason)
+            );
+        }
+        h.push_str("</tbody>\n</table>\n");
+    }
+    h.push_str("</div>\n</div>\n</section>\n");
+}
+
+/// The group a parameter belongs to, from its name: a joint, the base frame or the tool.
+fn param_group(name: &str) -> String {
+    if name.starts_with("base_") {
+        return "Base frame (column B)".into();
+    }
+    if name.starts_with("tool_") {
+        return "Tool (column T)".into();
+    }
+    let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
+    if digits > 0 && digits < name.len() {
+        format!("Joint {}", &name[name.len() - digits..])
+    } else {
+        "Other".into()
+    }
+}
+
+fn param_row(h: &mut String, p: &ParamRow) {
+    let d = PARAM_DECIMALS;
+    let (class, std) = if p.fixed {
+        (
+            " class=\"fixed\"",
+            "<span class=\"tag\">fixed</span>".to_string(),
+        )
+    } else {
+        ("", p.std.map_or_else(|| DASH.to_string(), sig2))
+    };
+    let diff = if p.fixed && p.difference() == 0.0 {
+        DASH.to_string()
+    } else {
+        signed(p.difference(), d)
+    };
+    let _ = writeln!(
+        h,
+        "<tr{class}><td class=\"code\">{}</td><td>{}</td><td class=\"num\">{}</td>\
+         <td class=\"num\">{}</td><td class=\"num\">{diff}</td><td class=\"num\">{std}</td></tr>",
+        esc(&p.name),
+        unit_str(p.unit),
+        fixed(p.nominal, d),
+        fixed(p.calibrated, d),
+    );
+}
+
+/// The "Run settings" section.
+pub fn settings_section(h: &mut String, data: &ReportData) {
+    if data.settings.is_empty() {
+        return;
+    }
+    h.push_str("<section id=\"settings\">\n<h2>Run settings</h2>\n<dl class=\"kv\">\n");
+    for s in &data.settings {
+        crate::html::kv(h, &s.key, &s.value);
+    }
+    h.push_str("</dl>\n</section>\n");
+}

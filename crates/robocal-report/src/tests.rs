@@ -1,0 +1,268 @@
+//! Tests of the rendered documents: well-formed XML, expected labels, counts, escaping, edge
+//! cases, atomic output.
+
+use super::*;
+use quick_xml::events::Event;
+use quick_xml::Reader;
+
+/// Parses `doc` as XML, checking that every tag is closed in order; returns the element names.
+/// HTML void elements (`<meta>`, `<br>`) are accepted unclosed.
+fn xml_elements(doc: &str) -> Vec<String> {
+    let doc = doc.strip_prefix("<!DOCTYPE html>").unwrap_or(doc);
+    let mut r = Reader::from_str(doc);
+    r.config_mut().check_end_names = true;
+    let mut names = Vec::new();
+    let mut stack: Vec<String> = Vec::new();
+    loop {
+        match r.read_event() {
+            Ok(Event::Start(e)) => {
+                let n = String::from_utf8(e.name().as_ref().to_vec()).unwrap();
+                names.push(n.clone());
+                if !matches!(n.as_str(), "meta" | "br" | "hr" | "img" | "link") {
+                    stack.push(n);
+                }
+            }
+            Ok(Event::Empty(e)) => {
+                names.push(String::from_utf8(e.name().as_ref().to_vec()).unwrap())
+            }
+            Ok(Event::End(e)) => {
+                let n = String::from_utf8(e.name().as_ref().to_vec()).unwrap();
+                assert_eq!(
+                    stack.pop().as_deref(),
+                    Some(n.as_str()),
+                    "unbalanced </{n}>"
+                );
+            }
+            Ok(Event::Text(t)) => {
+                t.unescape().expect("text with a bad entity");
+            }
+            Ok(Event::Eof) => break,
+            Ok(_) => {}
+            Err(e) => panic!("not well-formed at {}: {e}", r.buffer_position()),
+        }
+    }
+    assert!(stack.is_empty(), "unclosed elements: {stack:?}");
+    names
+}
+
+/// The HTML with void `<meta>` tags made self-closing, so that an XML parser can check it.
+fn xmlish(html: &str) -> String {
+    let mut out = String::with_capacity(html.len());
+    let mut rest = html;
+    while let Some(i) = rest.find("<meta ") {
+        out.push_str(&rest[..i]);
+        let end = rest[i..].find('>').unwrap() + i;
+        out.push_str(&rest[i..end]);
+        out.push_str("/>");
+        rest = &rest[end + 1..];
+    }
+    out.push_str(rest);
+    out
+}
+
+#[test]
+fn example_report_is_well_formed_and_complete() {
+    let data = ReportData::synthetic_example(7);
+    let r = render(&data).unwrap();
+    let names = xml_elements(&xmlish(&r.html));
+    assert!(
+        names.iter().filter(|n| *n == "svg").count() == 2,
+        "histogram and scatter inline"
+    );
+    xml_elements(&r.histogram_svg);
+    for label in [
+        "Displacement error ‖Eᵢ‖ (mm)",
+        "Number of points",
+        "Before calibration",
+        "After calibration",
+        "Reach from the base z axis (mm)",
+        "Before calibration (Table II)",
+        "After calibration, predicted (Table IV)",
+        "Verification, measured after compensation (Table V)",
+        "Samak et al. 2019, Table II",
+        "1.619",
+        "0.293",
+        "Fixed parameters",
+        "absorbed by the base frame",
+        "Condition number",
+        "Levenberg–Marquardt",
+        "Run settings",
+        "tool_c",
+    ] {
+        assert!(r.html.contains(label), "missing {label:?}");
+    }
+    assert!(r.histogram_svg.contains("Number of points"));
+    assert!(r.histogram_svg.contains("<title>"));
+    // self-contained: no scripts, no external references
+    let lower = r.html.to_lowercase();
+    for bad in [
+        "<script",
+        "http://",
+        "https://",
+        "@import",
+        "url(",
+        "@font-face",
+        "<link",
+    ] {
+        let ok = if bad == "http://" {
+            // the SVG namespace is the only URL allowed
+            lower.matches(bad).count() == lower.matches("http://www.w3.org/2000/svg").count()
+        } else {
+            !lower.contains(bad)
+        };
+        assert!(ok, "HTML contains {bad}");
+    }
+}
+
+#[test]
+fn histogram_counts_sum_to_n_and_match_the_bars() {
+    let data = ReportData::synthetic_example(3);
+    let fig = histogram_svg(&data.histogram, HISTOGRAM_TITLE).unwrap();
+    let b = fig.binning.as_ref().unwrap();
+    for (s, series) in data.histogram.iter().enumerate() {
+        let finite = series.values_mm.iter().filter(|v| v.is_finite()).count();
+        assert_eq!(b.counts[s].iter().sum::<usize>(), finite);
+        assert_eq!(b.n[s], finite);
+    }
+    // one filled <rect> per non-empty bin in the series' colour, plus its legend swatch
+    for s in 0..data.histogram.len() {
+        let c = crate::plot::series_color(s);
+        let fill = format!("fill=\"#{:02X}{:02X}{:02X}\"", c.0, c.1, c.2);
+        let rects = fig
+            .svg
+            .lines()
+            .filter(|l| l.starts_with("<rect") && l.contains(&fill))
+            .count();
+        let nonempty = b.counts[s].iter().filter(|c| **c > 0).count();
+        assert_eq!(rects, nonempty + 1, "series {s}");
+    }
+}
+
+#[test]
+fn text_is_escaped_everywhere() {
+    let evil = "<script>alert('x')</script> & \"q\" \u{1}";
+    let mut data = ReportData::synthetic_example(1);
+    data.title = evil.into();
+    data.subtitle = Some(evil.into());
+    data.settings.push(Setting::new(evil, evil));
+    data.notes.push(Note::warning(evil));
+    data.histogram[0].label = evil.into();
+    data.point_sets[0].name = evil.into();
+    data.error_tables[0].rows[0].label = evil.into();
+    data.parameters[0].name = evil.into();
+    data.identifiability.as_mut().unwrap().fixed[0].reason = evil.into();
+    let r = render(&data).unwrap();
+    assert!(!r.html.contains("<script"), "unescaped markup");
+    assert!(!r.histogram_svg.contains("<script"));
+    assert!(r.html.contains("&lt;script&gt;"));
+    assert!(!r.html.contains('\u{1}'));
+    xml_elements(&xmlish(&r.html));
+    xml_elements(&r.histogram_svg);
+}
+
+#[test]
+fn edge_cases_render() {
+    let p = |r: f64, b: f64, a: f64| PointError {
+        reach_mm: r,
+        before_mm: b,
+        after_mm: a,
+    };
+    let cases: Vec<(&str, Vec<f64>, Vec<PointError>)> = vec![
+        ("empty", vec![], vec![]),
+        ("single", vec![1.3], vec![p(2000.0, 1.3, 0.2)]),
+        ("all equal", vec![0.5; 20], vec![p(1500.0, 0.5, 0.5); 20]),
+        (
+            "nan",
+            vec![f64::NAN, 1.0, f64::INFINITY, 2.0],
+            vec![
+                p(f64::NAN, 1.0, 0.1),
+                p(2500.0, f64::NAN, 0.2),
+                p(2600.0, 1.5, 0.3),
+            ],
+        ),
+        (
+            "huge",
+            (0..30).map(|i| 0.1 * i as f64).chain([1.0e9]).collect(),
+            (0..30)
+                .map(|i| p(1000.0 + 50.0 * i as f64, 1.0 + 0.01 * i as f64, 0.1))
+                .chain([p(3000.0, 1.0e9, 5.0e3)])
+                .collect(),
+        ),
+    ];
+    for (name, values, points) in cases {
+        let data = ReportData {
+            title: name.into(),
+            histogram: vec![
+                HistogramSeries::new("Before", values.clone()),
+                HistogramSeries::new("After", values.iter().map(|v| v / 10.0).collect()),
+            ],
+            point_sets: vec![PointSet {
+                name: "Calibration".into(),
+                points,
+            }],
+            ..ReportData::default()
+        };
+        let r = render(&data).unwrap_or_else(|e| panic!("{name}: {e}"));
+        xml_elements(&xmlish(&r.html));
+        xml_elements(&r.histogram_svg);
+        let body = &r.html[r.html.find("</style>").unwrap()..];
+        for word in body.split(|c: char| !c.is_alphanumeric()) {
+            assert!(word != "NaN" && word != "inf", "{name}: {word} shown");
+        }
+        match name {
+            "empty" => assert!(r.histogram_svg.contains("No error values to show")),
+            "nan" => assert!(
+                r.html.contains("2 missing or non-finite values not shown"),
+                "{name}"
+            ),
+            "huge" => {
+                assert!(r.html.contains("gathered in the last bin"), "{name}");
+                assert!(r.html.contains("drawn as ▲"), "{name}");
+            }
+            _ => {}
+        }
+    }
+}
+
+#[test]
+fn write_report_creates_dir_and_both_files() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("a/b/report");
+    let data = ReportData::synthetic_example(2);
+    let files = write_report(&dir, &data).unwrap();
+    assert_eq!(files.html, dir.join("report.html"));
+    let html = std::fs::read_to_string(&files.html).unwrap();
+    let svg = std::fs::read_to_string(&files.histogram_svg).unwrap();
+    assert!(html.starts_with("<!DOCTYPE html>"));
+    assert!(svg.starts_with("<?xml"));
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        2,
+        "temporary files left"
+    );
+    // a file where the directory should be: an error naming it, nothing written
+    let f = tmp.path().join("file");
+    std::fs::write(&f, "x").unwrap();
+    let e = write_report(&f, &data).unwrap_err().to_string();
+    assert!(e.contains("not a directory"), "{e}");
+}
+
+#[test]
+fn report_data_round_trips_through_json() {
+    let data = ReportData::synthetic_example(5);
+    let j = serde_json::to_string(&data).unwrap();
+    let back: ReportData = serde_json::from_str(&j).unwrap();
+    // serde_json's float parsing may differ in the last bit: compare what the report shows
+    assert_eq!(back.parameters.len(), data.parameters.len());
+    for (a, b) in back.parameters.iter().zip(&data.parameters) {
+        assert_eq!(
+            (&a.name, a.unit, a.fixed, &a.reason),
+            (&b.name, b.unit, b.fixed, &b.reason)
+        );
+        assert!((a.calibrated - b.calibrated).abs() <= 1e-12 * b.calibrated.abs().max(1.0));
+    }
+    assert_eq!(back.error_tables.len(), data.error_tables.len());
+    // verification points have no "before" error: NaN survives as null
+    assert!(back.point_sets[2].points[0].before_mm.is_nan());
+    xml_elements(&xmlish(&render(&back).unwrap().html));
+}
