@@ -19,6 +19,8 @@ const CANDIDATES: usize = 300;
 const STARTS_PER_CORNER: usize = 25;
 /// Triangle orientations tried before giving up.
 const ORIENTATIONS: usize = 12;
+/// Plane poses keep this far from the joint limits (degrees), as a careful operator would.
+const LIMIT_MARGIN_DEG: f64 = 5.0;
 
 /// Joint values (rad) that put the nominal tool point at `target` (mm, base frame), starting
 /// from `start`, by damped least squares on the position Jacobian, staying within the joint
@@ -30,7 +32,28 @@ pub fn reach_position(
     tol_mm: f64,
     max_iter: usize,
 ) -> Option<Vec<f64>> {
+    reach_within(robot, start, target, tol_mm, max_iter, 0.0)
+}
+
+/// [`reach_position`] keeping `margin` (rad, at most a quarter of each joint's range) away from
+/// the joint limits.
+fn reach_within(
+    robot: &Robot,
+    start: &[f64],
+    target: &Vector3<f64>,
+    tol_mm: f64,
+    max_iter: usize,
+    margin: f64,
+) -> Option<Vec<f64>> {
     let n = robot.dof();
+    let bounds: Vec<(f64, f64)> = robot
+        .limits()
+        .iter()
+        .map(|l| {
+            let m = margin.min(0.25 * (l.max - l.min));
+            (l.min + m, l.max - m)
+        })
+        .collect();
     let mut q = start.to_vec();
     let mut jq = vec![Vector3::zeros(); n];
     for _ in 0..max_iter {
@@ -51,8 +74,8 @@ pub fn reach_position(
         if big > 0.2 {
             dq.iter_mut().for_each(|v| *v *= 0.2 / big);
         }
-        for ((v, d), l) in q.iter_mut().zip(&dq).zip(robot.limits()) {
-            *v = (*v + d).clamp(l.min, l.max);
+        for ((v, d), (lo, hi)) in q.iter_mut().zip(&dq).zip(&bounds) {
+            *v = (*v + d).clamp(*lo, *hi);
         }
     }
     None
@@ -72,7 +95,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Three poses whose nominal tool points lie on the plane `z = z_mm` (base frame), at the corners
-/// of an equilateral triangle centred on the base axis. `plane_z_mm: None` picks the median tool
+/// of an equilateral triangle centred on the base axis, with every joint at least 5 degrees (or a
+/// quarter of its range) inside its limits. `plane_z_mm: None` picks the median tool
 /// height of random poses; the triangle's radius is their median distance from the base axis.
 /// Returns the poses (rad, quantized as in the CSV) and the plane's height.
 pub fn plane_poses<R: Rng + ?Sized>(
@@ -110,7 +134,8 @@ pub fn plane_poses<R: Rng + ?Sized>(
                     .total_cmp(&(pos[b] - target).norm())
             });
             let hit = order.iter().take(STARTS_PER_CORNER).find_map(|&i| {
-                let mut q = reach_position(robot, &cands[i], &target, 1e-7, 200)?;
+                let margin = LIMIT_MARGIN_DEG.to_radians();
+                let mut q = reach_within(robot, &cands[i], &target, 1e-7, 200, margin)?;
                 quantize_joints(&mut q);
                 let p = robot.tool_position(&q);
                 ((p - target).norm() < 1e-5 && sampler.accepts(&p)).then_some(q)
@@ -153,7 +178,10 @@ mod tests {
         let p: Vec<_> = qs.iter().map(|q| r.tool_position(q)).collect();
         for (q, pi) in qs.iter().zip(&p) {
             assert!((pi.z - z).abs() < 1e-5, "{} vs {z}", pi.z);
-            assert!(r.joints_outside_limits(q).is_empty());
+            for (v, l) in q.iter().zip(r.limits()) {
+                let m = (LIMIT_MARGIN_DEG - 1e-6).to_radians();
+                assert!(v - l.min >= m && l.max - v >= m, "{v} near a limit");
+            }
             assert!(s.accepts(pi));
         }
         // Equilateral: every side at least 1.5 m for this robot.

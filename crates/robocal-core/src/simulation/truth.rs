@@ -76,6 +76,7 @@ impl GeometricErrors {
 
 /// Where the true robot comes from.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(clippy::large_enum_variant)] // built once per session; boxing would only burden callers
 pub enum TruthSpec {
     /// A given robot (a preset such as `kuka-kr480-r3330-table3`, a robot file, or the robot of
     /// an earlier truth file).
