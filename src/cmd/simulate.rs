@@ -313,25 +313,33 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     for w in &sim.warnings {
         eprintln!("warning: {w}");
     }
-    let sets = truth_file
-        .sets
+    // "wrote cell.csv (3 plane, 75 calibration rows), ..."
+    let mut per_file: Vec<(String, Vec<String>)> = Vec::new();
+    for (set, info) in &truth_file.sets {
+        let item = format!("{} {set}", info.rows);
+        match per_file.iter_mut().find(|(f, _)| *f == info.file) {
+            Some((_, v)) => v.push(item),
+            None => per_file.push((info.file.clone(), vec![item])),
+        }
+    }
+    let listing = per_file
         .iter()
-        .map(|(k, v)| format!("{} {k} in {}", v.rows, v.file))
+        .map(|(f, v)| format!("{f} ({} rows)", v.join(", ")))
         .collect::<Vec<_>>()
         .join(", ");
-    println!("wrote {sets}; truth in {}", truth_out.display());
+    println!("wrote {listing} and {}", truth_out.display());
+    let origin = match &truth_file.geometric_errors {
+        Some(e) => format!(
+            " (random errors: {} mm, {} deg, seed {})",
+            e.length_sigma_mm, e.angle_sigma_deg, cfg.seed
+        ),
+        None => String::new(),
+    };
+    let t = &cfg.tracker_frame;
+    println!("truth robot: {}{origin}", truth_file.robot.name);
     println!(
-        "truth robot: {} ({}); tracker at x={} y={} z={} mm, A={} B={} C={} deg; noise {} mm + {} mm/m per axis",
-        truth_file.robot.name,
-        truth_file.truth,
-        cfg.tracker_frame.x,
-        cfg.tracker_frame.y,
-        cfg.tracker_frame.z,
-        cfg.tracker_frame.a,
-        cfg.tracker_frame.b,
-        cfg.tracker_frame.c,
-        cfg.noise_mm,
-        cfg.noise_per_m
+        "tracker at x={} y={} z={} mm, A={} B={} C={} deg; noise {} mm + {} mm/m per axis",
+        t.x, t.y, t.z, t.a, t.b, t.c, cfg.noise_mm, cfg.noise_per_m
     );
     if let Some(g) = &truth_file.gravity_effect {
         println!(

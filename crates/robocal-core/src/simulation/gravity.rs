@@ -101,8 +101,14 @@ impl GravityModel {
     /// The point masses (kg) and their positions (mm, base frame) at joint values `q` (rad):
     /// one per link, then the payload.
     pub fn masses(&self, robot: &Robot, q: &[f64]) -> Vec<(f64, Vector3<f64>)> {
-        let axes = robot.joint_axes(q);
-        let tool = robot.tool_position(q);
+        self.masses_on(&robot.joint_axes(q), robot.tool_position(q))
+    }
+
+    fn masses_on(
+        &self,
+        axes: &[(Vector3<f64>, Vector3<f64>)],
+        tool: Vector3<f64>,
+    ) -> Vec<(f64, Vector3<f64>)> {
         let n = axes.len();
         let mut out = Vec::with_capacity(n + 1);
         for j in 0..n {
@@ -116,7 +122,7 @@ impl GravityModel {
     /// The gravity torque about each joint axis (N·m) at joint values `q` (rad).
     pub fn torques(&self, robot: &Robot, q: &[f64]) -> Vec<f64> {
         let axes = robot.joint_axes(q);
-        let masses = self.masses(robot, q);
+        let masses = self.masses_on(&axes, robot.tool_position(q));
         let g = Vector3::from(self.gravity_m_s2);
         // Mass k (k < n) belongs to link k and hangs beyond joints 0..=k; the payload (k = n)
         // beyond all joints.
