@@ -163,3 +163,52 @@ impl TruthFile {
         Ok(r)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::presets::preset;
+    use crate::simulation::{simulate, SimulationConfig, TruthSpec};
+
+    fn table3_file() -> TruthFile {
+        let nominal = preset("kuka-kr480-r3330").unwrap();
+        let truth = TruthSpec::Robot(preset("kuka-kr480-r3330-table3").unwrap());
+        let cfg = SimulationConfig {
+            poses: 2,
+            plane_points: false,
+            ..SimulationConfig::default()
+        };
+        simulate(&nominal, &truth, &cfg, &mut |_, _| {})
+            .unwrap()
+            .truth_file(&[])
+    }
+
+    #[test]
+    fn truth_robot_checks_the_file_against_the_nominal_robot() {
+        let nominal = preset("kuka-kr480-r3330").unwrap();
+        let p = Path::new("t.truth.json");
+        let tf = table3_file();
+        let r = tf.truth_robot(&nominal, p).unwrap();
+        assert_eq!(r.get_display(Param::D(3)), 1525.997);
+        assert_eq!(r.name(), "kuka-kr480-r3330-table3");
+
+        let mut missing = tf.clone();
+        missing.parameters.shift_remove("a3");
+        let e = missing.truth_robot(&nominal, p).unwrap_err().to_string();
+        assert!(
+            e.contains("t.truth.json") && e.contains("`a3` is missing"),
+            "{e}"
+        );
+
+        let mut unknown = tf.clone();
+        let entry = unknown.parameters["a3"].clone();
+        unknown.parameters.insert("a9".into(), entry);
+        let e = unknown.truth_robot(&nominal, p).unwrap_err().to_string();
+        assert!(e.contains("parameters.a9"), "{e}");
+
+        let mut other = tf.clone();
+        other.robot.dof = 7;
+        let e = other.truth_robot(&nominal, p).unwrap_err().to_string();
+        assert!(e.contains("robot.dof") && e.contains("7 joints"), "{e}");
+    }
+}
