@@ -313,6 +313,9 @@ fn outliers_and_gravity_are_recorded() {
     assert!((largest - max).abs() < 1e-5, "{largest} vs {max}");
 }
 
+/// A bad-input case: arguments, (option, path) pairs, exit code, expected message.
+type Case<'a> = (String, Vec<(&'a str, &'a Path)>, i32, &'a str);
+
 /// Every bad input: non-zero exit with a clear message, and no file written.
 #[test]
 fn bad_input_is_rejected_and_nothing_is_written() {
@@ -332,7 +335,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
     let wam = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/wam.toml");
     let out = d.path().join("out.csv");
     let kr = "--robot kuka-kr480-r3330 --truth kuka-kr480-r3330-table3";
-    let cases: Vec<(String, Vec<(&str, &Path)>, i32, &str)> = vec![
+    let cases: Vec<Case> = vec![
         (
             format!("{kr} --poses 5 --noise-mm -0.01"),
             vec![],
@@ -424,7 +427,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
             "--tracker",
         ),
         (
-            format!("{kr}"),
+            kr.to_string(),
             vec![("--joints", &joints)],
             3,
             "joints.csv:3: field `q3`",
