@@ -483,3 +483,17 @@ fn truth_file_roundtrip_gives_the_same_robot() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Drawing poses in chunks (as `simulate` does for its progress reports) gives the same poses
+/// as one draw.
+#[test]
+fn chunked_draws_equal_one_draw() {
+    let cfg = SimulationConfig::default();
+    let cell = VirtualCell::from_config(&kr480(), &table3(), &cfg).unwrap();
+    let whole = cell.clone().random_poses(2500).unwrap();
+    let mut c = cell.clone();
+    let mut parts = c.random_poses(1000).unwrap();
+    parts.extend(c.random_poses(1000).unwrap());
+    parts.extend(c.random_poses(500).unwrap());
+    assert_eq!(whole, parts);
+}
