@@ -3,6 +3,7 @@
 mod common;
 mod fk;
 mod robot;
+mod simulate;
 
 use clap::{Parser, Subcommand};
 
@@ -23,6 +24,8 @@ enum Command {
     Robot(robot::RobotCmd),
     /// Forward kinematics: the tool position for given joint values.
     Fk(fk::FkArgs),
+    /// Simulate a measurement: a true robot measured by a virtual laser tracker.
+    Simulate(Box<simulate::SimulateArgs>),
 }
 
 /// Runs a parsed command line.
@@ -30,5 +33,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Robot(c) => robot::run(c),
         Command::Fk(a) => fk::run(a),
+        Command::Simulate(a) => simulate::run(*a),
     }
 }

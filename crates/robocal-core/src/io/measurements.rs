@@ -6,9 +6,8 @@
 //! mark are accepted. Every rejection names the file, the line and the column.
 
 use crate::error::{Error, Result};
-use crate::io::atomic::AtomicFile;
 use nalgebra::Vector3;
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 /// Whether a file must, may or must not have `x,y,z` columns.
@@ -278,36 +277,37 @@ fn csv_error(path: &Path, e: csv::Error) -> Error {
 /// Writes a measurement (or joint) CSV atomically: `q1..qn` in degrees, then `x,y,z` in mm if
 /// every row has a position, then the extra columns.
 pub fn write_measurements(path: &Path, set: &MeasurementSet) -> Result<()> {
-    let mut out = AtomicFile::create(path)?;
-    let io = |e: std::io::Error| Error::Io {
+    let bytes = measurements_csv(set).map_err(|e| Error::Io {
         path: path.to_owned(),
         source: e,
-    };
+    })?;
+    crate::io::atomic::write_atomic(path, &bytes)
+}
+
+/// The CSV text [`write_measurements`] writes (`q` with 9 decimals of a degree, `x,y,z` with 6
+/// decimals of a millimetre), for callers that write several files together
+/// ([`crate::io::write_all_atomic`]).
+pub fn measurements_csv(set: &MeasurementSet) -> std::io::Result<Vec<u8>> {
     let with_p = set.has_positions();
     let mut header: Vec<String> = (1..=set.dof).map(|i| format!("q{i}")).collect();
     if with_p {
         header.extend(["x", "y", "z"].map(String::from));
     }
     header.extend(set.extra_columns.iter().cloned());
-    {
-        let mut w = csv::Writer::from_writer(&mut out);
-        w.write_record(&header)
-            .map_err(|e| io(std::io::Error::other(e)))?;
-        let mut fields = Vec::with_capacity(header.len());
-        for r in &set.rows {
-            fields.clear();
-            fields.extend(r.q.iter().map(|v| format!("{:.9}", v.to_degrees())));
-            if let (true, Some(p)) = (with_p, r.p) {
-                fields.extend([p.x, p.y, p.z].iter().map(|v| format!("{v:.6}")));
-            }
-            fields.extend(r.extra.iter().cloned());
-            w.write_record(&fields)
-                .map_err(|e| io(std::io::Error::other(e)))?;
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(&header).map_err(std::io::Error::other)?;
+    let mut fields = Vec::with_capacity(header.len());
+    for r in &set.rows {
+        fields.clear();
+        fields.extend(r.q.iter().map(|v| format!("{:.9}", v.to_degrees())));
+        if let (true, Some(p)) = (with_p, r.p) {
+            fields.extend([p.x, p.y, p.z].iter().map(|v| format!("{v:.6}")));
         }
-        w.flush().map_err(io)?;
+        fields.extend(r.extra.iter().cloned());
+        w.write_record(&fields).map_err(std::io::Error::other)?;
     }
-    out.flush().map_err(io)?;
-    out.commit()
+    w.into_inner()
+        .map_err(|e| std::io::Error::other(e.to_string()))
 }
 
 #[cfg(test)]

@@ -1,0 +1,157 @@
+//! The settings of a simulated measurement session, validated before any work is done.
+
+use super::gravity::GravityModel;
+use super::outliers::OutlierModel;
+use super::poses::PoseSampler;
+use crate::error::{Error, Result};
+use crate::io::result::FrameVec;
+use crate::model::Robot;
+use serde::{Deserialize, Serialize};
+
+/// The default pose of the tracker in the robot's base frame (mm, deg): 3.8 m away horizontally
+/// and 1.2 m up (about 4 m from the base origin), turned by 125 degrees about its vertical axis,
+/// levelled. A point m read by the tracker is `pose(frame) * m` in the base frame.
+pub const DEFAULT_TRACKER_FRAME: [f64; 6] = [3112.8, -2179.6, 1200.0, 125.0, 0.0, 0.0];
+
+/// The default tracker noise: 0.010 mm + 0.005 mm per metre of distance, per axis (ASME
+/// B89.4.19-style figures).
+pub const DEFAULT_NOISE_MM: f64 = 0.010;
+/// See [`DEFAULT_NOISE_MM`].
+pub const DEFAULT_NOISE_PER_M: f64 = 0.005;
+
+/// The default footprint radius as a fraction of the chain's total length (see
+/// [`SimulationConfig::footprint_radius`]).
+pub const FOOTPRINT_FRACTION: f64 = 0.15;
+
+/// Everything that defines a simulated session except the robots: poses, tracker, noise,
+/// non-geometric errors and the seed. All lengths in mm, angles in degrees.
+///
+/// Build it from [`SimulationConfig::default`] and set the fields, then call
+/// [`SimulationConfig::validate`] (the simulation functions call it too).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SimulationConfig {
+    /// The seed of every random choice. The same seed gives the same truth robot (for a
+    /// `random` truth), the same poses and the same noise.
+    pub seed: u64,
+    /// Number of random calibration poses (set `calibration`).
+    pub poses: usize,
+    /// Number of random validation poses (set `validation`), drawn independently of the
+    /// calibration poses.
+    pub validation_poses: usize,
+    /// Whether to add the paper's three plane points (set `plane`).
+    pub plane_points: bool,
+    /// Height of the plane of the three plane points (mm, base frame); `None`: the median tool
+    /// height of random poses.
+    pub plane_z_mm: Option<f64>,
+    /// Tool points below this height (mm, base frame) are rejected.
+    pub floor_z_mm: f64,
+    /// Tool points closer than this to the base z axis (mm) are rejected; `None`:
+    /// [`FOOTPRINT_FRACTION`] of the chain's total length.
+    pub footprint_radius_mm: Option<f64>,
+    /// Pose of the tracker frame in the base frame (mm, deg).
+    pub tracker_frame: FrameVec,
+    /// Constant part of the tracker's noise: standard deviation per axis (mm).
+    pub noise_mm: f64,
+    /// Distance-proportional part of the noise: standard deviation per axis per metre from the
+    /// tracker (mm/m).
+    pub noise_per_m: f64,
+    /// Gravity-induced joint deflection (off when `None`).
+    pub gravity: Option<GravityModel>,
+    /// Gross outliers (off when `None`).
+    pub outliers: Option<OutlierModel>,
+}
+
+impl Default for SimulationConfig {
+    /// Seed 1, 75 calibration poses and the plane points, no validation poses, floor at z = 0,
+    /// automatic footprint, the default tracker and noise, no non-geometric errors.
+    fn default() -> Self {
+        let t = DEFAULT_TRACKER_FRAME;
+        SimulationConfig {
+            seed: 1,
+            poses: 75,
+            validation_poses: 0,
+            plane_points: true,
+            plane_z_mm: None,
+            floor_z_mm: 0.0,
+            footprint_radius_mm: None,
+            tracker_frame: FrameVec {
+                x: t[0],
+                y: t[1],
+                z: t[2],
+                a: t[3],
+                b: t[4],
+                c: t[5],
+            },
+            noise_mm: DEFAULT_NOISE_MM,
+            noise_per_m: DEFAULT_NOISE_PER_M,
+            gravity: None,
+            outliers: None,
+        }
+    }
+}
+
+fn nonneg(name: &str, v: f64) -> Result<()> {
+    if !v.is_finite() || v < 0.0 {
+        return Err(Error::invalid(
+            name,
+            format!("{v} must be a finite number >= 0"),
+        ));
+    }
+    Ok(())
+}
+
+impl SimulationConfig {
+    /// Checks every setting against the nominal robot. Errors name the command-line option.
+    /// The number of poses is checked by [`super::simulate`], which needs it (measuring given
+    /// joints does not).
+    pub fn validate(&self, nominal: &Robot) -> Result<()> {
+        nonneg("--noise-mm", self.noise_mm)?;
+        nonneg("--noise-per-m", self.noise_per_m)?;
+        let t = &self.tracker_frame;
+        if [t.x, t.y, t.z, t.a, t.b, t.c]
+            .iter()
+            .any(|v| !v.is_finite())
+        {
+            return Err(Error::invalid("--tracker", "not a finite frame vector"));
+        }
+        if !self.floor_z_mm.is_finite() {
+            return Err(Error::invalid("--floor-mm", "not a finite number"));
+        }
+        if let Some(r) = self.footprint_radius_mm {
+            nonneg("--footprint-mm", r)?;
+        }
+        if let Some(z) = self.plane_z_mm {
+            if !z.is_finite() {
+                return Err(Error::invalid("--plane-z-mm", "not a finite number"));
+            }
+        }
+        if let Some(g) = &self.gravity {
+            g.validate(nominal.dof())?;
+        }
+        if let Some(o) = &self.outliers {
+            o.validate()?;
+        }
+        Ok(())
+    }
+
+    /// The footprint radius used (mm): the configured one, or [`FOOTPRINT_FRACTION`] of the
+    /// chain's total length `sum(|a_i| + |d_i|) + |tool translation|` (an upper bound of its
+    /// reach): about 750 mm for the KR 480 R3330, 180 mm for a UR5.
+    pub fn footprint_radius(&self, nominal: &Robot) -> f64 {
+        self.footprint_radius_mm.unwrap_or_else(|| {
+            let links: f64 = nominal.links().iter().map(|l| l.a.abs() + l.d.abs()).sum();
+            let t = nominal.tool0();
+            let tool = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+            FOOTPRINT_FRACTION * (links + tool)
+        })
+    }
+
+    /// The pose sampler of these settings for `nominal`.
+    pub fn sampler(&self, nominal: &Robot) -> PoseSampler {
+        PoseSampler {
+            floor_z_mm: self.floor_z_mm,
+            footprint_radius_mm: self.footprint_radius(nominal),
+            ..PoseSampler::default()
+        }
+    }
+}

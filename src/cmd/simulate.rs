@@ -1,0 +1,357 @@
+//! `robocal simulate`: measure a virtual robot with a virtual laser tracker.
+
+use super::common;
+use crate::exit;
+use anyhow::Context;
+use clap::Args;
+use robocal_core::io::measurements::{measurements_csv, read_measurements, Positions};
+use robocal_core::io::result::FrameVec;
+use robocal_core::io::write_all_atomic;
+use robocal_core::simulation::{
+    simulate, simulate_joints, GeometricErrors, GravityModel, OutlierModel, SimulationConfig,
+    TruthFile, TruthSpec, SET_VALIDATION,
+};
+use robocal_core::Robot;
+use std::path::{Path, PathBuf};
+
+/// Rows from which a progress bar is shown.
+const BAR_FROM: usize = 10_000;
+
+#[derive(Args, Debug)]
+pub struct SimulateArgs {
+    /// The nominal robot, the model the controller believes: a preset or a TOML robot file.
+    #[arg(long)]
+    robot: String,
+    /// The robot that really moves: a preset (e.g. kuka-kr480-r3330-table3), a TOML robot file,
+    /// the truth file (*.truth.json) of an earlier simulation (its tracker frame too), or
+    /// `random`: the nominal robot with seeded random geometric errors.
+    #[arg(long)]
+    truth: String,
+    /// Number of random calibration poses (set `calibration`).
+    #[arg(long, required_unless_present = "joints")]
+    poses: Option<usize>,
+    /// Measure the joint values of this CSV (q1..qn in degrees) instead of random poses, e.g.
+    /// commanded joints in the verification phase. Rows keep their order and extra columns; any
+    /// x,y,z columns are replaced by the new readings.
+    #[arg(long, conflicts_with_all = ["poses", "validation", "no_plane", "plane_z_mm"])]
+    joints: Option<PathBuf>,
+    /// Seed of every random choice: same arguments and seed give byte-identical files.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// The measurement CSV to write; the truth goes to FILE.truth.json beside it.
+    #[arg(long)]
+    out: PathBuf,
+    /// Also draw N validation poses (set `validation`), in the same file unless
+    /// --validation-out is given.
+    #[arg(long, default_value_t = 0)]
+    validation: usize,
+    /// Write the validation rows to this CSV instead of --out.
+    #[arg(long)]
+    validation_out: Option<PathBuf>,
+    /// Leave out the paper's three points on a plane parallel to the base plane (set `plane`).
+    #[arg(long)]
+    no_plane: bool,
+    /// Height of the plane points' plane (mm, base frame); default: the median tool height of
+    /// random poses.
+    #[arg(long, allow_hyphen_values = true)]
+    plane_z_mm: Option<f64>,
+    /// Pose of the tracker in the robot's base frame, x,y,z,A,B,C (mm, deg); default
+    /// 3112.8,-2179.6,1200,125,0,0 (about 4 m away, turned 125 degrees, levelled).
+    #[arg(long, allow_hyphen_values = true)]
+    tracker: Option<String>,
+    /// Tracker noise, constant part: standard deviation per axis (mm).
+    #[arg(long, default_value_t = robocal_core::simulation::DEFAULT_NOISE_MM, allow_hyphen_values = true)]
+    noise_mm: f64,
+    /// Tracker noise, distance part: standard deviation per axis per metre from the tracker (mm/m).
+    #[arg(long, default_value_t = robocal_core::simulation::DEFAULT_NOISE_PER_M, allow_hyphen_values = true)]
+    noise_per_m: f64,
+    /// With --truth random: standard deviation of the length errors (d, a, base and tool
+    /// x/y/z), mm [default: 0.5].
+    #[arg(long, allow_hyphen_values = true)]
+    length_error_mm: Option<f64>,
+    /// With --truth random: standard deviation of the angle errors (alpha, phi, base and tool
+    /// A/B/C), deg [default: 0.03].
+    #[arg(long, allow_hyphen_values = true)]
+    angle_error_deg: Option<f64>,
+    /// With --truth random: also tilt (Hayati beta) every joint axis nominally parallel to the
+    /// previous one, an error modified DH cannot represent.
+    #[arg(long)]
+    tilt_parallel_axes: bool,
+    /// Reject random poses whose nominal tool point is below this height (mm, base frame).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    floor_mm: f64,
+    /// Reject random poses whose nominal tool point is closer than this to the base axis (mm);
+    /// default: 15% of the chain's total length.
+    #[arg(long, allow_hyphen_values = true)]
+    footprint_mm: Option<f64>,
+    /// Gravity deflection: joint compliances in rad per N·m, one value for all joints or one per
+    /// joint (e.g. 1e-7). Turns the gravity model on.
+    #[arg(long, allow_hyphen_values = true)]
+    compliance: Option<String>,
+    /// Gravity deflection: link masses in kg, one value for all or one per joint (link j is
+    /// moved by joint j, its mass at its midpoint) [default: 0].
+    #[arg(long, allow_hyphen_values = true, requires = "compliance")]
+    link_masses_kg: Option<String>,
+    /// Gravity deflection: payload at the tool point, kg [default: 0].
+    #[arg(long, allow_hyphen_values = true, requires = "compliance")]
+    payload_kg: Option<f64>,
+    /// Gross outliers: fraction of the readings displaced, in [0, 1].
+    #[arg(long, allow_hyphen_values = true)]
+    outlier_fraction: Option<f64>,
+    /// Gross outliers: smallest displacement, mm [default: 2].
+    #[arg(long, allow_hyphen_values = true, requires = "outlier_fraction")]
+    outlier_min_mm: Option<f64>,
+    /// Gross outliers: largest displacement, mm [default: 5].
+    #[arg(long, allow_hyphen_values = true, requires = "outlier_fraction")]
+    outlier_max_mm: Option<f64>,
+}
+
+/// A list of numbers: one value for every joint, or one per joint.
+fn per_joint(name: &str, s: &str, dof: usize) -> anyhow::Result<Vec<f64>> {
+    let mut v = Vec::new();
+    for (i, part) in s.split(',').enumerate() {
+        let part = part.trim();
+        v.push(part.parse::<f64>().map_err(|_| {
+            exit::usage(format!("{name}: value {} `{part}` is not a number", i + 1))
+        })?);
+    }
+    match v.len() {
+        1 => Ok(vec![v[0]; dof]),
+        n if n == dof => Ok(v),
+        n => Err(exit::usage(format!(
+            "{name}: {n} values; give one for all joints or one per joint ({dof})"
+        ))),
+    }
+}
+
+fn tracker_arg(s: &str) -> anyhow::Result<FrameVec> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| exit::usage(format!("--tracker: `{s}` is not a list of numbers")))?;
+    let [x, y, z, a, b, c] = v[..] else {
+        return Err(exit::usage(format!(
+            "--tracker: expected 6 values x,y,z,A,B,C (mm, deg), got {}",
+            v.len()
+        )));
+    };
+    Ok(FrameVec { x, y, z, a, b, c })
+}
+
+/// The truth robot and, for a truth file, its tracker frame.
+fn truth_arg(a: &SimulateArgs, nominal: &Robot) -> anyhow::Result<(TruthSpec, Option<FrameVec>)> {
+    let random = a.truth == "random";
+    if !random
+        && (a.length_error_mm.is_some() || a.angle_error_deg.is_some() || a.tilt_parallel_axes)
+    {
+        return Err(exit::usage(
+            "--length-error-mm, --angle-error-deg and --tilt-parallel-axes apply only to --truth random",
+        ));
+    }
+    if random {
+        let d = GeometricErrors::default();
+        let e = GeometricErrors {
+            length_sigma_mm: a.length_error_mm.unwrap_or(d.length_sigma_mm),
+            angle_sigma_deg: a.angle_error_deg.unwrap_or(d.angle_sigma_deg),
+            tilt_parallel_axes: a.tilt_parallel_axes,
+        };
+        return Ok((TruthSpec::Random(e), None));
+    }
+    if a.truth.ends_with(".json") {
+        let p = Path::new(&a.truth);
+        let tf = TruthFile::read(p)?;
+        let robot = tf.truth_robot(nominal, p)?;
+        return Ok((TruthSpec::Robot(robot), Some(tf.tracker_frame)));
+    }
+    let robot =
+        robocal_core::load_robot(&a.truth).with_context(|| format!("--truth {}", a.truth))?;
+    Ok((TruthSpec::Robot(robot), None))
+}
+
+fn config(
+    a: &SimulateArgs,
+    nominal: &Robot,
+    truth_tracker: Option<FrameVec>,
+) -> anyhow::Result<SimulationConfig> {
+    let d = SimulationConfig::default();
+    let gravity = match &a.compliance {
+        None => None,
+        Some(c) => {
+            let dof = nominal.dof();
+            Some(GravityModel::new(
+                per_joint("--compliance", c, dof)?,
+                match &a.link_masses_kg {
+                    Some(m) => per_joint("--link-masses-kg", m, dof)?,
+                    None => vec![0.0; dof],
+                },
+                a.payload_kg.unwrap_or(0.0),
+            ))
+        }
+    };
+    let outliers = a.outlier_fraction.map(|fraction| {
+        let o = OutlierModel::default();
+        OutlierModel {
+            fraction,
+            min_mm: a.outlier_min_mm.unwrap_or(o.min_mm),
+            max_mm: a.outlier_max_mm.unwrap_or(o.max_mm),
+        }
+    });
+    let tracker_frame = match &a.tracker {
+        Some(s) => tracker_arg(s)?,
+        None => truth_tracker.unwrap_or(d.tracker_frame),
+    };
+    let joints = a.joints.is_some();
+    Ok(SimulationConfig {
+        seed: a.seed,
+        poses: a.poses.unwrap_or(0),
+        validation_poses: a.validation,
+        plane_points: !a.no_plane && !joints,
+        plane_z_mm: a.plane_z_mm,
+        floor_z_mm: a.floor_mm,
+        footprint_radius_mm: a.footprint_mm,
+        tracker_frame,
+        noise_mm: a.noise_mm,
+        noise_per_m: a.noise_per_m,
+        gravity,
+        outliers,
+    })
+}
+
+/// `FILE.truth.json` beside `FILE.csv`.
+fn truth_path(out: &Path) -> PathBuf {
+    out.with_extension("truth.json")
+}
+
+pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
+    if a.validation_out.is_some() && a.validation == 0 {
+        return Err(exit::usage(
+            "--validation-out needs --validation N (N >= 1)",
+        ));
+    }
+    let truth_out = truth_path(&a.out);
+    let mut outputs = vec![a.out.clone(), truth_out.clone()];
+    outputs.extend(a.validation_out.iter().cloned());
+    for (i, p) in outputs.iter().enumerate() {
+        if outputs[..i].contains(p) {
+            return Err(exit::usage(format!(
+                "{} is given for two outputs",
+                p.display()
+            )));
+        }
+        if a.joints.as_deref() == Some(p.as_path()) && *p != a.out {
+            return Err(exit::usage(format!(
+                "{} is the --joints input",
+                p.display()
+            )));
+        }
+    }
+    let nominal = common::robot(&a.robot)?;
+    let (truth, truth_tracker) = truth_arg(&a, &nominal)?;
+    let cfg = config(&a, &nominal, truth_tracker)?;
+    cfg.validate(&nominal)?;
+
+    let joints = match &a.joints {
+        Some(p) => Some(read_measurements(p, nominal.dof(), Positions::Optional)?),
+        None => None,
+    };
+    let rows = match &joints {
+        Some(j) => j.rows.len(),
+        None => cfg.poses + cfg.validation_poses + if cfg.plane_points { 3 } else { 0 },
+    };
+    let bar = (rows >= BAR_FROM).then(|| crate::progress::bar(0, "simulating"));
+    let mut progress = |done: usize, total: usize| {
+        if let Some(b) = &bar {
+            b.set_length(total as u64);
+            b.set_position(done as u64);
+        }
+    };
+    let sim = match &joints {
+        Some(j) => simulate_joints(&nominal, &truth, &cfg, j, &mut progress)?,
+        None => simulate(&nominal, &truth, &cfg, &mut progress)?,
+    };
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+
+    // Split the validation rows off if asked; every row's file, in row order, for the truth file.
+    let (main, val) = match &a.validation_out {
+        Some(_) => (
+            sim.select(SET_VALIDATION, false),
+            Some(sim.select(SET_VALIDATION, true)),
+        ),
+        None => (sim.measurements.clone(), None),
+    };
+    let m = &sim.measurements;
+    let set_col = m.extra_columns.iter().position(|c| c == "set");
+    let files: Vec<&Path> = m
+        .rows
+        .iter()
+        .map(|r| {
+            let is_val = set_col.is_some_and(|k| r.extra[k] == SET_VALIDATION);
+            match (&a.validation_out, is_val) {
+                (Some(v), true) => v.as_path(),
+                _ => a.out.as_path(),
+            }
+        })
+        .collect();
+    let truth_file = sim.truth_file(&files);
+    let io = |p: &Path, e: std::io::Error| robocal_core::Error::Io {
+        path: p.to_owned(),
+        source: e,
+    };
+    let main_csv = measurements_csv(&main).map_err(|e| io(&a.out, e))?;
+    let json = truth_file.to_json()?;
+    let mut writes: Vec<(&Path, Vec<u8>)> = vec![(a.out.as_path(), main_csv)];
+    if let (Some(p), Some(v)) = (&a.validation_out, &val) {
+        writes.push((p.as_path(), measurements_csv(v).map_err(|e| io(p, e))?));
+    }
+    writes.push((truth_out.as_path(), json.into_bytes()));
+    let refs: Vec<(&Path, &[u8])> = writes.iter().map(|(p, b)| (*p, b.as_slice())).collect();
+    write_all_atomic(&refs)?;
+
+    for w in &sim.warnings {
+        eprintln!("warning: {w}");
+    }
+    // "wrote cell.csv (3 plane, 75 calibration rows), ..."
+    let mut per_file: Vec<(String, Vec<String>)> = Vec::new();
+    for (set, info) in &truth_file.sets {
+        let item = format!("{} {set}", info.rows);
+        match per_file.iter_mut().find(|(f, _)| *f == info.file) {
+            Some((_, v)) => v.push(item),
+            None => per_file.push((info.file.clone(), vec![item])),
+        }
+    }
+    let listing = per_file
+        .iter()
+        .map(|(f, v)| format!("{f} ({} rows)", v.join(", ")))
+        .collect::<Vec<_>>()
+        .join(", ");
+    println!("wrote {listing} and {}", truth_out.display());
+    let origin = match &truth_file.geometric_errors {
+        Some(e) => format!(
+            " (random errors: {} mm, {} deg, seed {})",
+            e.length_sigma_mm, e.angle_sigma_deg, cfg.seed
+        ),
+        None => String::new(),
+    };
+    let t = &cfg.tracker_frame;
+    println!("truth robot: {}{origin}", truth_file.robot.name);
+    println!(
+        "tracker at x={} y={} z={} mm, A={} B={} C={} deg; noise {} mm + {} mm/m per axis",
+        t.x, t.y, t.z, t.a, t.b, t.c, cfg.noise_mm, cfg.noise_per_m
+    );
+    if let Some(g) = &truth_file.gravity_effect {
+        println!(
+            "gravity deflection moved the tool by {:.3} mm on average (max {:.3} mm)",
+            g.mean_mm, g.max_mm
+        );
+    }
+    if !truth_file.outliers.is_empty() {
+        println!(
+            "{} outliers injected (lines listed in the truth file)",
+            truth_file.outliers.len()
+        );
+    }
+    Ok(())
+}
