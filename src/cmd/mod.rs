@@ -1,5 +1,6 @@
 //! Command-line interface: one module per subcommand.
 
+mod calibrate;
 mod common;
 mod fk;
 mod robot;
@@ -23,6 +24,8 @@ enum Command {
     Robot(robot::RobotCmd),
     /// Forward kinematics: the tool position for given joint values.
     Fk(fk::FkArgs),
+    /// Fit the measurement frame and identify the calibrated parameters (writes a result JSON).
+    Calibrate(calibrate::CalibrateArgs),
 }
 
 /// Runs a parsed command line.
@@ -30,5 +33,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Robot(c) => robot::run(c),
         Command::Fk(a) => fk::run(a),
+        Command::Calibrate(a) => calibrate::run(a),
     }
 }
