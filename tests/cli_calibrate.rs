@@ -298,7 +298,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
     run(
         &few,
         &[],
-        3,
+        5,
         &["20 calibration points for 26 identifiable parameters"],
     );
     // A duplicated pose.
@@ -320,6 +320,17 @@ fn bad_input_is_rejected_and_nothing_is_written() {
         &[],
         3,
         &["nan.csv:4", "field `y`", "not a finite number"],
+    );
+    // An absurd reading (a unit mistake or a corrupt file).
+    cells[8] = "1e300".into();
+    lines[3] = cells.join(",");
+    let huge = dir.path().join("huge.csv");
+    std::fs::write(&huge, lines.join("\n")).unwrap();
+    run(
+        &huge,
+        &[],
+        3,
+        &["huge.csv:4", "not a plausible tracker reading"],
     );
     // A joint count that differs from the robot's.
     let seven = dir.path().join("seven.csv");
@@ -343,7 +354,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
     run(
         &ok,
         &["--free", "tool_a"],
-        3,
+        5,
         &["--free", "tool_a: no effect"],
     );
     run(&ok, &["--beta", "9"], 2, &["--beta", "joint 9"]);

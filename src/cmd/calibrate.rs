@@ -248,6 +248,14 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let cal = result.with_context(|| format!("calibrating from {}", a.data.display()))?;
     print_report(&cal);
+    if cal.registration.stats.mean_mm > 50.0 {
+        eprintln!(
+            "warning: the nominal model misses the measured points by {:.1} mm on average \
+             after the frame fit: check that positions are in mm, joint values in degrees and \
+             that --robot matches the data",
+            cal.registration.stats.mean_mm
+        );
+    }
     let mut extra = serde_json::Map::new();
     extra.insert("robot_arg".into(), json!(a.robot));
     extra.insert("data".into(), json!(a.data.display().to_string()));
@@ -362,40 +370,27 @@ fn print_report(c: &Calibration) {
         println!("  {:<8} fixed: {}", f.param.name(), f.describe());
     }
     println!();
-    println!("Table III. Calibrated parameters of the robot");
-    print!("{}", crate::tables::parameter_table(&c.calibrated, 4));
-    println!();
-    println!(
-        "{:<8} {:>14} {:>14} {:>12} {:>10}  {:<4} status",
-        "name", "nominal", "calibrated", "change", "std", "unit"
+    let fixed = |p: Param| c.covariance.std_of(p).is_none();
+    println!("Table III. Calibrated parameters of the robot (* fixed at its nominal value)");
+    print!(
+        "{}",
+        layout(&c.calibrated, &|p| {
+            let v = num(c.calibrated.get_display(p), 4);
+            if fixed(p) {
+                format!("{v}*")
+            } else {
+                format!("{v} ")
+            }
+        })
     );
-    for p in c.calibrated.params() {
-        let nom = c.nominal.get_display(p);
-        let cal = c.calibrated.get_display(p);
-        let (std, status) = match c.covariance.std_of(p) {
-            Some(sd) => (
-                format!("{:.6}", p.unit().from_internal(sd)),
-                "identified".to_string(),
-            ),
-            None => (
-                "-".to_string(),
-                format!(
-                    "fixed: {}",
-                    id.fixed_reason(p).map_or("fixed".into(), |f| f.describe())
-                ),
-            ),
-        };
-        println!(
-            "{:<8} {:>14.6} {:>14.6} {:>12.6} {:>10}  {:<4} {}",
-            p.name(),
-            nom,
-            cal,
-            cal - nom,
-            std,
-            p.unit().as_str(),
-            status
-        );
-    }
+    println!("Standard deviations (same layout; - fixed)");
+    print!(
+        "{}",
+        layout(&c.calibrated, &|p| match c.covariance.std_of(p) {
+            Some(sd) => format!("{:.4} ", p.unit().from_internal(sd)),
+            None => "- ".to_string(),
+        })
+    );
     let corr = c.covariance.most_correlated(5);
     if !corr.is_empty() {
         println!(
@@ -445,4 +440,70 @@ fn print_report(c: &Calibration) {
             &after_cols
         )
     );
+}
+
+/// A number with `decimals` decimals, without a minus sign on zero.
+fn num(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        s.trim_start_matches('-').to_owned()
+    } else {
+        s
+    }
+}
+
+/// The layout of the paper's Table III (rows per joint: alpha, d, a, phi and beta where enabled;
+/// columns B and T with x, y, z in mm and A, B, C in degrees), each cell given by `cell`.
+fn layout(robot: &Robot, cell: &dyn Fn(Param) -> String) -> String {
+    use std::fmt::Write;
+    let n = robot.dof();
+    let any_beta = (0..n).any(|i| robot.beta_enabled(i));
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        "{:>3} {:>13} {:>13} {:>13} {:>13}",
+        "i", "alpha (deg)", "d (mm)", "a (mm)", "phi (deg)"
+    );
+    if any_beta {
+        let _ = write!(s, " {:>13}", "beta (deg)");
+    }
+    let _ = writeln!(s, " {:>13} {:>13}", "B", "T");
+    let units = ["mm", "mm", "mm", "deg", "deg", "deg"];
+    for i in 0..n.max(6) {
+        if i < n {
+            let _ = write!(s, "{:>3}", i + 1);
+            for p in [Param::Alpha(i), Param::D(i), Param::A(i), Param::Phi(i)] {
+                let _ = write!(s, " {:>13}", cell(p));
+            }
+            if any_beta {
+                let b = if robot.beta_enabled(i) {
+                    cell(Param::Beta(i))
+                } else {
+                    String::new()
+                };
+                let _ = write!(s, " {b:>13}");
+            }
+        } else {
+            let _ = write!(
+                s,
+                "{:>3}{}",
+                "",
+                " ".repeat(14 * if any_beta { 5 } else { 4 })
+            );
+        }
+        if i < 6 {
+            let _ = write!(
+                s,
+                " {:>13} {:>13}  ({})",
+                cell(Param::Base(i)),
+                cell(Param::Tool(i)),
+                units[i]
+            );
+        }
+        s.push('\n');
+    }
+    s
 }

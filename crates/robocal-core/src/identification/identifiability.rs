@@ -316,19 +316,16 @@ pub fn analyze(
         }
     }
     if !bad.is_empty() {
-        return Err(Error::invalid(
-            "--free",
-            format!(
-                "cannot identify {} from these poses ({}); free only one of a set of \
-                 parameters with the same effect",
-                if bad.len() == 1 {
-                    "this parameter"
-                } else {
-                    "these parameters"
-                },
-                bad.join("; ")
-            ),
-        ));
+        return Err(Error::Numerical(format!(
+            "--free: cannot identify {} from these poses ({}); free only one of a set of \
+             parameters with the same effect",
+            if bad.len() == 1 {
+                "this parameter"
+            } else {
+                "these parameters"
+            },
+            bad.join("; ")
+        )));
     }
     let sv = svd.singular_values;
     let (smax, smin) = sv

@@ -7,6 +7,10 @@ use crate::model::Robot;
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
 
+/// Largest accepted measured coordinate (mm): 10 km, far beyond any tracker's range, but small
+/// enough that squares and sums of coordinates stay accurate.
+pub const MAX_COORDINATE_MM: f64 = 1e7;
+
 /// A set of measured tool points: joint values (model values, rad, stored flat) and the measured
 /// position of the tool in the tracker frame (mm), with the 1-based CSV line of each point.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -57,6 +61,16 @@ impl Observations {
             return Err(Error::invalid(
                 format!("{at}: {}", ["x", "y", "z"][k]),
                 "not a finite number",
+            ));
+        }
+        if let Some(k) = m.iter().position(|v| v.abs() > MAX_COORDINATE_MM) {
+            return Err(Error::invalid(
+                format!("{at}: {}", ["x", "y", "z"][k]),
+                format!(
+                    "{:.3e} mm is not a plausible tracker reading (more than {} km away)",
+                    m[k],
+                    MAX_COORDINATE_MM / 1e6
+                ),
             ));
         }
         self.q.extend_from_slice(q);

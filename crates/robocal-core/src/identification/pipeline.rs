@@ -136,7 +136,8 @@ pub struct Calibration {
     pub validation: Option<SetErrors>,
     /// The robust loss's scale (mm), for robust objectives.
     pub robust_scale_mm: Option<f64>,
-    /// Points the robust loss down-weighted (weight below 1/2), largest error first.
+    /// Points whose error exceeds the robust scale (Cauchy weight below 1/2, Huber weight below
+    /// 1), largest error first.
     pub downweighted: Vec<DownWeighted>,
     /// The settings used.
     pub settings: CalibrationSettings,
@@ -223,14 +224,11 @@ pub fn calibrate(
         ));
     }
     if cal.len() < k {
-        return Err(Error::invalid(
-            "calibration data",
-            format!(
-                "{} calibration points for {k} identifiable parameters: at least {k} points are \
+        return Err(Error::Numerical(format!(
+            "{} calibration points for {k} identifiable parameters: at least {k} points are \
                  needed (the paper uses 75)",
-                cal.len()
-            ),
-        ));
+            cal.len()
+        )));
     }
 
     let problem = Problem::new(nominal, &ident.identified, cal, &registration.frame);
@@ -276,7 +274,7 @@ pub fn calibrate(
             };
             let scale_of = |r: &Robot| {
                 let med = percentile(&problem.error_norms(r), 0.5);
-                (ROBUST_SCALE_SIGMAS * med / CHI3_MEDIAN).max(1e-9)
+                (ROBUST_SCALE_SIGMAS * med / CHI3_MEDIAN).max(SUM_OF_NORMS_SMOOTHING_MM)
             };
             let mut c = settings.robust_scale_mm.unwrap_or_else(|| scale_of(&robot));
             let mut loss = make(c);

@@ -559,3 +559,73 @@ fn bad_input_is_rejected_with_reasons() {
     );
     let _ = Frame::identity();
 }
+
+#[test]
+fn solver_reports_why_it_stopped() {
+    let truth = table3();
+    let tr = tracker(0.010, 0.005);
+    let mut rng = ChaCha8Rng::seed_from_u64(91);
+    let cal = measure(&truth, &tr, 75, &mut rng);
+    let nom = nominal();
+    let id = analyze(&nom, &cal, &IdentifiabilityOptions::default()).unwrap();
+    let frame = crate::registration::register(
+        &nom,
+        &cal,
+        None,
+        &crate::registration::RegistrationOptions::default(),
+    )
+    .unwrap()
+    .frame;
+    let problem = Problem::new(&nom, &id.identified, &cal, &frame);
+    let loss = Loss::SumOfNorms { delta: 1e-6 };
+    // One iteration: stopped by the limit, objective lowered, progress called once.
+    let mut r = nom.clone();
+    let mut calls = Vec::new();
+    let opts = SolverOptions {
+        max_iterations: 1,
+        ..Default::default()
+    };
+    let rep = solve(&problem, &mut r, &loss, &opts, &mut |i, n| {
+        calls.push((i, n))
+    });
+    assert_eq!(rep.termination, Termination::MaxIterations);
+    assert!(!rep.termination.converged());
+    assert_eq!(calls, vec![(1, 1)]);
+    assert!(rep.final_objective < rep.initial_objective);
+    // To convergence, then again from the solution: converged at once, nothing moves.
+    let mut r = nom.clone();
+    let rep = solve(
+        &problem,
+        &mut r,
+        &loss,
+        &SolverOptions::default(),
+        &mut |_, _| {},
+    );
+    assert!(rep.termination.converged(), "{rep:?}");
+    let before = problem.values(&r);
+    let again = solve(
+        &problem,
+        &mut r,
+        &loss,
+        &SolverOptions::default(),
+        &mut |_, _| {},
+    );
+    assert!(
+        again.termination.converged() && again.iterations <= 2,
+        "{again:?}"
+    );
+    assert!((problem.values(&r) - before).amax() < 1e-9);
+    assert!(again.final_objective <= rep.final_objective * (1.0 + 1e-12));
+    // Overflowing residuals make the solver fail, not loop.
+    let far = pose(&[f64::MAX, f64::MAX, 0.0, 0.0, 0.0, 0.0]);
+    let problem = Problem::new(&nom, &id.identified, &cal, &far);
+    let mut r = nom.clone();
+    let rep = solve(
+        &problem,
+        &mut r,
+        &loss,
+        &SolverOptions::default(),
+        &mut |_, _| {},
+    );
+    assert!(matches!(rep.termination, Termination::Failed(_)), "{rep:?}");
+}
