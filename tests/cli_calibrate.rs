@@ -358,6 +358,16 @@ fn bad_input_is_rejected_and_nothing_is_written() {
         &["--free", "tool_a: no effect"],
     );
     run(&ok, &["--beta", "9"], 2, &["--beta", "joint 9"]);
+    // Two plane points: the initial frame needs three.
+    let two = dir.path().join("two-plane.csv");
+    write_csv(&two, &simulate(40, 7, true), &|i| {
+        if i < 2 {
+            "plane"
+        } else {
+            ""
+        }
+    });
+    run(&two, &[], 3, &["plane points", "2 row(s) with set = plane"]);
     // An output directory that does not exist.
     let missing = dir.path().join("nope").join("r.json");
     expect_failure(
