@@ -1,5 +1,6 @@
 //! Command-line interface: one module per subcommand.
 
+mod calibrate;
 mod common;
 mod fk;
 mod robot;
@@ -26,6 +27,8 @@ enum Command {
     Fk(fk::FkArgs),
     /// Simulate a measurement: a true robot measured by a virtual laser tracker.
     Simulate(Box<simulate::SimulateArgs>),
+    /// Fit the measurement frame and identify the calibrated parameters (writes a result JSON).
+    Calibrate(calibrate::CalibrateArgs),
 }
 
 /// Runs a parsed command line.
@@ -34,5 +37,6 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Robot(c) => robot::run(c),
         Command::Fk(a) => fk::run(a),
         Command::Simulate(a) => simulate::run(*a),
+        Command::Calibrate(a) => calibrate::run(a),
     }
 }

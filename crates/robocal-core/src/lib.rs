@@ -12,9 +12,11 @@
 
 pub mod error;
 pub mod frame;
+pub mod identification;
 pub mod io;
 pub mod kinematics;
 pub mod model;
+pub mod registration;
 pub mod simulation;
 pub mod stats;
 

@@ -1,0 +1,112 @@
+//! Uncertainty of the identified parameters.
+//!
+//! For the objective `f = sum l(|e_i|)` the estimate is an M-estimator; its covariance is the
+//! sandwich `H^-1 B H^-1` with `H` the objective's Hessian (Gauss–Newton part,
+//! `sum J^T (w (I - u u^T) + l'' u u^T) J`) and `B` the covariance of the gradient. Assuming
+//! isotropic measurement errors, `B = (sum |l'(r_i)|^2 / 3N) sum J^T J`, and a factor
+//! `3N / (3N - k)` corrects for the k fitted parameters. For least squares this is the textbook
+//! `sigma^2 (J^T J)^-1` with `sigma^2 = sum r^2 / (3N - k)`; for the sum of norms and the robust
+//! losses it accounts for their weights (the plain `(J^T W J)^-1` formula would understate the
+//! spread of a sum-of-norms estimate by about a third).
+
+use crate::identification::system::Accumulated;
+use crate::model::Param;
+use nalgebra::DMatrix;
+
+/// The covariance of the identified parameters (internal units: mm, rad).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Covariance {
+    /// The parameters, in the order of the matrix.
+    pub params: Vec<Param>,
+    /// The covariance matrix (NaN when the Hessian is singular).
+    pub matrix: DMatrix<f64>,
+    /// Estimated per-axis standard deviation of the measurement errors, `sqrt(B/S)` with the
+    /// degrees-of-freedom correction (mm): for least squares the residual RMS per axis.
+    pub sigma_mm: f64,
+}
+
+/// A pair of parameters and the correlation of their estimates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Correlation {
+    /// First parameter.
+    pub a: Param,
+    /// Second parameter.
+    pub b: Param,
+    /// Correlation coefficient in [-1, 1].
+    pub rho: f64,
+}
+
+impl Covariance {
+    /// The covariance from a full accumulation pass at the solution with `n_points` points.
+    pub fn from_accumulated(params: &[Param], acc: &Accumulated, n_points: usize) -> Covariance {
+        let k = params.len();
+        let m = 3 * n_points;
+        let dof_factor = if m > k {
+            m as f64 / (m - k) as f64
+        } else {
+            f64::NAN
+        };
+        let psi_var = acc.psi_sq / m.max(1) as f64 * dof_factor;
+        let nan = || DMatrix::from_element(k, k, f64::NAN);
+        let (Some(h), Some(s)) = (&acc.h, &acc.s) else {
+            return Covariance {
+                params: params.to_vec(),
+                matrix: nan(),
+                sigma_mm: f64::NAN,
+            };
+        };
+        let matrix = match h.clone().cholesky() {
+            Some(ch) => {
+                let hinv_s = ch.solve(s);
+                let mut c = ch.solve(&hinv_s.transpose()) * psi_var;
+                // Symmetrize rounding.
+                c = (&c + c.transpose()) * 0.5;
+                c
+            }
+            None => nan(),
+        };
+        // For least squares psi = r, so psi_var is the residual variance per axis.
+        Covariance {
+            params: params.to_vec(),
+            matrix,
+            sigma_mm: psi_var.sqrt(),
+        }
+    }
+
+    /// Standard deviation of each parameter (internal units).
+    pub fn std(&self) -> Vec<f64> {
+        (0..self.params.len())
+            .map(|j| self.matrix[(j, j)].max(0.0).sqrt())
+            .collect()
+    }
+
+    /// The standard deviation of one parameter, if identified.
+    pub fn std_of(&self, p: Param) -> Option<f64> {
+        self.params
+            .iter()
+            .position(|q| *q == p)
+            .map(|j| self.matrix[(j, j)].max(0.0).sqrt())
+    }
+
+    /// The `count` most correlated pairs, strongest first.
+    pub fn most_correlated(&self, count: usize) -> Vec<Correlation> {
+        let k = self.params.len();
+        let sd = self.std();
+        let mut out = Vec::new();
+        for a in 0..k {
+            for b in a + 1..k {
+                let den = sd[a] * sd[b];
+                if den > 0.0 && den.is_finite() {
+                    out.push(Correlation {
+                        a: self.params[a],
+                        b: self.params[b],
+                        rho: (self.matrix[(a, b)] / den).clamp(-1.0, 1.0),
+                    });
+                }
+            }
+        }
+        out.sort_by(|x, y| y.rho.abs().total_cmp(&x.rho.abs()));
+        out.truncate(count);
+        out
+    }
+}

@@ -1,0 +1,356 @@
+//! Which parameters the poses can identify (DESIGN.md, "Facts worth knowing").
+//!
+//! The identification Jacobian (`d p / d theta` for every parameter of the model, stacked over
+//! the poses, 3N x n) is reduced to its triangular factor R by Householder QR, block by block, so
+//! its size does not grow with N (R^T R = J^T J, and QR keeps the rank test accurate where the
+//! normal matrix would square the condition number). Each column is scaled by its norm (the
+//! parameter's RMS effect on the tool point), which makes millimetres and radians comparable.
+//!
+//! The columns are then visited in a priority order, a Gram–Schmidt (pivoted QR) pass with
+//! priority pivoting: a column is kept when its distance from the span of the columns already
+//! kept, relative to its own length (its *independence*, the sine of the angle to that span), is
+//! above `rank_tolerance` (default 1e-6); otherwise the parameter is fixed at its nominal value,
+//! and its column is solved against the kept ones to name the parameters it duplicates. The
+//! default priority gives the paper's choice: the base frame before `alpha1, a1, d1, phi1`; the
+//! tool position before `d_n` and `phi_n`; then the joints in order, so that of two parallel axes'
+//! offsets (`d2`, `d3`) the first is kept. Parameters named in `--free` come first of all (so
+//! `--free d3` keeps d3 and fixes d2); parameters in `--fix` are left out.
+
+use crate::error::{Error, Result};
+use crate::identification::Observations;
+use crate::model::{Param, Robot};
+use nalgebra::{DMatrix, DVector, Vector3};
+use rayon::prelude::*;
+
+/// Default relative rank threshold (see the module docs).
+pub const DEFAULT_RANK_TOLERANCE: f64 = 1e-6;
+
+/// Points per QR block.
+const BLOCK_POINTS: usize = 128;
+/// Points per parallel task.
+const TASK_POINTS: usize = 4096;
+
+/// Settings of the identifiability analysis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IdentifiabilityOptions {
+    /// Relative threshold on a column's independence (see the module docs).
+    pub rank_tolerance: f64,
+    /// Parameters held fixed whatever the analysis says (`--fix`).
+    pub fix: Vec<Param>,
+    /// Parameters given the highest priority (`--free`); an error if one is still not
+    /// identifiable.
+    pub free: Vec<Param>,
+}
+
+impl Default for IdentifiabilityOptions {
+    fn default() -> Self {
+        IdentifiabilityOptions {
+            rank_tolerance: DEFAULT_RANK_TOLERANCE,
+            fix: Vec::new(),
+            free: Vec::new(),
+        }
+    }
+}
+
+/// Why a parameter is not identified.
+#[derive(Debug, Clone, PartialEq)]
+pub enum FixReason {
+    /// Named in `--fix`.
+    User,
+    /// Its column is zero: it does not move the tool point (e.g. the tool orientation).
+    NoEffect,
+    /// Its column is (numerically) a combination of identified parameters' columns.
+    Duplicate {
+        /// The dominant parameters and their coefficients in internal units: a change `dx` of the
+        /// fixed parameter moves every point as `sum c * dx` changes of these.
+        of: Vec<(Param, f64)>,
+        /// The column's independence (below the rank tolerance).
+        independence: f64,
+    },
+}
+
+/// A parameter held at its nominal value, with the reason.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FixedParam {
+    /// The parameter.
+    pub param: Param,
+    /// Why.
+    pub reason: FixReason,
+}
+
+impl FixedParam {
+    /// The reason as a sentence, e.g. `same effect as base_z`.
+    pub fn describe(&self) -> String {
+        match &self.reason {
+            FixReason::User => "fixed by --fix".to_string(),
+            FixReason::NoEffect => match self.param {
+                Param::Tool(k) if k >= 3 => {
+                    "no effect on the tool point (tool orientation; points carry no orientation)"
+                        .to_string()
+                }
+                _ => "no effect on the tool point".to_string(),
+            },
+            FixReason::Duplicate { of, .. } => {
+                let names: Vec<String> = of.iter().map(|(p, _)| p.name()).collect();
+                match names.len() {
+                    0 => "not identifiable from these poses".to_string(),
+                    1 => format!("same effect as {}", names[0]),
+                    _ => format!(
+                        "same effect as a combination of {} and {}",
+                        names[..names.len() - 1].join(", "),
+                        names[names.len() - 1]
+                    ),
+                }
+            }
+        }
+    }
+}
+
+/// The result of the analysis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Identifiability {
+    /// The identified parameters, in model order.
+    pub identified: Vec<Param>,
+    /// Each identified parameter's independence when it was accepted (same order).
+    pub independence: Vec<f64>,
+    /// The fixed parameters, in model order.
+    pub fixed: Vec<FixedParam>,
+    /// Condition number of the column-scaled Jacobian of the identified parameters.
+    pub condition_number: f64,
+    /// The threshold used.
+    pub rank_tolerance: f64,
+    /// RMS effect on the tool point of a unit change of every model parameter (mm per mm or mm
+    /// per rad), in model order.
+    pub column_rms: Vec<(Param, f64)>,
+}
+
+impl Identifiability {
+    /// The reason a parameter is fixed, if it is.
+    pub fn fixed_reason(&self, p: Param) -> Option<&FixedParam> {
+        self.fixed.iter().find(|f| f.param == p)
+    }
+}
+
+/// The default priority of a robot's parameters (see the module docs); `free` first.
+pub fn priority_order(robot: &Robot, free: &[Param]) -> Vec<Param> {
+    let mut out: Vec<Param> = free.to_vec();
+    let mut push = |p: Param| {
+        if robot.has_param(p) && !out.contains(&p) {
+            out.push(p);
+        }
+    };
+    for k in 0..6 {
+        push(Param::Base(k));
+    }
+    for k in 0..3 {
+        push(Param::Tool(k));
+    }
+    for i in 0..robot.dof() {
+        for p in [
+            Param::Alpha(i),
+            Param::A(i),
+            Param::Beta(i),
+            Param::Phi(i),
+            Param::D(i),
+        ] {
+            push(p);
+        }
+    }
+    for k in 3..6 {
+        push(Param::Tool(k));
+    }
+    out
+}
+
+/// The R factor (n x n, n = all parameters) of the stacked identification Jacobian over the poses
+/// of `obs`, computed blockwise (and in parallel for large sets).
+pub fn jacobian_r(robot: &Robot, obs: &Observations) -> DMatrix<f64> {
+    let n = robot.param_count();
+    let idx: Vec<usize> = (0..obs.len()).collect();
+    let r_of = |points: &[usize]| -> DMatrix<f64> {
+        let mut r = DMatrix::<f64>::zeros(0, n);
+        let mut jp = vec![Vector3::zeros(); n];
+        for block in points.chunks(BLOCK_POINTS) {
+            let rows = r.nrows() + 3 * block.len();
+            let mut m = DMatrix::<f64>::zeros(rows, n);
+            m.view_mut((0, 0), (r.nrows(), n)).copy_from(&r);
+            for (b, &i) in block.iter().enumerate() {
+                robot.tool_position_jacobians(obs.q(i), None, Some(&mut jp));
+                for (c, v) in jp.iter().enumerate() {
+                    for a in 0..3 {
+                        m[(r.nrows() + 3 * b + a, c)] = v[a];
+                    }
+                }
+            }
+            r = upper(m);
+        }
+        r
+    };
+    let parts: Vec<DMatrix<f64>> = if obs.len() > TASK_POINTS {
+        idx.par_chunks(TASK_POINTS).map(r_of).collect()
+    } else {
+        vec![r_of(&idx)]
+    };
+    let mut r = parts
+        .into_iter()
+        .reduce(|a, b| {
+            let mut m = DMatrix::zeros(a.nrows() + b.nrows(), n);
+            m.view_mut((0, 0), (a.nrows(), n)).copy_from(&a);
+            m.view_mut((a.nrows(), 0), (b.nrows(), n)).copy_from(&b);
+            upper(m)
+        })
+        .unwrap_or_else(|| DMatrix::zeros(0, n));
+    if r.nrows() < n {
+        // Fewer equations than parameters: pad with zero rows (R^T R is unchanged).
+        let mut p = DMatrix::zeros(n, n);
+        p.view_mut((0, 0), (r.nrows(), n)).copy_from(&r);
+        r = p;
+    }
+    r
+}
+
+/// The upper-triangular factor of a QR decomposition (min(rows, cols) x cols).
+fn upper(m: DMatrix<f64>) -> DMatrix<f64> {
+    if m.nrows() == 0 {
+        return m;
+    }
+    m.qr().r()
+}
+
+/// Decides which parameters of `robot` the poses of `obs` identify (see the module docs).
+pub fn analyze(
+    robot: &Robot,
+    obs: &Observations,
+    opts: &IdentifiabilityOptions,
+) -> Result<Identifiability> {
+    let all = robot.params();
+    let n = all.len();
+    let r = jacobian_r(robot, obs);
+    let npts = obs.len().max(1) as f64;
+    let norms: Vec<f64> = (0..n).map(|j| r.column(j).norm()).collect();
+    let max_norm = norms.iter().cloned().fold(0.0, f64::max);
+    let col = |p: Param| all.iter().position(|q| *q == p).expect("robot parameter");
+    let unit = |j: usize| -> DVector<f64> {
+        if norms[j] > 0.0 {
+            r.column(j) / norms[j]
+        } else {
+            DVector::zeros(n)
+        }
+    };
+    let tol = opts.rank_tolerance;
+    let mut basis: Vec<DVector<f64>> = Vec::new();
+    let mut kept: Vec<(Param, f64)> = Vec::new();
+    let mut fixed: Vec<FixedParam> = opts
+        .fix
+        .iter()
+        .map(|p| FixedParam {
+            param: *p,
+            reason: FixReason::User,
+        })
+        .collect();
+    let mut dependent: Vec<(Param, f64)> = Vec::new();
+    for p in priority_order(robot, &opts.free) {
+        if opts.fix.contains(&p) {
+            continue;
+        }
+        let j = col(p);
+        if norms[j] <= 1e-12 * max_norm || norms[j] == 0.0 {
+            fixed.push(FixedParam {
+                param: p,
+                reason: FixReason::NoEffect,
+            });
+            continue;
+        }
+        let mut v = unit(j);
+        for _ in 0..2 {
+            for q in &basis {
+                let c = q.dot(&v);
+                v.axpy(-c, q, 1.0);
+            }
+        }
+        let rho = v.norm();
+        if rho > tol {
+            basis.push(v / rho);
+            kept.push((p, rho));
+        } else {
+            dependent.push((p, rho));
+        }
+    }
+    // Explain each dependent column by the kept ones.
+    let kept_cols: Vec<usize> = kept.iter().map(|(p, _)| col(*p)).collect();
+    let ks = DMatrix::from_fn(n, kept_cols.len(), |a, b| {
+        r[(a, kept_cols[b])] / norms[kept_cols[b]]
+    });
+    let svd = ks.clone().svd(true, true);
+    for (p, rho) in dependent {
+        let j = col(p);
+        let c = svd
+            .solve(&unit(j), 1e-12)
+            .map_err(|e| Error::Numerical(format!("identifiability: {e}")))?;
+        let cmax = c.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let mut terms: Vec<(usize, f64)> = c
+            .iter()
+            .enumerate()
+            .filter(|(_, v)| v.abs() >= 0.1 * cmax && v.abs() > 1e-9)
+            .map(|(b, v)| (b, *v))
+            .collect();
+        terms.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+        terms.truncate(4);
+        let of = terms
+            .into_iter()
+            .map(|(b, v)| (kept[b].0, v * norms[j] / norms[kept_cols[b]]))
+            .collect();
+        fixed.push(FixedParam {
+            param: p,
+            reason: FixReason::Duplicate {
+                of,
+                independence: rho,
+            },
+        });
+    }
+    // --free parameters must have been kept.
+    let mut bad = Vec::new();
+    for p in &opts.free {
+        if let Some(f) = fixed.iter().find(|f| f.param == *p) {
+            bad.push(format!("{}: {}", p.name(), f.describe()));
+        }
+    }
+    if !bad.is_empty() {
+        return Err(Error::Numerical(format!(
+            "--free: cannot identify {} from these poses ({}); free only one of a set of \
+             parameters with the same effect",
+            if bad.len() == 1 {
+                "this parameter"
+            } else {
+                "these parameters"
+            },
+            bad.join("; ")
+        )));
+    }
+    let sv = svd.singular_values;
+    let (smax, smin) = sv
+        .iter()
+        .fold((0.0f64, f64::INFINITY), |(a, b), v| (a.max(*v), b.min(*v)));
+    let condition_number = if sv.is_empty() {
+        f64::NAN
+    } else if smin > 0.0 {
+        smax / smin
+    } else {
+        f64::INFINITY
+    };
+    let order = |p: &Param| all.iter().position(|q| q == p).unwrap_or(usize::MAX);
+    kept.sort_by_key(|(p, _)| order(p));
+    fixed.sort_by_key(|f| order(&f.param));
+    Ok(Identifiability {
+        identified: kept.iter().map(|(p, _)| *p).collect(),
+        independence: kept.iter().map(|(_, r)| *r).collect(),
+        fixed,
+        condition_number,
+        rank_tolerance: tol,
+        column_rms: all
+            .iter()
+            .zip(&norms)
+            .map(|(p, v)| (*p, v / npts.sqrt()))
+            .collect(),
+    })
+}

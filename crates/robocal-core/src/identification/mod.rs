@@ -1,0 +1,35 @@
+//! Identification of the calibrated parameters (paper, sections II.A and III): minimize the
+//! total displacement error `sum |E_i|` (eq. 4) over the parameters the poses can identify.
+//!
+//! - [`observations`]: the measured points and their CSV lines;
+//! - [`objective`]: sum of norms (eq. 4), least squares and robust losses;
+//! - [`identifiability`]: which parameters are identifiable, and why the others are fixed;
+//! - [`system`]: the per-point accumulation of the normal equations (the hot loop);
+//! - [`solver`]: Levenberg–Marquardt with reweighting and a termination report;
+//! - [`covariance`]: standard deviations and correlations of the estimates;
+//! - [`pipeline`]: registration + all of the above ([`calibrate`]);
+//! - [`report`]: the result JSON.
+
+pub mod covariance;
+pub mod identifiability;
+pub mod objective;
+pub mod observations;
+pub mod pipeline;
+pub mod report;
+pub mod solver;
+pub mod system;
+
+#[cfg(test)]
+mod tests;
+
+pub use covariance::{Correlation, Covariance};
+pub use identifiability::{
+    analyze, FixReason, FixedParam, Identifiability, IdentifiabilityOptions, DEFAULT_RANK_TOLERANCE,
+};
+pub use objective::{Loss, Objective, RobustLoss};
+pub use observations::{split_measurements, Observations, SplitData};
+pub use pipeline::{
+    calibrate, Calibration, CalibrationData, CalibrationSettings, DownWeighted, SetErrors, Stage,
+};
+pub use solver::{solve, SolverOptions, SolverReport, Termination};
+pub use system::Problem;

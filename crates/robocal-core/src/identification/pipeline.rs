@@ -1,0 +1,334 @@
+//! The whole calibration of the paper's sections II.C and III: registration of the measurement
+//! frame, identifiability, identification (eq. 4), uncertainty, and the error tables before and
+//! after (Tables II and IV).
+//!
+//! The tracker frame F and the robot's base frame B are the same unknown seen twice. As in the
+//! paper, F is fitted once to the nominal model (registration) and then held, and B (six
+//! parameters) is identified with the rest, absorbing whatever rigid motion remains. The result's
+//! `tracker_frame` is that F, and the calibrated model includes B, so that
+//! `pose(tracker_frame) * m` compared with the calibrated model's tool point gives the "after"
+//! errors, for the calibration and for the validation points alike.
+
+use crate::error::{Error, Result};
+use crate::identification::covariance::Covariance;
+use crate::identification::identifiability::{analyze, Identifiability, IdentifiabilityOptions};
+use crate::identification::objective::{
+    Loss, Objective, RobustLoss, CHI3_MEDIAN, ROBUST_SCALE_SIGMAS, SUM_OF_NORMS_SMOOTHING_MM,
+};
+use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
+use crate::identification::system::{Level, Problem};
+use crate::identification::Observations;
+use crate::model::Robot;
+use crate::registration::{register, Registration, RegistrationObjective, RegistrationOptions};
+use crate::stats::{percentile, ErrorStats};
+
+/// Everything that steers a calibration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CalibrationSettings {
+    /// The objective (default: the paper's sum of norms).
+    pub objective: Objective,
+    /// Scale of the robust loss (mm); `None`: from the residuals (see [`RobustLoss`]).
+    pub robust_scale_mm: Option<f64>,
+    /// Also fit and report the paper's affine Tr (eq. 8-11).
+    pub affine_registration: bool,
+    /// Identifiability threshold and `--fix`/`--free`.
+    pub identifiability: IdentifiabilityOptions,
+    /// Solver settings.
+    pub solver: SolverOptions,
+}
+
+impl Default for CalibrationSettings {
+    fn default() -> Self {
+        CalibrationSettings {
+            objective: Objective::SumOfNorms,
+            robust_scale_mm: None,
+            affine_registration: false,
+            identifiability: IdentifiabilityOptions::default(),
+            solver: SolverOptions::default(),
+        }
+    }
+}
+
+/// The measured points of a calibration.
+#[derive(Debug, Clone, Copy)]
+pub struct CalibrationData<'a> {
+    /// Points the parameters are identified from (the paper's 75).
+    pub calibration: &'a Observations,
+    /// The paper's plane points for the initial frame (3), if measured.
+    pub plane: Option<&'a Observations>,
+    /// Points held out to validate the calibrated model (the paper's 73), if any.
+    pub validation: Option<&'a Observations>,
+}
+
+/// Error norms of one set of points under the nominal and the calibrated model (mm), both with
+/// the fitted tracker frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SetErrors {
+    /// CSV line of each point.
+    pub lines: Vec<usize>,
+    /// Nominal model (Table II).
+    pub before: Vec<f64>,
+    /// Calibrated model (Table IV).
+    pub after: Vec<f64>,
+}
+
+impl SetErrors {
+    fn new(obs: &Observations, reg: &Registration, nominal: &Robot, cal: &Robot) -> SetErrors {
+        let p = Problem::new(nominal, &[], obs, &reg.frame);
+        SetErrors {
+            lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
+            before: p.error_norms(nominal),
+            after: p.error_norms(cal),
+        }
+    }
+
+    /// Statistics before calibration.
+    pub fn before_stats(&self) -> ErrorStats {
+        ErrorStats::from_norms(&self.before)
+    }
+
+    /// Statistics after calibration.
+    pub fn after_stats(&self) -> ErrorStats {
+        ErrorStats::from_norms(&self.after)
+    }
+}
+
+/// One solver run of the identification.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stage {
+    /// The loss minimized.
+    pub loss: Loss,
+    /// What the solver did.
+    pub report: SolverReport,
+}
+
+/// A calibration point the robust loss down-weighted.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DownWeighted {
+    /// Index among the calibration points.
+    pub index: usize,
+    /// CSV line.
+    pub line: usize,
+    /// Error norm under the calibrated model (mm).
+    pub error_mm: f64,
+    /// Its weight relative to a perfectly fitting point (1).
+    pub weight: f64,
+}
+
+/// The outcome of [`calibrate`].
+#[derive(Debug, Clone)]
+pub struct Calibration {
+    /// The nominal model (as given, beta parameters included).
+    pub nominal: Robot,
+    /// The calibrated model.
+    pub calibrated: Robot,
+    /// The fitted measurement frame and Table II.
+    pub registration: Registration,
+    /// Which parameters were identified, which fixed and why.
+    pub identifiability: Identifiability,
+    /// The solver runs, in order (robust objectives start from a sum-of-norms fit).
+    pub stages: Vec<Stage>,
+    /// Uncertainty of the identified parameters.
+    pub covariance: Covariance,
+    /// Errors on the calibration points.
+    pub calibration: SetErrors,
+    /// Errors on the validation points.
+    pub validation: Option<SetErrors>,
+    /// The robust loss's scale (mm), for robust objectives.
+    pub robust_scale_mm: Option<f64>,
+    /// Points whose error exceeds the robust scale (Cauchy weight below 1/2, Huber weight below
+    /// 1), largest error first.
+    pub downweighted: Vec<DownWeighted>,
+    /// The settings used.
+    pub settings: CalibrationSettings,
+}
+
+impl Calibration {
+    /// The last solver run.
+    pub fn solver(&self) -> &SolverReport {
+        &self.stages.last().expect("at least one stage").report
+    }
+}
+
+/// Runs a calibration of `nominal` (see the module docs). `progress(stage, step, steps)` is
+/// called as the work advances.
+pub fn calibrate(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    progress: &mut dyn FnMut(&str, usize, usize),
+) -> Result<Calibration> {
+    let cal = data.calibration;
+    for obs in [Some(cal), data.plane, data.validation]
+        .into_iter()
+        .flatten()
+    {
+        if obs.dof() != nominal.dof() {
+            return Err(Error::JointCount {
+                context: obs
+                    .source()
+                    .map_or("measurements".into(), |p| p.display().to_string()),
+                expected: nominal.dof(),
+                got: obs.dof(),
+            });
+        }
+    }
+    if cal.is_empty() {
+        return Err(Error::invalid("calibration data", "no calibration points"));
+    }
+    cal.check_no_duplicate_poses()?;
+    let idopts = &settings.identifiability;
+    if let Some(p) = idopts.fix.iter().find(|p| idopts.free.contains(p)) {
+        return Err(Error::invalid(
+            "--fix/--free",
+            format!("`{}` is given both to --fix and to --free", p.name()),
+        ));
+    }
+    if !(idopts.rank_tolerance > 0.0 && idopts.rank_tolerance < 1.0) {
+        return Err(Error::invalid(
+            "--rank-tol",
+            format!(
+                "{} is not in (0, 1): it is the smallest independence (sine of the angle \
+                 between a parameter's effect and the others') accepted",
+                idopts.rank_tolerance
+            ),
+        ));
+    }
+    if let Some(c) = settings.robust_scale_mm {
+        if !(c > 0.0 && c.is_finite()) {
+            return Err(Error::invalid(
+                "--robust-scale",
+                format!("{c} is not a positive length (mm)"),
+            ));
+        }
+    }
+
+    progress("registration", 0, 1);
+    let reg_opts = RegistrationOptions {
+        objective: match settings.objective {
+            Objective::LeastSquares => RegistrationObjective::LeastSquares,
+            _ => RegistrationObjective::SumOfNorms,
+        },
+        affine: settings.affine_registration,
+        ..Default::default()
+    };
+    let registration = register(nominal, cal, data.plane, &reg_opts)?;
+
+    progress("identifiability", 0, 1);
+    let ident = analyze(nominal, cal, idopts)?;
+    let k = ident.identified.len();
+    if k == 0 {
+        return Err(Error::invalid(
+            "--fix",
+            "every parameter is fixed; nothing to identify",
+        ));
+    }
+    if cal.len() < k {
+        return Err(Error::Numerical(format!(
+            "{} calibration points for {k} identifiable parameters: at least {k} points are \
+                 needed (the paper uses 75)",
+            cal.len()
+        )));
+    }
+
+    let problem = Problem::new(nominal, &ident.identified, cal, &registration.frame);
+    let mut robot = nominal.clone();
+    let mut stages = Vec::new();
+    let mut run = |robot: &mut Robot, loss: Loss, stages: &mut Vec<Stage>| -> Result<()> {
+        let name = match loss {
+            Loss::SumOfNorms { .. } => "sum of norms",
+            Loss::Squared => "least squares",
+            Loss::Huber { .. } => "Huber",
+            Loss::Cauchy { .. } => "Cauchy",
+        };
+        let report = solve(&problem, robot, &loss, &settings.solver, &mut |i, n| {
+            progress(name, i, n)
+        });
+        if let Termination::Failed(m) = &report.termination {
+            return Err(Error::Numerical(format!(
+                "identification ({name}) failed after {} iterations: {m}",
+                report.iterations
+            )));
+        }
+        stages.push(Stage { loss, report });
+        Ok(())
+    };
+    let son = Loss::SumOfNorms {
+        delta: SUM_OF_NORMS_SMOOTHING_MM,
+    };
+    let mut robust_scale = None;
+    let final_loss = match settings.objective {
+        Objective::LeastSquares => {
+            run(&mut robot, Loss::Squared, &mut stages)?;
+            Loss::Squared
+        }
+        Objective::SumOfNorms => {
+            run(&mut robot, son, &mut stages)?;
+            son
+        }
+        Objective::Robust(kind) => {
+            run(&mut robot, son, &mut stages)?;
+            let make = |c: f64| match kind {
+                RobustLoss::Cauchy => Loss::Cauchy { c },
+                RobustLoss::Huber => Loss::Huber { k: c },
+            };
+            let scale_of = |r: &Robot| {
+                let med = percentile(&problem.error_norms(r), 0.5);
+                (ROBUST_SCALE_SIGMAS * med / CHI3_MEDIAN).max(SUM_OF_NORMS_SMOOTHING_MM)
+            };
+            let mut c = settings.robust_scale_mm.unwrap_or_else(|| scale_of(&robot));
+            let mut loss = make(c);
+            for _ in 0..3 {
+                loss = make(c);
+                run(&mut robot, loss, &mut stages)?;
+                if settings.robust_scale_mm.is_some() {
+                    break;
+                }
+                let c2 = scale_of(&robot);
+                if (c2 - c).abs() <= 0.05 * c {
+                    break;
+                }
+                c = c2;
+            }
+            robust_scale = Some(c);
+            loss
+        }
+    };
+
+    progress("uncertainty", 0, 1);
+    let acc = problem.accumulate(&robot, &final_loss, Level::Full);
+    let covariance = Covariance::from_accumulated(&ident.identified, &acc, cal.len());
+
+    let calibration = SetErrors::new(cal, &registration, nominal, &robot);
+    let validation = data
+        .validation
+        .filter(|v| !v.is_empty())
+        .map(|v| SetErrors::new(v, &registration, nominal, &robot));
+    let mut downweighted = Vec::new();
+    if let Some(c) = robust_scale {
+        for (i, &r) in calibration.after.iter().enumerate() {
+            if r > c {
+                downweighted.push(DownWeighted {
+                    index: i,
+                    line: cal.line(i),
+                    error_mm: r,
+                    weight: final_loss.weight(r),
+                });
+            }
+        }
+        downweighted.sort_by(|a, b| b.error_mm.total_cmp(&a.error_mm));
+    }
+    Ok(Calibration {
+        nominal: nominal.clone(),
+        calibrated: robot,
+        registration,
+        identifiability: ident,
+        stages,
+        covariance,
+        calibration,
+        validation,
+        robust_scale_mm: robust_scale,
+        downweighted,
+        settings: settings.clone(),
+    })
+}

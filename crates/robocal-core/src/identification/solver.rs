@@ -1,0 +1,271 @@
+//! A small Levenberg–Marquardt solver with iteratively reweighted steps, written for the
+//! identification problem (masks, robust weights and the covariance need more control than a
+//! generic least-squares crate gives).
+//!
+//! Each iteration solves `(A + lambda D) delta = b` with `A = sum w J^T J`, `b = sum w J^T e` at
+//! the current weights `w = l'(r)/r` (see [`Loss`]), `D` the running maximum of `diag(A)`
+//! (Marquardt's scaling, which makes the step independent of the parameters' units), and accepts
+//! the step when the true objective decreases by a fair share of the decrease the weighted
+//! quadratic model predicts (gain ratio above 1e-4, Nielsen's update of lambda). Because the
+//! weighted model majorizes every loss used here, an accepted step always lowers the objective.
+
+use crate::identification::objective::Loss;
+use crate::identification::system::{Level, Problem};
+use crate::model::Robot;
+use nalgebra::{DMatrix, DVector};
+
+/// Solver settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverOptions {
+    /// Largest number of iterations (each with one Jacobian pass).
+    pub max_iterations: usize,
+    /// Converged when no parameter of the step moves the tool by more than this, in RMS over
+    /// the points (mm).
+    pub step_tolerance_mm: f64,
+    /// Converged when, for every parameter, the cosine between its (weighted) Jacobian column and
+    /// the (weighted) residual vector is below this (MINPACK's gtol).
+    pub gradient_tolerance: f64,
+    /// Initial damping, relative to `diag(A)`.
+    pub initial_lambda: f64,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        SolverOptions {
+            max_iterations: 200,
+            step_tolerance_mm: 1e-9,
+            gradient_tolerance: 1e-10,
+            initial_lambda: 1e-3,
+        }
+    }
+}
+
+/// Why the solver stopped.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Termination {
+    /// The last step moved the tool by less than `step_tolerance_mm`.
+    ConvergedStep,
+    /// The gradient vanished (relative to `gradient_tolerance`), or the fit is exact.
+    ConvergedGradient,
+    /// `max_iterations` reached before convergence.
+    MaxIterations,
+    /// Numerical failure (non-finite values, no descent direction); see the message.
+    Failed(String),
+}
+
+impl Termination {
+    /// Whether the solver converged.
+    pub fn converged(&self) -> bool {
+        matches!(
+            self,
+            Termination::ConvergedStep | Termination::ConvergedGradient
+        )
+    }
+
+    /// A sentence for reports.
+    pub fn describe(&self) -> String {
+        match self {
+            Termination::ConvergedStep => "converged (step below tolerance)".into(),
+            Termination::ConvergedGradient => "converged (gradient below tolerance)".into(),
+            Termination::MaxIterations => "stopped at the iteration limit".into(),
+            Termination::Failed(m) => format!("failed: {m}"),
+        }
+    }
+}
+
+/// What a solve did.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct SolverReport {
+    /// Why it stopped.
+    pub termination: Termination,
+    /// Iterations (Jacobian passes).
+    pub iterations: usize,
+    /// Objective evaluations (forward-kinematics passes for trial steps).
+    pub evaluations: usize,
+    /// Objective at the start.
+    pub initial_objective: f64,
+    /// Objective at the end.
+    pub final_objective: f64,
+    /// Largest gradient cosine at the end (see [`SolverOptions::gradient_tolerance`]).
+    pub final_gradient: f64,
+    /// Last step size, as the largest RMS tool displacement of one parameter's change (mm).
+    pub last_step_mm: f64,
+}
+
+/// Minimizes `sum l(|e_i|)` over the problem's parameters, starting from (and updating) `robot`.
+/// `progress(iteration, max_iterations)` is called once per iteration.
+pub fn solve(
+    problem: &Problem,
+    robot: &mut Robot,
+    loss: &Loss,
+    opts: &SolverOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> SolverReport {
+    let k = problem.params().len();
+    let n = problem.len().max(1) as f64;
+    let mut x = problem.values(robot);
+    // Newton steps need the objective's Hessian; for least squares it is A itself.
+    let level = if matches!(loss, Loss::Squared) {
+        Level::Normal
+    } else {
+        Level::Newton
+    };
+    let first = problem.accumulate(robot, loss, Level::Full);
+    // RMS tool displacement per unit change of each parameter, for the step test.
+    let s = first.s.as_ref().expect("full pass");
+    let col_rms: Vec<f64> = (0..k).map(|j| (s[(j, j)] / n).sqrt()).collect();
+    let mut acc = first;
+    let mut report = SolverReport {
+        termination: Termination::MaxIterations,
+        iterations: 0,
+        evaluations: 1,
+        initial_objective: acc.objective,
+        final_objective: acc.objective,
+        final_gradient: f64::NAN,
+        last_step_mm: f64::NAN,
+    };
+    if k == 0 {
+        report.termination = Termination::ConvergedGradient;
+        report.final_gradient = 0.0;
+        return report;
+    }
+    let mut d = DVector::from_fn(k, |j, _| acc.a[(j, j)]);
+    let mut lambda = opts.initial_lambda;
+    let mut nu = 2.0;
+    let mut trial = robot.clone();
+    let mut m = DMatrix::zeros(k, k);
+    let mut delta = DVector::zeros(k);
+    let mut x_new = DVector::zeros(k);
+    'outer: for it in 1..=opts.max_iterations {
+        report.iterations = it;
+        progress(it, opts.max_iterations);
+        if !acc.objective.is_finite() || acc.b.iter().any(|v| !v.is_finite()) {
+            report.termination =
+                Termination::Failed("non-finite residuals or Jacobian".to_string());
+            break;
+        }
+        let grad = gradient_cosine(&acc.a, &acc.b, acc.weighted_sq);
+        report.final_gradient = grad;
+        if grad <= opts.gradient_tolerance {
+            report.termination = Termination::ConvergedGradient;
+            break;
+        }
+        for j in 0..k {
+            d[j] = d[j].max(acc.a[(j, j)]).max(f64::MIN_POSITIVE);
+        }
+        loop {
+            // Newton's model first (fast near the minimum), then the reweighted one (a
+            // majorizer: reliable far from it and for exact fits).
+            let mut best_step = f64::INFINITY;
+            let mut accepted = false;
+            for use_newton in [true, false] {
+                let model = match (use_newton, &acc.h) {
+                    (true, Some(h)) => h,
+                    (true, None) => continue,
+                    (false, _) => &acc.a,
+                };
+                if !damped_solve(model, &d, lambda, &acc.b, &mut m, &mut delta) {
+                    continue;
+                }
+                let step = (0..k)
+                    .map(|j| delta[j].abs() * col_rms[j])
+                    .fold(0.0, f64::max);
+                best_step = best_step.min(step);
+                report.last_step_mm = step;
+                x_new.copy_from(&x);
+                x_new += &delta;
+                problem.apply(&mut trial, &x_new);
+                let f_new = problem.objective(&trial, loss);
+                report.evaluations += 1;
+                let pred = acc.b.dot(&delta) - 0.5 * delta.dot(&(model * &delta));
+                let gain = (acc.objective - f_new) / pred;
+                if f_new.is_finite() && pred > 0.0 && gain > 1e-4 {
+                    lambda *= (1.0 - (2.0 * gain - 1.0).powi(3)).max(1.0 / 3.0);
+                    accepted = true;
+                    break;
+                }
+                problem.apply(&mut trial, &x);
+            }
+            if accepted {
+                x.copy_from(&x_new);
+                problem.apply(robot, &x);
+                nu = 2.0;
+                if report.last_step_mm <= opts.step_tolerance_mm {
+                    report.termination = Termination::ConvergedStep;
+                    break 'outer;
+                }
+                acc = problem.accumulate(robot, loss, level);
+                report.evaluations += 1;
+                report.final_objective = acc.objective;
+                continue 'outer;
+            }
+            // Rejected: the current point stays. A rejected step below the tolerance means the
+            // objective cannot be lowered at this precision.
+            if best_step <= opts.step_tolerance_mm {
+                report.termination = Termination::ConvergedStep;
+                break 'outer;
+            }
+            lambda *= nu;
+            nu *= 2.0;
+            if lambda > 1e30 {
+                report.termination = Termination::Failed(if best_step.is_finite() {
+                    "no step lowers the objective".to_string()
+                } else {
+                    "the damped normal equations are singular".to_string()
+                });
+                break 'outer;
+            }
+        }
+    }
+    report.final_objective = problem.objective(robot, loss);
+    report
+}
+
+/// The largest cosine between a weighted Jacobian column and the weighted residual vector:
+/// `|b_j| / sqrt(A_jj * sum w r^2)` (0 for an exact fit).
+pub fn gradient_cosine(a: &DMatrix<f64>, b: &DVector<f64>, weighted_sq: f64) -> f64 {
+    if weighted_sq <= 0.0 {
+        return 0.0;
+    }
+    (0..b.len())
+        .map(|j| {
+            let den = (a[(j, j)] * weighted_sq).sqrt();
+            if den > 0.0 {
+                b[j].abs() / den
+            } else {
+                0.0
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Solves `(model + lambda diag(d)) delta = b` by Cholesky into `delta`, reusing `m`'s storage.
+/// Returns false when the matrix is not positive definite or the solution not finite.
+fn damped_solve(
+    model: &DMatrix<f64>,
+    d: &DVector<f64>,
+    lambda: f64,
+    b: &DVector<f64>,
+    m: &mut DMatrix<f64>,
+    delta: &mut DVector<f64>,
+) -> bool {
+    let k = b.len();
+    let mut mm = std::mem::replace(m, DMatrix::zeros(0, 0));
+    mm.copy_from(model);
+    for j in 0..k {
+        mm[(j, j)] += lambda * d[j];
+    }
+    delta.copy_from(b);
+    match nalgebra::Cholesky::new(mm) {
+        Some(ch) => {
+            ch.solve_mut(delta);
+            *m = ch.unpack();
+            delta.iter().all(|v| v.is_finite())
+        }
+        None => {
+            *m = DMatrix::zeros(k, k);
+            false
+        }
+    }
+}

@@ -1,0 +1,509 @@
+//! `robocal calibrate`: registration of the measurement frame and identification of the
+//! calibrated parameters (paper, sections II.C and III).
+
+use super::common;
+use crate::exit;
+use anyhow::Context;
+use clap::{Args, ValueEnum};
+use robocal_core::identification::{
+    calibrate, split_measurements, Calibration, CalibrationData, CalibrationSettings,
+    IdentifiabilityOptions, Objective, Observations, RobustLoss, SolverOptions,
+    DEFAULT_RANK_TOLERANCE,
+};
+use robocal_core::io::{read_measurements, Positions};
+use robocal_core::{ErrorStats, Param, Robot};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+#[derive(Args, Debug)]
+pub struct CalibrateArgs {
+    /// The nominal robot: a preset name or a TOML robot file.
+    #[arg(long)]
+    robot: String,
+    /// Calibration measurements (CSV: q1..qn in degrees, x,y,z in mm in the tracker frame).
+    /// Rows with `set` = `plane` give the initial frame; rows with `set` = `validation` are
+    /// validation points.
+    #[arg(long)]
+    data: PathBuf,
+    /// Validation measurements (same format), evaluated with the fitted tracker frame.
+    #[arg(long)]
+    validate: Option<PathBuf>,
+    /// What to minimize: the paper's total displacement error, squared errors, or a robust loss
+    /// that down-weights outliers.
+    #[arg(long, value_enum, default_value_t = ObjectiveArg::SumOfNorms)]
+    objective: ObjectiveArg,
+    /// The robust loss of `--objective robust`.
+    #[arg(long, value_enum, default_value_t = RobustArg::Cauchy)]
+    robust_loss: RobustArg,
+    /// Scale of the robust loss in mm (default: 4 sigma, sigma estimated from the median error).
+    #[arg(long, value_name = "MM")]
+    robust_scale: Option<f64>,
+    /// Parameters to hold at their nominal values (comma-separated names, e.g. `a6,alpha6`).
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    fix: Vec<String>,
+    /// Parameters to identify in preference to those with the same effect (e.g. `--free d3`
+    /// keeps d3 and fixes d2). An error if one cannot be identified at all.
+    #[arg(long, value_delimiter = ',', value_name = "NAMES")]
+    free: Vec<String>,
+    /// Hayati tilt parameters: `parallel` (every joint whose axis is parallel to the previous
+    /// one), a list of joint numbers (e.g. `3`), or `none`.
+    #[arg(long, default_value = "none", value_name = "parallel|none|J,..")]
+    beta: String,
+    /// Also fit the paper's 12-parameter affine Tr (eq. 8-11) and report it (the tracker frame
+    /// stays rigid).
+    #[arg(long)]
+    affine: bool,
+    /// Relative rank threshold of the identifiability analysis.
+    #[arg(long, default_value_t = DEFAULT_RANK_TOLERANCE, value_name = "TOL")]
+    rank_tol: f64,
+    /// Iteration limit of the solver.
+    #[arg(long, default_value_t = 200)]
+    max_iterations: usize,
+    /// Where to write the result JSON.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+enum ObjectiveArg {
+    /// Sum of error norms, the paper's eq. 4.
+    SumOfNorms,
+    /// Sum of squared errors.
+    LeastSquares,
+    /// Robust loss (see --robust-loss).
+    Robust,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+enum RobustArg {
+    /// Cauchy: gross outliers get almost no weight.
+    Cauchy,
+    /// Huber: bounded influence.
+    Huber,
+}
+
+/// Parses a list of parameter names, naming every unknown one at once.
+fn param_list(robot: &Robot, names: &[String], flag: &str) -> anyhow::Result<Vec<Param>> {
+    let mut out = Vec::new();
+    let mut unknown = Vec::new();
+    for n in names.iter().map(|n| n.trim()).filter(|n| !n.is_empty()) {
+        match robot.param_by_name(n) {
+            Ok(p) if !out.contains(&p) => out.push(p),
+            Ok(_) => {}
+            Err(_) => unknown.push(format!("`{n}`")),
+        }
+    }
+    if !unknown.is_empty() {
+        let known: Vec<String> = robot.params().iter().map(|p| p.name()).collect();
+        return Err(exit::usage(format!(
+            "{flag}: unknown parameter{} {} (robot `{}` has: {})",
+            if unknown.len() > 1 { "s" } else { "" },
+            unknown.join(", "),
+            robot.name(),
+            known.join(", ")
+        )));
+    }
+    Ok(out)
+}
+
+/// Applies `--beta`.
+fn apply_beta(robot: &mut Robot, arg: &str) -> anyhow::Result<Vec<usize>> {
+    match arg.trim() {
+        "none" | "" => Ok(Vec::new()),
+        "parallel" => Ok(robot.enable_beta_for_parallel_axes()),
+        list => {
+            let mut out = Vec::new();
+            for part in list.split(',') {
+                let j: usize = part.trim().parse().map_err(|_| {
+                    exit::usage(format!(
+                        "--beta: `{part}` is not `parallel`, `none` or a joint number"
+                    ))
+                })?;
+                if j == 0 || j > robot.dof() {
+                    return Err(exit::usage(format!(
+                        "--beta: joint {j} does not exist (robot `{}` has joints 1..{})",
+                        robot.name(),
+                        robot.dof()
+                    )));
+                }
+                robot.enable_beta(j - 1)?;
+                out.push(j - 1);
+            }
+            Ok(out)
+        }
+    }
+}
+
+/// Reads a measurement file and sorts its rows (see `split_measurements`).
+fn read(path: &Path, robot: &Robot) -> anyhow::Result<robocal_core::identification::SplitData> {
+    let set = read_measurements(path, robot.dof(), Positions::Required)?;
+    for w in &set.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(split_measurements(&set)?)
+}
+
+pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
+    let mut robot = common::robot(&a.robot)?;
+    let betas = apply_beta(&mut robot, &a.beta)?;
+    if betas.is_empty() && a.beta.trim() == "parallel" {
+        eprintln!(
+            "note: --beta parallel: robot `{}` has no pair of consecutive parallel axes; no tilt \
+             parameter added",
+            robot.name()
+        );
+    }
+    let fix = param_list(&robot, &a.fix, "--fix")?;
+    let free = param_list(&robot, &a.free, "--free")?;
+    if let Some(parent) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if !parent.is_dir() {
+            return Err(exit::usage(format!(
+                "--out {}: directory {} does not exist",
+                a.out.display(),
+                parent.display()
+            )));
+        }
+    }
+    let data = read(&a.data, &robot)?;
+    let mut validation = data.validation.clone();
+    if let Some(v) = &a.validate {
+        let vd = read(v, &robot)?;
+        if !vd.plane.is_empty() {
+            eprintln!(
+                "note: {}: {} plane point(s) ignored in the validation set",
+                v.display(),
+                vd.plane.len()
+            );
+        }
+        validation = merge(validation, &vd.calibration)?;
+        validation = merge(validation, &vd.validation)?;
+    }
+    let settings = CalibrationSettings {
+        objective: match a.objective {
+            ObjectiveArg::SumOfNorms => Objective::SumOfNorms,
+            ObjectiveArg::LeastSquares => Objective::LeastSquares,
+            ObjectiveArg::Robust => Objective::Robust(match a.robust_loss {
+                RobustArg::Cauchy => RobustLoss::Cauchy,
+                RobustArg::Huber => RobustLoss::Huber,
+            }),
+        },
+        robust_scale_mm: a.robust_scale,
+        affine_registration: a.affine,
+        identifiability: IdentifiabilityOptions {
+            rank_tolerance: a.rank_tol,
+            fix,
+            free,
+        },
+        solver: SolverOptions {
+            max_iterations: a.max_iterations,
+            ..Default::default()
+        },
+    };
+    println!(
+        "robot {} ({} joints, {}){}; {} calibration point(s){}{}",
+        robot.name(),
+        robot.dof(),
+        robot.convention().as_str(),
+        if betas.is_empty() {
+            String::new()
+        } else {
+            format!(
+                ", Hayati tilt on {}",
+                betas
+                    .iter()
+                    .map(|i| format!("beta{}", i + 1))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        },
+        data.calibration.len(),
+        if data.plane.is_empty() {
+            String::new()
+        } else {
+            format!(", {} plane point(s)", data.plane.len())
+        },
+        if validation.is_empty() {
+            String::new()
+        } else {
+            format!(", {} validation point(s)", validation.len())
+        },
+    );
+    let bar = crate::progress::spinner("calibrating");
+    let result = calibrate(
+        &robot,
+        CalibrationData {
+            calibration: &data.calibration,
+            plane: Some(&data.plane),
+            validation: Some(&validation),
+        },
+        &settings,
+        &mut |stage, i, _| {
+            if i > 0 {
+                bar.set_message(format!("{stage}: iteration {i}"));
+            } else {
+                bar.set_message(stage.to_owned());
+            }
+        },
+    );
+    bar.finish_and_clear();
+    let cal = result.with_context(|| format!("calibrating from {}", a.data.display()))?;
+    print_report(&cal);
+    if cal.registration.stats.mean_mm > 50.0 {
+        eprintln!(
+            "warning: the nominal model misses the measured points by {:.1} mm on average \
+             after the frame fit: check that positions are in mm, joint values in degrees and \
+             that --robot matches the data",
+            cal.registration.stats.mean_mm
+        );
+    }
+    let mut extra = serde_json::Map::new();
+    extra.insert("robot_arg".into(), json!(a.robot));
+    extra.insert("data".into(), json!(a.data.display().to_string()));
+    if let Some(v) = &a.validate {
+        extra.insert("validate".into(), json!(v.display().to_string()));
+    }
+    let res = cal.to_result(extra);
+    res.write(&a.out)?;
+    println!("result written to {}", a.out.display());
+    if !cal.solver().termination.converged() {
+        eprintln!(
+            "warning: the solver {}; the result may not be the minimum (raise --max-iterations)",
+            cal.solver().termination.describe()
+        );
+    }
+    Ok(())
+}
+
+/// Appends the points of `b` to `a` (validation points from two sources).
+fn merge(mut a: Observations, b: &Observations) -> anyhow::Result<Observations> {
+    if a.is_empty() {
+        return Ok(b.clone());
+    }
+    for i in 0..b.len() {
+        a.push(b.q(i), *b.m(i), b.line(i))?;
+    }
+    Ok(a)
+}
+
+fn stats_table(title: &str, cols: &[(&str, ErrorStats)]) -> String {
+    use std::fmt::Write;
+    let mut s = format!("{title}\n");
+    let _ = write!(s, "{:<16}", "");
+    for (name, _) in cols {
+        let _ = write!(s, "{name:>14}");
+    }
+    s.push('\n');
+    type Row = (&'static str, fn(&ErrorStats) -> String);
+    let rows: [Row; 5] = [
+        ("points", |e| e.n.to_string()),
+        ("Mean (mm)", |e| format!("{:.4}", e.mean_mm)),
+        ("St. dev. (mm)", |e| format!("{:.4}", e.std_mm)),
+        ("Max. (mm)", |e| format!("{:.4}", e.max_mm)),
+        ("RMS (mm)", |e| format!("{:.4}", e.rms_mm)),
+    ];
+    for (label, f) in rows {
+        let _ = write!(s, "{label:<16}");
+        for (_, e) in cols {
+            let _ = write!(s, "{:>14}", f(e));
+        }
+        s.push('\n');
+    }
+    s
+}
+
+fn print_report(c: &Calibration) {
+    let reg = &c.registration;
+    let tf = robocal_core::io::result::FrameVec::from_frame(&reg.frame);
+    println!();
+    match reg.initial {
+        robocal_core::registration::InitialFrame::Plane {
+            n,
+            tilt_deg,
+            max_error_mm,
+            ..
+        } => println!(
+            "initial measurement frame from {n} plane points (plane tilt {tilt_deg:.3} deg; \
+             largest error under it {max_error_mm:.3} mm)"
+        ),
+        robocal_core::registration::InitialFrame::LeastSquares => {
+            println!("initial measurement frame: least-squares fit (no plane points)")
+        }
+    }
+    println!(
+        "tracker frame in the base frame (mm, deg): x {:.4}  y {:.4}  z {:.4}  A {:.5}  B {:.5}  C {:.5}",
+        tf.x, tf.y, tf.z, tf.a, tf.b, tf.c
+    );
+    let before_cols: Vec<(&str, ErrorStats)> =
+        std::iter::once(("Calibration", c.calibration.before_stats()))
+            .chain(
+                c.validation
+                    .as_ref()
+                    .map(|v| ("Validation", v.before_stats())),
+            )
+            .collect();
+    println!();
+    print!(
+        "{}",
+        stats_table(
+            "Table II. Error before calibration (nominal model, fitted measurement frame)",
+            &before_cols
+        )
+    );
+    if let Some(af) = &reg.affine {
+        let sv = af.tr.singular_values();
+        println!(
+            "affine Tr (eq. 8-11): mean {:.4} mm, max {:.4} mm; singular values {:.6} {:.6} {:.6}",
+            af.stats.mean_mm, af.stats.max_mm, sv[0], sv[1], sv[2]
+        );
+    }
+    let id = &c.identifiability;
+    println!();
+    println!(
+        "identifiability: {} parameters identified, {} fixed (rank tolerance {:.0e}); condition \
+         number of the scaled Jacobian {:.1}",
+        id.identified.len(),
+        id.fixed.len(),
+        id.rank_tolerance,
+        id.condition_number
+    );
+    for f in &id.fixed {
+        println!("  {:<8} fixed: {}", f.param.name(), f.describe());
+    }
+    println!();
+    let fixed = |p: Param| c.covariance.std_of(p).is_none();
+    println!("Table III. Calibrated parameters of the robot (* fixed at its nominal value)");
+    print!(
+        "{}",
+        layout(&c.calibrated, &|p| {
+            let v = num(c.calibrated.get_display(p), 4);
+            if fixed(p) {
+                format!("{v}*")
+            } else {
+                format!("{v} ")
+            }
+        })
+    );
+    println!("Standard deviations (same layout; - fixed)");
+    print!(
+        "{}",
+        layout(&c.calibrated, &|p| match c.covariance.std_of(p) {
+            Some(sd) => format!("{:.4} ", p.unit().from_internal(sd)),
+            None => "- ".to_string(),
+        })
+    );
+    let corr = c.covariance.most_correlated(5);
+    if !corr.is_empty() {
+        println!(
+            "most correlated: {}",
+            corr.iter()
+                .map(|k| format!("{}/{} {:+.3}", k.a.name(), k.b.name(), k.rho))
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
+    println!();
+    let s = c.solver();
+    println!(
+        "solver ({}): {} after {} iteration(s); objective {:.6} -> {:.6}",
+        c.settings.objective.name(),
+        s.termination.describe(),
+        c.stages.iter().map(|s| s.report.iterations).sum::<usize>(),
+        c.stages[0].report.initial_objective,
+        s.final_objective
+    );
+    if let Some(scale) = c.robust_scale_mm {
+        println!(
+            "robust scale {scale:.4} mm; {} point(s) down-weighted{}",
+            c.downweighted.len(),
+            if c.downweighted.is_empty() { "" } else { ":" }
+        );
+        for d in &c.downweighted {
+            println!(
+                "  line {:>5}: error {:.4} mm, weight {:.4}",
+                d.line, d.error_mm, d.weight
+            );
+        }
+    }
+    let after_cols: Vec<(&str, ErrorStats)> =
+        std::iter::once(("Calibration", c.calibration.after_stats()))
+            .chain(
+                c.validation
+                    .as_ref()
+                    .map(|v| ("Validation", v.after_stats())),
+            )
+            .collect();
+    println!();
+    print!(
+        "{}",
+        stats_table(
+            "Table IV. Error after calibration (calibrated model)",
+            &after_cols
+        )
+    );
+}
+
+/// A number with `decimals` decimals, without a minus sign on zero.
+fn num(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        s.trim_start_matches('-').to_owned()
+    } else {
+        s
+    }
+}
+
+/// The layout of the paper's Table III (rows per joint: alpha, d, a, phi and beta where enabled;
+/// columns B and T with x, y, z in mm and A, B, C in degrees), each cell given by `cell`.
+fn layout(robot: &Robot, cell: &dyn Fn(Param) -> String) -> String {
+    use std::fmt::Write;
+    let n = robot.dof();
+    let any_beta = (0..n).any(|i| robot.beta_enabled(i));
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        "{:>3} {:>13} {:>13} {:>13} {:>13}",
+        "i", "alpha (deg)", "d (mm)", "a (mm)", "phi (deg)"
+    );
+    if any_beta {
+        let _ = write!(s, " {:>13}", "beta (deg)");
+    }
+    let _ = writeln!(s, " {:>13} {:>13}", "B", "T");
+    let units = ["mm", "mm", "mm", "deg", "deg", "deg"];
+    for i in 0..n.max(6) {
+        if i < n {
+            let _ = write!(s, "{:>3}", i + 1);
+            for p in [Param::Alpha(i), Param::D(i), Param::A(i), Param::Phi(i)] {
+                let _ = write!(s, " {:>13}", cell(p));
+            }
+            if any_beta {
+                let b = if robot.beta_enabled(i) {
+                    cell(Param::Beta(i))
+                } else {
+                    String::new()
+                };
+                let _ = write!(s, " {b:>13}");
+            }
+        } else {
+            let _ = write!(
+                s,
+                "{:>3}{}",
+                "",
+                " ".repeat(14 * if any_beta { 5 } else { 4 })
+            );
+        }
+        if i < 6 {
+            let _ = write!(
+                s,
+                " {:>13} {:>13}  ({})",
+                cell(Param::Base(i)),
+                cell(Param::Tool(i)),
+                units[i]
+            );
+        }
+        s.push('\n');
+    }
+    s
+}
