@@ -10,7 +10,9 @@
 //! (files, reports). See `DESIGN.md` for the conventions.
 #![warn(missing_docs)]
 
+pub mod compensation;
 pub mod error;
+pub mod evaluation;
 pub mod frame;
 pub mod io;
 pub mod kinematics;
@@ -18,6 +20,7 @@ pub mod model;
 pub mod simulation;
 pub mod stats;
 
+pub use compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
 pub use error::{Error, Result};
 pub use frame::{frame_vector, pose, Frame};
 pub use kinematics::poe::{Poe, Twist};

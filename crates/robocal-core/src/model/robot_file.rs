@@ -263,7 +263,7 @@ beta = 0
     }
 
     fn expect_err(s: &str, needles: &[&str]) {
-        let e = parse(s).err().expect("must fail").to_string();
+        let e = parse(s).expect_err("must fail").to_string();
         assert!(e.starts_with("robot.toml"), "{e}");
         for n in needles {
             assert!(e.contains(n), "`{e}` lacks `{n}`");
