@@ -1,6 +1,8 @@
 //! Command-line interface: one module per subcommand.
 
 mod common;
+mod compensate;
+mod evaluate;
 mod fk;
 mod robot;
 
@@ -23,6 +25,11 @@ enum Command {
     Robot(robot::RobotCmd),
     /// Forward kinematics: the tool position for given joint values.
     Fk(fk::FkArgs),
+    /// Error statistics of measured data under the nominal and calibrated models (validation),
+    /// or of measured commanded poses against their desired positions (verification).
+    Evaluate(evaluate::EvaluateArgs),
+    /// Commanded joints that make the real robot reach the nominal positions (compensation).
+    Compensate(compensate::CompensateArgs),
 }
 
 /// Runs a parsed command line.
@@ -30,5 +37,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Robot(c) => robot::run(c),
         Command::Fk(a) => fk::run(a),
+        Command::Evaluate(a) => evaluate::run(a),
+        Command::Compensate(a) => compensate::run(a),
     }
 }

@@ -13,11 +13,13 @@
 //! projected back into the limits. The damping adapts as in Levenberg–Marquardt: divided by 10
 //! after a step that reduced the error, multiplied by 10 and the step retried otherwise.
 //!
-//! When a solve stops short of the tolerance, it is classified (see [`IkStatus`]): a joint held at
-//! a limit that blocks the way, and the same solve without limits reaching the target, gives
-//! [`IkStatus::JointLimit`]; a stop at a stationary point of the distance (no free joint can move
-//! the tool towards the target, even without limits) gives [`IkStatus::Unreachable`]; anything
-//! else [`IkStatus::NotConverged`].
+//! When a solve stops short of the tolerance, it is classified (see [`IkStatus`]). If a joint held
+//! at a limit blocks the way, the solve continues from there without limits. Then: the target
+//! reached without limits gives [`IkStatus::JointLimit`]; a stop at a stationary point of the
+//! distance (no damped step reduces the error, no free joint moves the tool towards the target, or
+//! the residual has stopped decreasing over the second half of the iteration budget) gives
+//! [`IkStatus::Unreachable`]; a run still making progress when the budget ran out gives
+//! [`IkStatus::NotConverged`].
 
 use super::{IkReport, IkSolver, IkStatus};
 use crate::error::{Error, Result};
@@ -60,7 +62,12 @@ impl Default for DampedLeastSquares {
     }
 }
 
+/// Relative decrease of the residual over the second half of the iteration budget below which a
+/// run that used up its budget counts as stopped at a stationary point (a plateau).
+const PLATEAU: f64 = 1e-3;
+
 /// Where one run of the iteration stopped.
+#[derive(Clone, Copy)]
 struct Run {
     residual: f64,
     iterations: usize,
@@ -68,8 +75,10 @@ struct Run {
     blocking: u32,
     /// The joints at a limit (bit mask).
     at_limit: u32,
-    /// Largest direction cosine between a free joint's tool motion and the error.
-    max_cosine: f64,
+    /// Whether the run stopped at a stationary point of the distance: no step with any damping
+    /// reduced the error, or no free joint's tool motion has a direction cosine with the error
+    /// above [`DampedLeastSquares::stationary_cosine`], or the residual reached a plateau.
+    stationary: bool,
 }
 
 impl DampedLeastSquares {
@@ -117,7 +126,12 @@ impl DampedLeastSquares {
         let mut r = e.norm();
         let mut mu = self.initial_damping;
         let mut iterations = 1;
+        let mut stalled = false;
+        let mut r_half = f64::INFINITY;
         loop {
+            if r_half.is_infinite() && 2 * iterations >= self.max_iterations {
+                r_half = r;
+            }
             // Free joints: those not held at a limit by the descent direction g_i = j_i . e.
             let mut free = 0u32;
             for i in 0..n {
@@ -137,6 +151,7 @@ impl DampedLeastSquares {
             }
             let scale = a.trace() / 3.0;
             if scale <= 0.0 || !scale.is_finite() {
+                stalled = true;
                 break;
             }
             // Levenberg–Marquardt: retry with more damping until the error decreases; the
@@ -197,6 +212,7 @@ impl DampedLeastSquares {
                 }
             }
             if !accepted {
+                stalled = mu > MAX_DAMPING;
                 break;
             }
         }
@@ -222,12 +238,13 @@ impl DampedLeastSquares {
                 max_cosine = max_cosine.max(cos.abs());
             }
         }
+        let plateau = iterations >= self.max_iterations && r_half - r < PLATEAU * r_half;
         Run {
             residual: r,
             iterations,
             blocking,
             at_limit,
-            max_cosine,
+            stationary: stalled || plateau || max_cosine < self.stationary_cosine,
         }
     }
 }
@@ -256,19 +273,20 @@ impl IkSolver for DampedLeastSquares {
         if run.residual <= self.tolerance_mm {
             return report(IkStatus::Converged);
         }
-        if run.blocking != 0 {
-            // Would the target be reached without the limits? Continue from here, unconstrained.
+        // Where would the solve end without the limits? Continue from here, unconstrained.
+        let unc = if run.blocking != 0 {
             let mut free = [0.0; MAX_JOINTS];
             free[..n].copy_from_slice(q);
-            let unc = self.run(robot, target, &mut free[..n], false);
-            if unc.residual > self.tolerance_mm && unc.max_cosine < self.stationary_cosine {
-                return report(IkStatus::Unreachable);
-            }
-            return report(IkStatus::JointLimit);
+            self.run(robot, target, &mut free[..n], false)
+        } else {
+            run
+        };
+        if unc.residual <= self.tolerance_mm {
+            report(IkStatus::JointLimit)
+        } else if unc.stationary {
+            report(IkStatus::Unreachable)
+        } else {
+            report(IkStatus::NotConverged)
         }
-        if run.max_cosine < self.stationary_cosine {
-            return report(IkStatus::Unreachable);
-        }
-        report(IkStatus::NotConverged)
     }
 }

@@ -29,13 +29,14 @@ pub enum IkStatus {
     /// The tool point is within the tolerance of the target, all joints within their limits.
     Converged,
     /// The target is reachable only with some joint outside its limits: stopped at a limit that
-    /// blocks the way, and the same solve without limits reaches the target.
+    /// blocks the way, and the same solve continued without limits reaches the target.
     JointLimit,
     /// The target lies outside the workspace: the solver stopped at the arm's nearest approach
-    /// (a stationary point of the distance, even without joint limits); the residual is how far
-    /// the target is from it.
+    /// (a stationary point of the distance, even without joint limits). The residual is the
+    /// distance from the closest point reached within the limits.
     Unreachable,
-    /// Neither of the above: the iteration limit was reached while still far from the target.
+    /// Neither of the above: the iteration limit was reached while the error was still
+    /// decreasing.
     NotConverged,
 }
 
@@ -183,7 +184,8 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
     /// Joint values (rad) that put the calibrated model's tool point at `target` (mm, base frame).
     /// With a `seed` the solve starts there (and only there); without, it tries up to
     /// [`Compensator::seeds`] start configurations ([`default_seeds`], turned towards the target)
-    /// and keeps the first that converges, else the best (by status, then residual).
+    /// and keeps the first that converges, else the one that ends closest to the target (with its
+    /// status).
     pub fn reach(&self, target: &Vector3<f64>, seed: Option<&[f64]>, q: &mut [f64]) -> IkReport {
         if let Some(s) = seed {
             return self.solver.solve(self.calibrated, target, s, q);
@@ -200,7 +202,7 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
                 .solve(self.calibrated, target, &start[..n], &mut trial[..n]);
             let better = match &best {
                 None => true,
-                Some(b) => (rep.status, rep.residual_mm) < (b.status, b.residual_mm),
+                Some(b) => rep.status.is_converged() || rep.residual_mm < b.residual_mm,
             };
             if better {
                 q.copy_from_slice(&trial[..n]);

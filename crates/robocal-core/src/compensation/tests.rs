@@ -191,6 +191,11 @@ fn targets_outside_the_workspace_are_reported() {
         assert!(r > 1_000.0, "{r}");
         assert!(within_limits(&cal, &q));
     }
+    // Below the floor, beyond reach even without joint limits (while the limits also block the
+    // way from most starts): unreachable, not joint_limit.
+    let p = Vector3::new(0.0, 0.0, -3_000.0);
+    let rep = comp.reach(&p, None, &mut q);
+    assert_eq!(rep.status, IkStatus::Unreachable, "{rep:?}");
     // The same through the batch API with a seed: the row is kept and flagged.
     let targets = vec![
         Target {
