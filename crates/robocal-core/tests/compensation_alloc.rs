@@ -58,4 +58,14 @@ fn compensate_does_not_allocate() {
     let after = ALLOCATIONS.load(Ordering::SeqCst);
     assert_eq!(after - before, 0, "allocations in the compensation loop");
     assert!(converged >= 495, "{converged}");
+    // Cartesian targets from the default seeds: no allocation either.
+    let targets: Vec<_> = poses.iter().map(|d| cal.tool_position(d)).collect();
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let mut reached = 0;
+    for t in &targets {
+        reached += comp.reach(t, None, &mut q).status.is_converged() as usize;
+    }
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert_eq!(after - before, 0, "allocations in reach");
+    assert_eq!(reached, targets.len());
 }

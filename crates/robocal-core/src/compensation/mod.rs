@@ -317,9 +317,14 @@ fn halton(mut k: usize, base: usize) -> f64 {
 /// Turns joint 1 of `q` so that the tool point's azimuth about joint 1's axis matches the
 /// target's (when the result stays within joint 1's limits, trying a full turn either way).
 fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
-    let Some(&(axis, origin)) = robot.joint_axes(q).first() else {
-        return;
+    // Joint 1's axis frame (as in `Robot::joint_axes`, without its allocation): MDH applies the
+    // link's constant part before the joint rotation, DH after it.
+    let f = match robot.convention() {
+        crate::model::Convention::Mdh => robot.base_frame() * robot.link_constant(0),
+        crate::model::Convention::Dh => *robot.base_frame(),
     };
+    let axis: Vector3<f64> = f.rotation.matrix().column(2).into();
+    let origin = f.translation.vector;
     let p = robot.tool_position(q);
     let flat = |v: Vector3<f64>| v - axis * axis.dot(&v);
     let (a, b) = (flat(p - origin), flat(target - origin));

@@ -343,3 +343,26 @@ fn statuses_roundtrip_and_seeds_are_within_limits() {
     }
     assert_ne!(seeds[1], seeds[2]);
 }
+
+/// The allocation-free axis of joint 1 used to turn seeds agrees with `joint_axes`.
+#[test]
+fn seed_turning_uses_joint_1_axis() {
+    let (_, cal) = kuka();
+    let wam = crate::load_robot(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/wam.toml"
+    ))
+    .unwrap();
+    for r in [&cal, &wam] {
+        let n = r.dof();
+        let mut q = vec![0.3; n];
+        let target = r.tool_position(&{
+            let mut t = q.clone();
+            t[0] += 0.7;
+            t
+        });
+        turn_towards(r, &target, &mut q);
+        // Turning joint 1 alone back onto the target's azimuth recovers the 0.7 rad.
+        assert!((q[0] - 1.0).abs() < 1e-9, "{}: {}", r.name(), q[0]);
+    }
+}
