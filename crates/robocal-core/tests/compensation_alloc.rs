@@ -1,24 +1,36 @@
 //! The compensation inner loop (nominal forward kinematics + damped least-squares IK on the
-//! calibrated model) does not allocate: counted with a global allocator wrapper.
+//! calibrated model) does not allocate: counted with a global allocator wrapper, per thread (the
+//! test harness's own thread may allocate meanwhile).
 
 use robocal_core::{preset, Compensator, DampedLeastSquares};
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 struct Counting;
 
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    /// Allocations made by the current thread.
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+fn count() {
+    let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
+}
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(|c| c.get())
+}
 
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        count();
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        count();
         unsafe { System.realloc(ptr, layout, new_size) }
     }
 }
@@ -50,22 +62,22 @@ fn compensate_does_not_allocate() {
         .collect();
     let mut q = [0.0; 6];
     let mut converged = 0;
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     for d in &poses {
         let (_, rep) = comp.compensate(d, &mut q);
         converged += rep.status.is_converged() as usize;
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = allocations();
     assert_eq!(after - before, 0, "allocations in the compensation loop");
     assert!(converged >= 495, "{converged}");
     // Cartesian targets from the default seeds: no allocation either.
     let targets: Vec<_> = poses.iter().map(|d| cal.tool_position(d)).collect();
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = allocations();
     let mut reached = 0;
     for t in &targets {
         reached += comp.reach(t, None, &mut q).status.is_converged() as usize;
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = allocations();
     assert_eq!(after - before, 0, "allocations in reach");
     assert_eq!(reached, targets.len());
 }
