@@ -2,6 +2,8 @@
 
 mod calibrate;
 mod common;
+mod compensate;
+mod evaluate;
 mod fk;
 mod robot;
 mod simulate;
@@ -29,6 +31,11 @@ enum Command {
     Simulate(Box<simulate::SimulateArgs>),
     /// Fit the measurement frame and identify the calibrated parameters (writes a result JSON).
     Calibrate(calibrate::CalibrateArgs),
+    /// Error statistics of measured data under the nominal and calibrated models (validation),
+    /// or of measured commanded poses against their desired positions (verification).
+    Evaluate(evaluate::EvaluateArgs),
+    /// Commanded joints that make the real robot reach the nominal positions (compensation).
+    Compensate(compensate::CompensateArgs),
 }
 
 /// Runs a parsed command line.
@@ -38,5 +45,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Fk(a) => fk::run(a),
         Command::Simulate(a) => simulate::run(*a),
         Command::Calibrate(a) => calibrate::run(a),
+        Command::Evaluate(a) => evaluate::run(a),
+        Command::Compensate(a) => compensate::run(a),
     }
 }

@@ -10,7 +10,9 @@
 //! (files, reports). See `DESIGN.md` for the conventions.
 #![warn(missing_docs)]
 
+pub mod compensation;
 pub mod error;
+pub mod evaluation;
 pub mod frame;
 pub mod identification;
 pub mod io;
@@ -20,6 +22,7 @@ pub mod registration;
 pub mod simulation;
 pub mod stats;
 
+pub use compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
 pub use error::{Error, Result};
 pub use frame::{frame_vector, pose, Frame};
 pub use kinematics::poe::{Poe, Twist};

@@ -1,0 +1,142 @@
+//! The commanded-joints CSV written by `robocal compensate`.
+//!
+//! Columns, in order:
+//! - `q1..qn`: the commanded joint values theta_com (degrees, model joint values; eq. 14): what
+//!   to send to the controller (after the controller's own axis mapping);
+//! - `status` ([`IkStatus::as_str`]), `residual_mm`, `iterations`, `at_limit` (joints that end at a
+//!   limit, e.g. `q2 q5`, empty when none);
+//! - `x_desired,y_desired,z_desired`: the desired tool position P_des (mm, base frame; eq. 13, or
+//!   the given target);
+//! - `q1_desired..qn_desired`: the desired joint values theta_des (degrees; eq. 12), when the input
+//!   was a joint file;
+//! - the input's other columns, unchanged.
+//!
+//! As a joint file it reads with [`crate::io::read_measurements`] (`q1..qn` are the commanded
+//! joints, the rest are extra columns), so a simulator or a measurement of the commanded poses
+//! carries the desired columns through, and `evaluate` compares the measured points with
+//! `x_desired,y_desired,z_desired` (the paper's verification, Table V).
+
+use super::{Compensation, IkStatus};
+use crate::error::{Error, Result};
+use crate::io::atomic::AtomicFile;
+use std::io::Write;
+use std::path::Path;
+
+/// Column with the solve's [`IkStatus`].
+pub const STATUS_COLUMN: &str = "status";
+/// Column with the solve's residual (mm).
+pub const RESIDUAL_COLUMN: &str = "residual_mm";
+/// Column with the solve's iteration count.
+pub const ITERATIONS_COLUMN: &str = "iterations";
+/// Column listing the joints that end at a limit.
+pub const AT_LIMIT_COLUMN: &str = "at_limit";
+/// Columns of the desired tool position P_des (mm, base frame).
+pub const DESIRED_POSITION_COLUMNS: [&str; 3] = ["x_desired", "y_desired", "z_desired"];
+
+/// The column of desired joint `i` (0-based): `q{i+1}_desired`.
+pub fn desired_joint_column(i: usize) -> String {
+    format!("q{}_desired", i + 1)
+}
+
+/// The header of a commanded file for `dof` joints, with or without desired joints, before the
+/// input's extra columns.
+pub fn commanded_header(dof: usize, with_desired_joints: bool) -> Vec<String> {
+    let mut h: Vec<String> = (1..=dof).map(|i| format!("q{i}")).collect();
+    h.extend(
+        [
+            STATUS_COLUMN,
+            RESIDUAL_COLUMN,
+            ITERATIONS_COLUMN,
+            AT_LIMIT_COLUMN,
+        ]
+        .map(String::from),
+    );
+    h.extend(DESIRED_POSITION_COLUMNS.map(String::from));
+    if with_desired_joints {
+        h.extend((0..dof).map(desired_joint_column));
+    }
+    h
+}
+
+/// Checks that no extra column of the input (`input` names the file in the message) has the name
+/// of a column the commanded file adds (desired joints included, whichever the mode).
+pub fn check_extra_columns(input: &Path, dof: usize, extra_columns: &[String]) -> Result<()> {
+    let own = commanded_header(dof, true);
+    for c in extra_columns {
+        if own.contains(c) {
+            return Err(Error::parse(
+                input,
+                Some(1),
+                Some(c),
+                "the output of compensate has a column of this name; rename or remove it \
+                 (is this already a commanded file?)",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Writes a commanded file atomically (nothing is written if anything fails). `desired_joints`
+/// (rad) are the eq. 12 vectors in joint mode; `extra_rows[k]` are row k's values of
+/// `extra_columns`.
+pub fn write_commanded(
+    path: &Path,
+    dof: usize,
+    rows: &[Compensation],
+    desired_joints: Option<&[Vec<f64>]>,
+    extra_columns: &[String],
+    extra_rows: &[&[String]],
+) -> Result<()> {
+    if extra_rows.len() != rows.len() || desired_joints.is_some_and(|d| d.len() != rows.len()) {
+        return Err(Error::invalid(
+            "commanded file",
+            "row counts of results, desired joints and extra columns differ",
+        ));
+    }
+    let io = |e: std::io::Error| Error::Io {
+        path: path.to_owned(),
+        source: e,
+    };
+    let mut out = AtomicFile::create(path)?;
+    {
+        let mut w = csv::Writer::from_writer(&mut out);
+        let mut header = commanded_header(dof, desired_joints.is_some());
+        header.extend(extra_columns.iter().cloned());
+        w.write_record(&header)
+            .map_err(|e| io(std::io::Error::other(e)))?;
+        let mut f: Vec<String> = Vec::with_capacity(header.len());
+        for (k, c) in rows.iter().enumerate() {
+            f.clear();
+            f.extend(
+                c.commanded
+                    .iter()
+                    .map(|v| format!("{:.10}", v.to_degrees())),
+            );
+            f.push(c.report.status.as_str().to_owned());
+            f.push(format!("{:.3e}", c.report.residual_mm));
+            f.push(c.report.iterations.to_string());
+            f.push(
+                c.report
+                    .limited_joints()
+                    .map(|i| format!("q{}", i + 1))
+                    .collect::<Vec<_>>()
+                    .join(" "),
+            );
+            f.extend(c.desired_position.iter().map(|v| format!("{v:.9}")));
+            if let Some(d) = desired_joints {
+                f.extend(d[k].iter().map(|v| format!("{:.10}", v.to_degrees())));
+            }
+            f.extend(extra_rows[k].iter().cloned());
+            w.write_record(&f)
+                .map_err(|e| io(std::io::Error::other(e)))?;
+        }
+        w.flush().map_err(io)?;
+    }
+    out.flush().map_err(io)?;
+    out.commit()
+}
+
+/// Counts of each status in `rows`, in [`IkStatus::ALL`] order.
+pub fn status_counts(rows: &[Compensation]) -> [(IkStatus, usize); 4] {
+    IkStatus::ALL.map(|s| (s, rows.iter().filter(|c| c.report.status == s).count()))
+}

@@ -1,0 +1,347 @@
+//! Compensation (paper, section V.A, eq. 12-14): commanded joint values that put the *calibrated*
+//! model's tool point where the controller's *nominal* model believes it to be.
+//!
+//! For a desired joint vector `theta_des` (eq. 12) the target is its nominal tool position
+//! `P_des = FK_nominal(theta_des)` (eq. 13); numerical inverse kinematics on the calibrated model,
+//! started from `theta_des`, finds the commanded joints `theta_com` (eq. 14) with
+//! `FK_calibrated(theta_com) = P_des`. Sent to the real robot (whose geometry the calibrated model
+//! describes), `theta_com` puts the tool at `P_des`. Targets can also be given directly as points in
+//! the base frame ([`Compensator::reach`]).
+//!
+//! The inverse kinematics sits behind the [`IkSolver`] trait; [`DampedLeastSquares`] is the
+//! method provided. Every solve ends with an [`IkStatus`] and its residual: nothing is dropped or
+//! hidden, a caller decides what to do with rows that did not converge.
+
+pub mod commanded;
+mod dls;
+mod targets;
+
+pub use dls::DampedLeastSquares;
+pub use targets::{read_targets, Target, TargetSet};
+
+use crate::error::{Error, Result};
+use crate::model::{Robot, MAX_JOINTS};
+use nalgebra::Vector3;
+
+/// How an inverse-kinematics solve ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum IkStatus {
+    /// The tool point is within the tolerance of the target, all joints within their limits.
+    Converged,
+    /// The target is reachable only with some joint outside its limits: stopped at a limit that
+    /// blocks the way, and the same solve continued without limits reaches the target.
+    JointLimit,
+    /// The target lies outside the workspace: the solver stopped at the arm's nearest approach
+    /// (a stationary point of the distance, even without joint limits). The residual is the
+    /// distance from the closest point reached within the limits.
+    Unreachable,
+    /// Neither of the above: the iteration limit was reached while the error was still
+    /// decreasing.
+    NotConverged,
+}
+
+impl IkStatus {
+    /// Every status, in the order used for summaries.
+    pub const ALL: [IkStatus; 4] = [
+        IkStatus::Converged,
+        IkStatus::JointLimit,
+        IkStatus::Unreachable,
+        IkStatus::NotConverged,
+    ];
+
+    /// The word written to files: `converged`, `joint_limit`, `unreachable`, `not_converged`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            IkStatus::Converged => "converged",
+            IkStatus::JointLimit => "joint_limit",
+            IkStatus::Unreachable => "unreachable",
+            IkStatus::NotConverged => "not_converged",
+        }
+    }
+
+    /// Parses [`IkStatus::as_str`].
+    pub fn parse(s: &str) -> Option<IkStatus> {
+        IkStatus::ALL.into_iter().find(|x| x.as_str() == s.trim())
+    }
+
+    /// Whether the solve succeeded.
+    pub fn is_converged(self) -> bool {
+        self == IkStatus::Converged
+    }
+}
+
+impl std::fmt::Display for IkStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// The outcome of one inverse-kinematics solve.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IkReport {
+    /// How it ended.
+    pub status: IkStatus,
+    /// Distance (mm) between the tool point at the returned joints and the target.
+    pub residual_mm: f64,
+    /// Iterations used (Jacobian evaluations of the solve within the limits).
+    pub iterations: usize,
+    /// Bit `i` set: joint `i` (0-based) ends at one of its limits.
+    pub joints_at_limit: u32,
+}
+
+impl IkReport {
+    /// The joints (0-based) that end at a limit.
+    pub fn limited_joints(&self) -> impl Iterator<Item = usize> + '_ {
+        (0..MAX_JOINTS).filter(move |i| self.joints_at_limit & (1 << i) != 0)
+    }
+}
+
+/// An inverse-kinematics method for the tool *position* (3 equations).
+///
+/// Implementations must keep the returned joints within the robot's limits and must not allocate
+/// per solve, so that batches run at full speed.
+pub trait IkSolver {
+    /// Finds joint values (rad) that put `robot`'s tool point at `target` (mm, base frame),
+    /// starting from `start` (rad; moved into the limits first). Writes them to `q`, which has
+    /// `robot.dof()` entries, and reports how the solve ended.
+    ///
+    /// Panics if `start` or `q` do not have `robot.dof()` entries (a programming error: check
+    /// joint vectors from users with [`Robot::check_joints`]).
+    fn solve(&self, robot: &Robot, target: &Vector3<f64>, start: &[f64], q: &mut [f64])
+        -> IkReport;
+}
+
+/// The result of compensating one pose or reaching one target.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Compensation {
+    /// The desired tool position `P_des` (mm, base frame): eq. 13, or the given target.
+    pub desired_position: Vector3<f64>,
+    /// The commanded joint values `theta_com` (rad, model joint values), eq. 14. For a row that
+    /// did not converge: the closest configuration found, within the limits.
+    pub commanded: Vec<f64>,
+    /// How the solve ended.
+    pub report: IkReport,
+}
+
+/// Compensation of a nominal model by a calibrated one (eq. 12-14).
+#[derive(Debug, Clone)]
+pub struct Compensator<'a, S: IkSolver = DampedLeastSquares> {
+    nominal: &'a Robot,
+    calibrated: &'a Robot,
+    /// The inverse-kinematics method and its tolerances.
+    pub solver: S,
+    /// How many start configurations [`Compensator::reach`] tries for a target without a seed
+    /// (see [`default_seeds`]).
+    pub seeds: usize,
+}
+
+/// How often batch functions call the progress callback (rows).
+const PROGRESS_EVERY: usize = 256;
+
+impl<'a, S: IkSolver> Compensator<'a, S> {
+    /// A compensator for the controller's `nominal` model and the `calibrated` model of the same
+    /// robot. Fails if their joint counts differ.
+    pub fn new(nominal: &'a Robot, calibrated: &'a Robot, solver: S) -> Result<Self> {
+        if nominal.dof() != calibrated.dof() {
+            return Err(Error::invalid(
+                "calibrated model",
+                format!(
+                    "has {} joints, the nominal model {}",
+                    calibrated.dof(),
+                    nominal.dof()
+                ),
+            ));
+        }
+        Ok(Compensator {
+            nominal,
+            calibrated,
+            solver,
+            seeds: 8,
+        })
+    }
+
+    /// The nominal model.
+    pub fn nominal(&self) -> &Robot {
+        self.nominal
+    }
+
+    /// The calibrated model.
+    pub fn calibrated(&self) -> &Robot {
+        self.calibrated
+    }
+
+    /// Compensates one desired joint vector (rad): target `P_des = FK_nominal(desired)` (eq. 13),
+    /// solved on the calibrated model from `desired` (eq. 14); writes `theta_com` to `commanded`.
+    /// Returns `P_des` and the solve's report. Allocation-free.
+    pub fn compensate(&self, desired: &[f64], commanded: &mut [f64]) -> (Vector3<f64>, IkReport) {
+        let target = self.nominal.tool_position(desired);
+        let rep = self
+            .solver
+            .solve(self.calibrated, &target, desired, commanded);
+        (target, rep)
+    }
+
+    /// Joint values (rad) that put the calibrated model's tool point at `target` (mm, base frame).
+    /// With a `seed` the solve starts there (and only there); without, it tries up to
+    /// [`Compensator::seeds`] start configurations ([`default_seeds`], turned towards the target)
+    /// and keeps the first that converges, else the one that ends closest to the target (with its
+    /// status).
+    pub fn reach(&self, target: &Vector3<f64>, seed: Option<&[f64]>, q: &mut [f64]) -> IkReport {
+        if let Some(s) = seed {
+            return self.solver.solve(self.calibrated, target, s, q);
+        }
+        let n = self.calibrated.dof();
+        let mut start = [0.0; MAX_JOINTS];
+        let mut trial = [0.0; MAX_JOINTS];
+        let mut best: Option<IkReport> = None;
+        for k in 0..self.seeds.max(1) {
+            seed_configuration(self.calibrated, k, &mut start[..n]);
+            turn_towards(self.calibrated, target, &mut start[..n]);
+            let rep = self
+                .solver
+                .solve(self.calibrated, target, &start[..n], &mut trial[..n]);
+            let better = match &best {
+                None => true,
+                Some(b) => rep.status.is_converged() || rep.residual_mm < b.residual_mm,
+            };
+            if better {
+                q.copy_from_slice(&trial[..n]);
+                best = Some(rep);
+            }
+            if rep.status.is_converged() {
+                break;
+            }
+        }
+        best.expect("at least one seed")
+    }
+
+    /// Compensates every desired joint vector (rad), in order (eq. 12-14). `progress(done, total)`
+    /// is called as rows complete.
+    pub fn compensate_all(
+        &self,
+        desired: &[Vec<f64>],
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<Vec<Compensation>> {
+        let n = self.nominal.dof();
+        let mut out = Vec::with_capacity(desired.len());
+        for (k, d) in desired.iter().enumerate() {
+            self.nominal
+                .check_joints(d, &format!("desired pose {}", k + 1))?;
+            let mut q = vec![0.0; n];
+            let (p, report) = self.compensate(d, &mut q);
+            out.push(Compensation {
+                desired_position: p,
+                commanded: q,
+                report,
+            });
+            if (k + 1) % PROGRESS_EVERY == 0 {
+                progress(k + 1, desired.len());
+            }
+        }
+        progress(desired.len(), desired.len());
+        Ok(out)
+    }
+
+    /// Reaches every target of a target file, in order (see [`Compensator::reach`]).
+    pub fn reach_all(
+        &self,
+        targets: &[Target],
+        progress: &mut dyn FnMut(usize, usize),
+    ) -> Result<Vec<Compensation>> {
+        let n = self.calibrated.dof();
+        let mut out = Vec::with_capacity(targets.len());
+        for (k, t) in targets.iter().enumerate() {
+            if let Some(s) = &t.seed {
+                self.calibrated
+                    .check_joints(s, &format!("target on line {}", t.line))?;
+            }
+            if t.p.iter().any(|v| !v.is_finite()) {
+                return Err(Error::invalid(
+                    format!("target on line {}", t.line),
+                    "not a finite position",
+                ));
+            }
+            let mut q = vec![0.0; n];
+            let report = self.reach(&t.p, t.seed.as_deref(), &mut q);
+            out.push(Compensation {
+                desired_position: t.p,
+                commanded: q,
+                report,
+            });
+            if (k + 1) % PROGRESS_EVERY == 0 {
+                progress(k + 1, targets.len());
+            }
+        }
+        progress(targets.len(), targets.len());
+        Ok(out)
+    }
+}
+
+/// The `k`-th default start configuration for a Cartesian target without a seed, written to `q`
+/// (rad): `k = 0` is the middle of every joint's range; further ones are spread over the limits
+/// by a Halton sequence (deterministic, so the same file gives the same answer). Ranges wider than
+/// a full turn are sampled over one turn around their middle.
+pub fn default_seeds(robot: &Robot, count: usize) -> Vec<Vec<f64>> {
+    (0..count)
+        .map(|k| {
+            let mut q = vec![0.0; robot.dof()];
+            seed_configuration(robot, k, &mut q);
+            q
+        })
+        .collect()
+}
+
+fn seed_configuration(robot: &Robot, k: usize, q: &mut [f64]) {
+    const PRIMES: [usize; MAX_JOINTS] =
+        [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53];
+    for (i, (v, l)) in q.iter_mut().zip(robot.limits()).enumerate() {
+        let mid = 0.5 * (l.min + l.max);
+        let half = (0.5 * (l.max - l.min)).min(std::f64::consts::PI);
+        // Halton value in (0, 1) shifted so that k = 0 gives the middle.
+        let u = if k == 0 { 0.5 } else { halton(k, PRIMES[i]) };
+        *v = mid + (2.0 * u - 1.0) * half;
+    }
+}
+
+fn halton(mut k: usize, base: usize) -> f64 {
+    let mut f = 1.0;
+    let mut r = 0.0;
+    while k > 0 {
+        f /= base as f64;
+        r += f * (k % base) as f64;
+        k /= base;
+    }
+    r
+}
+
+/// Turns joint 1 of `q` so that the tool point's azimuth about joint 1's axis matches the
+/// target's (when the result stays within joint 1's limits, trying a full turn either way).
+fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
+    // Joint 1's axis frame (as in `Robot::joint_axes`, without its allocation): MDH applies the
+    // link's constant part before the joint rotation, DH after it.
+    let f = match robot.convention() {
+        crate::model::Convention::Mdh => robot.base_frame() * robot.link_constant(0),
+        crate::model::Convention::Dh => *robot.base_frame(),
+    };
+    let axis: Vector3<f64> = f.rotation.matrix().column(2).into();
+    let origin = f.translation.vector;
+    let p = robot.tool_position(q);
+    let flat = |v: Vector3<f64>| v - axis * axis.dot(&v);
+    let (a, b) = (flat(p - origin), flat(target - origin));
+    if a.norm() < 1e-9 || b.norm() < 1e-9 {
+        return;
+    }
+    let angle = a.cross(&b).dot(&axis).atan2(a.dot(&b));
+    let l = robot.limits()[0];
+    let tau = std::f64::consts::TAU;
+    for turn in [0.0, tau, -tau] {
+        let v = q[0] + angle + turn;
+        if l.contains(v) {
+            q[0] = v;
+            return;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,218 @@
+//! Target files for `robocal compensate --targets`: a header row, columns `x,y,z` (mm, robot base
+//! frame = ACS) and, optionally, `q1..qn` (degrees), a start configuration for the solve. Other
+//! columns are carried through. Every rejection names the file, the line and the column.
+
+use crate::error::{Error, Result};
+use nalgebra::Vector3;
+use std::path::{Path, PathBuf};
+
+/// One target.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Target {
+    /// 1-based line in the file.
+    pub line: usize,
+    /// The target point (mm, base frame).
+    pub p: Vector3<f64>,
+    /// Start configuration (rad), when the file has `q1..qn`.
+    pub seed: Option<Vec<f64>>,
+    /// Values of the extra columns, in [`TargetSet::extra_columns`] order.
+    pub extra: Vec<String>,
+}
+
+/// A target file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TargetSet {
+    /// The file it was read from.
+    pub path: PathBuf,
+    /// Names of the columns other than `x,y,z` and `q1..qn`.
+    pub extra_columns: Vec<String>,
+    /// The targets, in file order.
+    pub rows: Vec<Target>,
+}
+
+/// Reads a target file for a robot with `dof` joints.
+pub fn read_targets(path: &Path, dof: usize) -> Result<TargetSet> {
+    let file = std::fs::File::open(path).map_err(|e| Error::Io {
+        path: path.to_owned(),
+        source: e,
+    })?;
+    parse_targets(std::io::BufReader::new(file), path, dof)
+}
+
+/// Parses target CSV text from any reader; `path` is used in messages.
+pub fn parse_targets<R: std::io::Read>(reader: R, path: &Path, dof: usize) -> Result<TargetSet> {
+    let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
+        Error::parse(path, line, field, msg)
+    };
+    let csv_err = |e: csv::Error| {
+        let line = e.position().map(|p| p.line() as usize);
+        let msg = match e.kind() {
+            csv::ErrorKind::UnequalLengths {
+                expected_len, len, ..
+            } => format!("{len} fields, but the header has {expected_len}"),
+            csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_owned(),
+            _ => e.to_string(),
+        };
+        Error::parse(path, line, None, msg)
+    };
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .trim(csv::Trim::All)
+        .from_reader(reader);
+    let headers: Vec<String> = rdr
+        .headers()
+        .map_err(csv_err)?
+        .iter()
+        .map(|h| h.trim_start_matches('\u{feff}').to_owned())
+        .collect();
+    if headers.iter().all(|h| h.is_empty()) {
+        return Err(perr(
+            Some(1),
+            None,
+            "empty file: expected a header row with x,y,z (and optionally q1..qn)".into(),
+        ));
+    }
+    let mut xyz = [None; 3];
+    let mut qcol = vec![None; dof];
+    let mut extra = Vec::new();
+    let mut extra_columns = Vec::new();
+    for (k, h) in headers.iter().enumerate() {
+        if h.is_empty() {
+            return Err(perr(
+                Some(1),
+                None,
+                format!("column {} has an empty name", k + 1),
+            ));
+        }
+        if headers[..k].contains(h) {
+            return Err(perr(Some(1), Some(h), "column appears twice".into()));
+        }
+        if let Some(a) = ["x", "y", "z"].iter().position(|a| a == h) {
+            xyz[a] = Some(k);
+        } else if let Some(j) = h
+            .strip_prefix('q')
+            .filter(|s| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()))
+            .and_then(|s| s.parse::<usize>().ok())
+        {
+            if j == 0 || j > dof {
+                return Err(perr(
+                    Some(1),
+                    Some(h),
+                    format!("the robot has {dof} joints (q1..q{dof})"),
+                ));
+            }
+            qcol[j - 1] = Some(k);
+        } else {
+            extra.push(k);
+            extra_columns.push(h.clone());
+        }
+    }
+    if let Some(a) = xyz.iter().position(Option::is_none) {
+        return Err(perr(
+            Some(1),
+            Some(["x", "y", "z"][a]),
+            "missing column (targets need x,y,z in mm, robot base frame)".into(),
+        ));
+    }
+    let nq = qcol.iter().filter(|c| c.is_some()).count();
+    if nq > 0 && nq < dof {
+        let j = qcol.iter().position(Option::is_none).expect("some missing");
+        return Err(perr(
+            Some(1),
+            Some(&format!("q{}", j + 1)),
+            format!("missing column: a start configuration needs all of q1..q{dof}"),
+        ));
+    }
+    let mut rows = Vec::new();
+    let mut rec = csv::StringRecord::new();
+    while rdr.read_record(&mut rec).map_err(csv_err)? {
+        let line = rec.position().map(|p| p.line() as usize).unwrap_or(0);
+        if rec.iter().all(|f| f.is_empty()) {
+            continue;
+        }
+        let num = |k: usize| -> Result<f64> {
+            let s = &rec[k];
+            let field = Some(headers[k].as_str());
+            if s.is_empty() {
+                return Err(perr(Some(line), field, "empty cell".into()));
+            }
+            match s.parse::<f64>() {
+                Ok(v) if v.is_finite() => Ok(v),
+                Ok(_) => Err(perr(
+                    Some(line),
+                    field,
+                    format!("`{s}` is not a finite number"),
+                )),
+                Err(_) => Err(perr(Some(line), field, format!("`{s}` is not a number"))),
+            }
+        };
+        let p = Vector3::new(
+            num(xyz[0].expect("checked"))?,
+            num(xyz[1].expect("checked"))?,
+            num(xyz[2].expect("checked"))?,
+        );
+        let seed = if nq == dof {
+            let mut q = Vec::with_capacity(dof);
+            for c in &qcol {
+                q.push(num(c.expect("checked"))?.to_radians());
+            }
+            Some(q)
+        } else {
+            None
+        };
+        rows.push(Target {
+            line,
+            p,
+            seed,
+            extra: extra.iter().map(|&k| rec[k].to_owned()).collect(),
+        });
+    }
+    if rows.is_empty() {
+        return Err(perr(None, None, "no data rows after the header".into()));
+    }
+    Ok(TargetSet {
+        path: path.to_owned(),
+        extra_columns,
+        rows,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(s: &str) -> Result<TargetSet> {
+        parse_targets(s.as_bytes(), Path::new("t.csv"), 2)
+    }
+
+    #[test]
+    fn reads_targets_with_and_without_seeds() {
+        let t = parse("id,x,y,z\na,1,2,3\n").unwrap();
+        assert_eq!(t.rows[0].p, Vector3::new(1.0, 2.0, 3.0));
+        assert_eq!(t.rows[0].seed, None);
+        assert_eq!(t.extra_columns, vec!["id"]);
+        let t = parse("x,y,z,q1,q2\n1,2,3,90,-45\n").unwrap();
+        let s = t.rows[0].seed.as_ref().unwrap();
+        assert!((s[0] - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+        assert_eq!(t.rows[0].line, 2);
+    }
+
+    #[test]
+    fn rejections_name_line_and_column() {
+        let e = parse("x,y\n1,2\n").unwrap_err().to_string();
+        assert!(e.contains("t.csv:1: field `z`: missing column"), "{e}");
+        let e = parse("x,y,z,q1\n1,2,3,4\n").unwrap_err().to_string();
+        assert!(e.contains("field `q2`: missing column"), "{e}");
+        let e = parse("x,y,z\n1,2,3\n1,inf,3\n").unwrap_err().to_string();
+        assert!(
+            e.contains("t.csv:3: field `y`") && e.contains("finite"),
+            "{e}"
+        );
+        let e = parse("x,y,z,q3\n1,2,3,4\n").unwrap_err().to_string();
+        assert!(e.contains("field `q3`") && e.contains("2 joints"), "{e}");
+        let e = parse("x,y,z\n").unwrap_err().to_string();
+        assert!(e.contains("no data rows"), "{e}");
+        let e = parse("x,y,z\n1,2\n").unwrap_err().to_string();
+        assert!(e.contains("t.csv:2") && e.contains("2 fields"), "{e}");
+    }
+}
