@@ -87,6 +87,35 @@ pub fn write_commanded(
     extra_columns: &[String],
     extra_rows: &[&[String]],
 ) -> Result<()> {
+    let bytes = commanded_csv(dof, rows, desired_joints, extra_columns, extra_rows).map_err(
+        |e| match e {
+            Error::Io { source, .. } => Error::Io {
+                path: path.to_owned(),
+                source,
+            },
+            other => other,
+        },
+    )?;
+    let mut out = AtomicFile::create(path)?;
+    out.write_all(&bytes)
+        .and_then(|_| out.flush())
+        .map_err(|e| Error::Io {
+            path: path.to_owned(),
+            source: e,
+        })?;
+    out.commit()
+}
+
+/// The text [`write_commanded`] writes, for callers that write several files together
+/// ([`crate::io::write_all_atomic`]) or read it back as a joint file
+/// ([`crate::io::parse_measurements`]).
+pub fn commanded_csv(
+    dof: usize,
+    rows: &[Compensation],
+    desired_joints: Option<&[Vec<f64>]>,
+    extra_columns: &[String],
+    extra_rows: &[&[String]],
+) -> Result<Vec<u8>> {
     if extra_rows.len() != rows.len() || desired_joints.is_some_and(|d| d.len() != rows.len()) {
         return Err(Error::invalid(
             "commanded file",
@@ -94,46 +123,42 @@ pub fn write_commanded(
         ));
     }
     let io = |e: std::io::Error| Error::Io {
-        path: path.to_owned(),
+        path: "commanded file".into(),
         source: e,
     };
-    let mut out = AtomicFile::create(path)?;
-    {
-        let mut w = csv::Writer::from_writer(&mut out);
-        let mut header = commanded_header(dof, desired_joints.is_some());
-        header.extend(extra_columns.iter().cloned());
-        w.write_record(&header)
-            .map_err(|e| io(std::io::Error::other(e)))?;
-        let mut f: Vec<String> = Vec::with_capacity(header.len());
-        for (k, c) in rows.iter().enumerate() {
-            f.clear();
-            f.extend(
-                c.commanded
-                    .iter()
-                    .map(|v| format!("{:.10}", v.to_degrees())),
-            );
-            f.push(c.report.status.as_str().to_owned());
-            f.push(format!("{:.3e}", c.report.residual_mm));
-            f.push(c.report.iterations.to_string());
-            f.push(
-                c.report
-                    .limited_joints()
-                    .map(|i| format!("q{}", i + 1))
-                    .collect::<Vec<_>>()
-                    .join(" "),
-            );
-            f.extend(c.desired_position.iter().map(|v| format!("{v:.9}")));
-            if let Some(d) = desired_joints {
-                f.extend(d[k].iter().map(|v| format!("{:.10}", v.to_degrees())));
-            }
-            f.extend(extra_rows[k].iter().cloned());
-            w.write_record(&f)
-                .map_err(|e| io(std::io::Error::other(e)))?;
+    let mut w = csv::Writer::from_writer(Vec::new());
+    let mut header = commanded_header(dof, desired_joints.is_some());
+    header.extend(extra_columns.iter().cloned());
+    w.write_record(&header)
+        .map_err(|e| io(std::io::Error::other(e)))?;
+    let mut f: Vec<String> = Vec::with_capacity(header.len());
+    for (k, c) in rows.iter().enumerate() {
+        f.clear();
+        f.extend(
+            c.commanded
+                .iter()
+                .map(|v| format!("{:.10}", v.to_degrees())),
+        );
+        f.push(c.report.status.as_str().to_owned());
+        f.push(format!("{:.3e}", c.report.residual_mm));
+        f.push(c.report.iterations.to_string());
+        f.push(
+            c.report
+                .limited_joints()
+                .map(|i| format!("q{}", i + 1))
+                .collect::<Vec<_>>()
+                .join(" "),
+        );
+        f.extend(c.desired_position.iter().map(|v| format!("{v:.9}")));
+        if let Some(d) = desired_joints {
+            f.extend(d[k].iter().map(|v| format!("{:.10}", v.to_degrees())));
         }
-        w.flush().map_err(io)?;
+        f.extend(extra_rows[k].iter().cloned());
+        w.write_record(&f)
+            .map_err(|e| io(std::io::Error::other(e)))?;
     }
-    out.flush().map_err(io)?;
-    out.commit()
+    w.into_inner()
+        .map_err(|e| io(std::io::Error::other(e.to_string())))
 }
 
 /// Counts of each status in `rows`, in [`IkStatus::ALL`] order.
