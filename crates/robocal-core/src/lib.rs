@@ -13,6 +13,7 @@
 pub mod compensation;
 pub mod error;
 pub mod evaluation;
+pub mod experiment;
 pub mod frame;
 pub mod identification;
 pub mod io;
