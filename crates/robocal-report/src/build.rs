@@ -148,11 +148,36 @@ pub fn before_after_histogram(
     ]
 }
 
+/// Where a parameter goes in a table by joint: `(joint, kind)` for `alpha`, `d`, `a`, `phi`,
+/// `beta` of a joint (in that order), then the base and the tool frame's x, y, z, A, B, C.
+fn display_order(name: &str) -> (usize, usize) {
+    const AXES: [&str; 6] = ["x", "y", "z", "a", "b", "c"];
+    let axis = |rest: &str| AXES.iter().position(|a| *a == rest).unwrap_or(AXES.len());
+    if let Some(rest) = name.strip_prefix("base_") {
+        return (usize::MAX - 1, axis(rest));
+    }
+    if let Some(rest) = name.strip_prefix("tool_") {
+        return (usize::MAX, axis(rest));
+    }
+    let digits = name.trim_start_matches(|c: char| !c.is_ascii_digit());
+    let kind = &name[..name.len() - digits.len()];
+    match (
+        digits.parse::<usize>(),
+        ["alpha", "d", "a", "phi", "beta"]
+            .iter()
+            .position(|k| *k == kind),
+    ) {
+        (Ok(j), Some(k)) => (j, k),
+        _ => (usize::MAX - 2, 0),
+    }
+}
+
 impl ReportData {
-    /// A report skeleton from a result file: parameters, error tables, robot and tracker frame.
-    /// Per-point errors, identifiability and solver details are the caller's to add.
+    /// A report skeleton from a result file: parameters, error tables, robot and tracker frame,
+    /// and, when the file has the keys `robocal calibrate` writes, identifiability, solver and
+    /// run settings. Per-point errors are the caller's to add (see [`ReportData::from_run`]).
     pub fn from_result(result: &CalibrationResult) -> ReportData {
-        let parameters: Vec<ParamRow> = result
+        let mut parameters: Vec<ParamRow> = result
             .parameters
             .iter()
             .map(|(name, p)| ParamRow {
@@ -163,10 +188,14 @@ impl ReportData {
                 std: p.std,
                 fixed: p.fixed,
                 reason: p.reason.clone(),
+                truth: None,
             })
             .collect();
+        // By joint, then base and tool, as in the paper's Tables I and III (the result lists
+        // them by kind: alpha1..n, d1..n, ...).
+        parameters.sort_by_key(|p| display_order(&p.name));
         let t = &result.tracker_frame;
-        let settings = vec![
+        let mut settings = vec![
             Setting::new("Robot", &result.robot.name),
             Setting::new(
                 "Model",
@@ -177,13 +206,14 @@ impl ReportData {
                 ),
             ),
             Setting::new(
-                "Tracker frame in base (x, y, z mm; A, B, C deg)",
+                "Measurement frame: tracker in the base frame, fitted (x, y, z mm; A, B, C deg)",
                 format!(
                     "{:.3}, {:.3}, {:.3}; {:.4}, {:.4}, {:.4}",
                     t.x, t.y, t.z, t.a, t.b, t.c
                 ),
             ),
         ];
+        settings.extend(crate::result_details::settings(result));
         let mut notes = Vec::new();
         if result.errors.validation.is_none() {
             notes.push(Note::info(
@@ -200,6 +230,8 @@ impl ReportData {
                 false,
             ),
             parameters,
+            identifiability: crate::result_details::identifiability(result),
+            solver: crate::result_details::solver(result),
             notes,
             ..ReportData::default()
         }
@@ -232,6 +264,22 @@ mod tests {
         assert_eq!(h[0].values_mm, vec![1.0, 2.0]);
         assert_eq!(h[1].values_mm, vec![0.3]);
         assert!(h[1].label.contains("verification points"), "{}", h[1].label);
+    }
+
+    #[test]
+    fn parameters_by_joint_then_base_and_tool() {
+        let mut names = vec![
+            "tool_x", "alpha1", "alpha2", "d1", "d2", "a1", "a2", "phi1", "phi2", "base_c",
+            "base_x", "beta2", "tool_a",
+        ];
+        names.sort_by_key(|n| display_order(n));
+        assert_eq!(
+            names,
+            vec![
+                "alpha1", "d1", "a1", "phi1", "alpha2", "d2", "a2", "phi2", "beta2", "base_x",
+                "base_c", "tool_x", "tool_a"
+            ]
+        );
     }
 
     #[test]

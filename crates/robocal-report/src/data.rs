@@ -224,6 +224,11 @@ pub struct ParamRow {
     /// Why it was fixed.
     #[serde(default)]
     pub reason: Option<String>,
+    /// The true value, where it is known (a simulation), in the same parameterization as the
+    /// calibration (see `robocal_core::experiment::TruthComparison`): shown in a column of its
+    /// own beside the calibrated value.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth: Option<f64>,
 }
 
 impl ParamRow {
@@ -372,6 +377,7 @@ mod tests {
             std: None,
             fixed: false,
             reason: None,
+            truth: None,
         };
         assert!((p.difference() - 0.01).abs() < 1e-9, "{}", p.difference());
         let q = ParamRow {

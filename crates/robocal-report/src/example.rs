@@ -136,6 +136,7 @@ impl ReportData {
                     std: reason.is_none().then(|| scale * 0.02 * (0.5 + rng.next())),
                     fixed: reason.is_some(),
                     reason: reason.map(str::to_owned),
+                    truth: None,
                     name,
                     unit,
                     nominal,

@@ -34,12 +34,15 @@
 pub mod bins;
 mod build;
 pub mod data;
+mod demo;
 pub mod escape;
 mod example;
 pub mod histogram;
 mod html;
 mod numfmt;
 mod plot;
+mod result_details;
+pub mod run;
 pub mod scatter;
 mod serde_nan;
 mod tables;
@@ -51,6 +54,7 @@ pub use data::{
     SolverSummary,
 };
 pub use histogram::{histogram_svg, HistogramFigure};
+pub use run::RunData;
 pub use scatter::{scatter_svg, ScatterFigure};
 
 use robocal_core::{Error, Result};
@@ -84,7 +88,11 @@ pub struct ReportFiles {
 /// Renders the report without writing anything.
 pub fn render(data: &ReportData) -> Result<Rendered> {
     let hist = histogram_svg(&data.histogram, HISTOGRAM_TITLE)?;
-    let has_points = data.point_sets.iter().any(|s| !s.points.is_empty());
+    // The reach plot needs points with a reach (a report from a result file alone has none).
+    let has_points = data
+        .point_sets
+        .iter()
+        .any(|s| s.points.iter().any(|p| p.reach_mm.is_finite()));
     let scatter = if has_points {
         Some(scatter_svg(&data.point_sets, data.reach)?)
     } else {

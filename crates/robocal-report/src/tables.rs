@@ -131,14 +131,32 @@ pub fn parameters_section(h: &mut String, data: &ReportData) {
         return;
     }
     let identified = data.parameters.iter().filter(|p| !p.fixed).count();
-    let _ = writeln!(
+    let with_truth = data.parameters.iter().any(|p| p.truth.is_some());
+    let _ = write!(
         h,
         "<p class=\"lead\">{identified} of {} parameters identified; the others were held at \
          their nominal values. Lengths in mm, angles in degrees; difference = calibrated − \
-         nominal; std. dev. from the covariance of the fit.</p>",
+         nominal; std. dev. from the covariance of the fit.",
         data.parameters.len()
     );
-    h.push_str("<div class=\"params-layout\">\n<div>\n<table class=\"params\">\n<thead><tr><th>Parameter</th><th>Unit</th><th class=\"num\">Nominal</th><th class=\"num\">Calibrated</th><th class=\"num\">Difference</th><th class=\"num\">Std. dev.</th></tr></thead>\n<tbody>\n");
+    if with_truth {
+        h.push_str(
+            " True: the simulated robot’s values in the same parameters (what a calibration \
+             from exact measurements would find); cal. − true is the calibration’s error.",
+        );
+    }
+    h.push_str("</p>\n");
+    let columns = if with_truth { 8 } else { 6 };
+    let layout = if with_truth {
+        "params-layout wide"
+    } else {
+        "params-layout"
+    };
+    let _ = write!(h, "<div class=\"{layout}\">\n<div>\n<table class=\"params\">\n<thead><tr><th>Parameter</th><th>Unit</th><th class=\"num\">Nominal</th><th class=\"num\">Calibrated</th><th class=\"num\">Difference</th><th class=\"num\">Std. dev.</th>");
+    if with_truth {
+        h.push_str("<th class=\"num\">True</th><th class=\"num\">Cal. − true</th>");
+    }
+    h.push_str("</tr></thead>\n<tbody>\n");
     let groups: Vec<String> = data
         .parameters
         .iter()
@@ -149,11 +167,11 @@ pub fn parameters_section(h: &mut String, data: &ReportData) {
         if grouped && (i == 0 || groups[i] != groups[i - 1]) {
             let _ = writeln!(
                 h,
-                "<tr class=\"group\"><th colspan=\"6\">{}</th></tr>",
+                "<tr class=\"group\"><th colspan=\"{columns}\">{}</th></tr>",
                 esc(&groups[i])
             );
         }
-        param_row(h, p);
+        param_row(h, p, with_truth);
     }
     h.push_str("</tbody>\n</table>\n</div>\n<div>\n<h3>Fixed parameters</h3>\n");
     let fixed = fixed_list(data);
@@ -190,7 +208,7 @@ fn param_group(name: &str) -> String {
     }
 }
 
-fn param_row(h: &mut String, p: &ParamRow) {
+fn param_row(h: &mut String, p: &ParamRow, with_truth: bool) {
     let d = PARAM_DECIMALS;
     let (class, std) = if p.fixed {
         (
@@ -205,15 +223,43 @@ fn param_row(h: &mut String, p: &ParamRow) {
     } else {
         signed(p.difference(), d)
     };
-    let _ = writeln!(
+    let _ = write!(
         h,
         "<tr{class}><td class=\"code\">{}</td><td>{}</td><td class=\"num\">{}</td>\
-         <td class=\"num\">{}</td><td class=\"num\">{diff}</td><td class=\"num\">{std}</td></tr>",
+         <td class=\"num\">{}</td><td class=\"num\">{diff}</td><td class=\"num\">{std}</td>",
         esc(&p.name),
         unit_str(p.unit),
         fixed(p.nominal, d),
         fixed(p.calibrated, d),
     );
+    if with_truth {
+        match p.truth {
+            Some(t) => {
+                let err = ParamRow {
+                    nominal: t,
+                    ..p.clone()
+                }
+                .difference();
+                let err = if p.fixed && err == 0.0 {
+                    DASH.to_string()
+                } else {
+                    signed(err, d)
+                };
+                let _ = write!(
+                    h,
+                    "<td class=\"num\">{}</td><td class=\"num\">{err}</td>",
+                    fixed(t, d)
+                );
+            }
+            None => {
+                let _ = write!(
+                    h,
+                    "<td class=\"num\">{DASH}</td><td class=\"num\">{DASH}</td>"
+                );
+            }
+        }
+    }
+    h.push_str("</tr>\n");
 }
 
 /// The "Run settings" section.

@@ -266,3 +266,150 @@ fn report_data_round_trips_through_json() {
     assert!(back.point_sets[2].points[0].before_mm.is_nan());
     xml_elements(&xmlish(&render(&back).unwrap().html));
 }
+
+mod runs {
+    //! Reports of real runs: the simulated paper's experiment, and a result file with and
+    //! without its measurement files.
+    use super::{xml_elements, xmlish};
+    use crate::*;
+    use robocal_core::experiment::{run_experiment, Experiment, ExperimentConfig};
+    use robocal_core::identification::{calibrate, split_measurements, CalibrationData};
+
+    fn experiment() -> Experiment {
+        run_experiment(ExperimentConfig::paper(1).unwrap(), &mut |_, _, _| {}).unwrap()
+    }
+
+    fn svg_count(html: &str) -> usize {
+        html.matches("<svg").count()
+    }
+
+    #[test]
+    fn demo_report_is_well_formed_and_shows_every_table() {
+        let e = experiment();
+        let data = ReportData::from_experiment(&e, "out").unwrap();
+        let r = render(&data).unwrap();
+        xml_elements(&xmlish(&r.html));
+        xml_elements(&r.histogram_svg);
+        assert_eq!(svg_count(&r.html), 2, "histogram and reach plot");
+        for label in [
+            "Before calibration (Table II)",
+            "After calibration, predicted (Table IV)",
+            "Verification, measured after compensation (Table V)",
+            "Paper: Samak et al. 2019, Table II",
+            "Paper: Samak et al. 2019, Table V",
+            "Fixed parameters",
+            "same effect as base_z",
+            "Cal. − true",
+            "Condition number",
+            "Gravity deflection",
+            "After calibration, measured – verification points",
+        ] {
+            assert!(r.html.contains(label), "missing {label:?}");
+        }
+        // Our figures, as the tables print them.
+        for s in [
+            e.before(),
+            e.predicted(),
+            e.verified(),
+            e.result.errors.validation.unwrap().after,
+        ] {
+            assert!(r.html.contains(&format!("{:.3}", s.mean_mm)), "{s:?}");
+        }
+        // Every parameter once, in joint order, each with its true value.
+        assert_eq!(data.parameters.len(), 36);
+        assert!(data.parameters.iter().all(|p| p.truth.is_some()));
+        let names: Vec<&str> = data.parameters.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(&names[..5], ["alpha1", "d1", "a1", "phi1", "alpha2"]);
+        // Point sets: 75 calibration, 73 validation, 75 verification, all with a reach.
+        let sizes: Vec<(String, usize)> = data
+            .point_sets
+            .iter()
+            .map(|s| (s.name.clone(), s.points.len()))
+            .collect();
+        assert_eq!(
+            sizes,
+            [
+                ("Calibration".into(), 75),
+                ("Validation".into(), 73),
+                ("Verification".into(), 75)
+            ]
+        );
+        for s in &data.point_sets {
+            assert!(s
+                .points
+                .iter()
+                .all(|p| p.reach_mm > 500.0 && p.after_mm.is_finite()));
+        }
+        // The per-point errors are the result's: the same statistics.
+        let after: Vec<f64> = data.point_sets[0]
+            .points
+            .iter()
+            .map(|p| p.after_mm)
+            .collect();
+        let s = robocal_core::ErrorStats::from_norms(&after);
+        assert!((s.mean_mm - e.predicted().mean_mm).abs() < 1e-9);
+    }
+
+    #[test]
+    fn result_alone_gives_tables_and_histogram_but_no_reach_plot() {
+        let e = experiment();
+        let data = ReportData::from_run(&RunData {
+            result: &e.result,
+            nominal: &e.config.nominal,
+            calibrated: &e.calibrated,
+            calibration: None,
+            validation: None,
+            verification: None,
+            with_paper: false,
+        })
+        .unwrap();
+        let r = render(&data).unwrap();
+        xml_elements(&xmlish(&r.html));
+        assert_eq!(svg_count(&r.html), 1, "histogram only");
+        assert_eq!(data.histogram[0].values_mm.len(), 75);
+        assert!(r.html.contains("cannot place the points"));
+        assert!(!r.html.contains("Paper: Samak"));
+        assert!(data.identifiability.as_ref().unwrap().fixed.len() == 10);
+        assert_eq!(data.solver.as_ref().unwrap().iterations, Some(12));
+    }
+
+    #[test]
+    fn validation_statistics_are_computed_when_the_result_has_none() {
+        let e = experiment();
+        let split = split_measurements(&e.data).unwrap();
+        let cal = calibrate(
+            &e.config.nominal,
+            CalibrationData {
+                calibration: &split.calibration,
+                plane: Some(&split.plane),
+                validation: None,
+            },
+            &Default::default(),
+            &mut |_, _, _| {},
+        )
+        .unwrap();
+        let result = cal.to_result(Default::default());
+        assert!(result.errors.validation.is_none());
+        let data = ReportData::from_run(&RunData {
+            result: &result,
+            nominal: &e.config.nominal,
+            calibrated: &cal.calibrated,
+            calibration: Some(&e.data),
+            validation: Some(&e.validation),
+            verification: None,
+            with_paper: false,
+        })
+        .unwrap();
+        let table2 = &data.error_tables[0];
+        assert_eq!(table2.rows.len(), 2);
+        // The same calibration as the experiment's: the same validation figures.
+        let want = e.result.errors.validation.unwrap();
+        assert!((table2.rows[1].stats.mean_mm - want.before.mean_mm).abs() < 1e-9);
+        assert!((data.error_tables[1].rows[1].stats.mean_mm - want.after.mean_mm).abs() < 1e-9);
+        assert!(data.notes.iter().any(|n| n.text.contains("computed here")));
+        assert!(!data
+            .notes
+            .iter()
+            .any(|n| n.text.starts_with("No validation set")));
+    }
+}

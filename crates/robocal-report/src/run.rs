@@ -1,0 +1,244 @@
+//! A report of one calibration run: the result file plus, when available, the measured data the
+//! per-point figures need (what `robocal report` and `robocal demo` show).
+
+use crate::build::{before_after_histogram, paper_tables};
+use crate::data::{HistogramSeries, Note, PointError, PointSet, ReachKind, ReportData};
+use robocal_core::evaluation::{evaluate, Against, Evaluation};
+use robocal_core::io::result::BeforeAfter;
+use robocal_core::io::{CalibrationResult, Measurement, MeasurementSet};
+use robocal_core::simulation::{SET_PLANE, SET_VALIDATION};
+use robocal_core::{ErrorStats, Result, Robot};
+use serde_json::Value;
+
+/// Name of the calibration point set.
+pub const CALIBRATION: &str = "Calibration";
+/// Name of the validation point set.
+pub const VALIDATION: &str = "Validation";
+/// Name of the verification point set.
+pub const VERIFICATION: &str = "Verification";
+
+/// A calibration run: the result and, each optional, the measured data.
+#[derive(Debug, Clone, Copy)]
+pub struct RunData<'a> {
+    /// The result file's content.
+    pub result: &'a CalibrationResult,
+    /// The nominal robot the result belongs to.
+    pub nominal: &'a Robot,
+    /// Its calibrated model (from the result).
+    pub calibrated: &'a Robot,
+    /// The calibration data file: rows with `set` = `plane` are skipped, rows with `set` =
+    /// `validation` are validation points, the others calibration points.
+    pub calibration: Option<&'a MeasurementSet>,
+    /// Validation measurements (every row except plane points).
+    pub validation: Option<&'a MeasurementSet>,
+    /// Measurements of compensated poses carrying their desired positions (the columns
+    /// `robocal compensate` writes): the verification (Table V).
+    pub verification: Option<&'a MeasurementSet>,
+    /// Show the paper's figures beside the error tables (for the paper's experiment).
+    pub with_paper: bool,
+}
+
+/// What the per-point errors of a data set are.
+struct Evaluated {
+    points: Vec<PointError>,
+    stats: [ErrorStats; 2],
+}
+
+/// The rows of `set` whose `set` column is (or is not) one of `labels`.
+fn rows_where(set: &MeasurementSet, labels: &[&str], keep: bool) -> MeasurementSet {
+    let col = set
+        .extra_columns
+        .iter()
+        .position(|c| c.eq_ignore_ascii_case("set"));
+    let is = |r: &Measurement| {
+        col.is_some_and(|k| {
+            let v = r.extra[k].trim().to_ascii_lowercase();
+            labels.iter().any(|l| *l == v) || (labels.contains(&SET_VALIDATION) && v == "val")
+        })
+    };
+    MeasurementSet {
+        rows: set.rows.iter().filter(|r| is(r) == keep).cloned().collect(),
+        ..set.clone()
+    }
+}
+
+fn reach_of(v: nalgebra::Vector3<f64>) -> f64 {
+    ReachKind::Radial.of([v.x, v.y, v.z])
+}
+
+/// Per-point errors of `set` against the models (validation) or the desired positions
+/// (verification: `before` is not available and left NaN).
+fn evaluated(run: &RunData, set: &MeasurementSet, against: Against) -> Result<Evaluated> {
+    let frame = run.result.tracker_frame();
+    let ev: Evaluation = evaluate(run.nominal, run.calibrated, &frame, set, against)?;
+    let desired = against == Against::Desired;
+    let points = set
+        .rows
+        .iter()
+        .enumerate()
+        .map(|(k, r)| {
+            let measured = (frame * nalgebra::Point3::from(r.p.unwrap_or_default())).coords;
+            let (reach, before, after) = if desired {
+                // The desired position is the measured point minus its error.
+                let e = ev.series[0].errors[k];
+                (reach_of(measured - e), f64::NAN, e.norm())
+            } else {
+                (
+                    reach_of(run.nominal.tool_position(&r.q)),
+                    ev.series[0].errors[k].norm(),
+                    ev.series[1].errors[k].norm(),
+                )
+            };
+            PointError {
+                reach_mm: reach,
+                before_mm: before,
+                after_mm: after,
+            }
+        })
+        .collect();
+    Ok(Evaluated {
+        points,
+        stats: [ev.series[0].stats, ev.series[1].stats],
+    })
+}
+
+/// The per-point errors the result file itself lists (`points.<set>`, written by `robocal
+/// calibrate`), without reach.
+fn result_points(result: &CalibrationResult, key: &str) -> Option<Vec<PointError>> {
+    let list = result.extra.get("points")?.get(key)?.as_array()?;
+    let num = |v: &Value, k: &str| v.get(k).and_then(Value::as_f64).unwrap_or(f64::NAN);
+    Some(
+        list.iter()
+            .map(|p| PointError {
+                reach_mm: f64::NAN,
+                before_mm: num(p, "before_mm"),
+                after_mm: num(p, "after_mm"),
+            })
+            .collect(),
+    )
+}
+
+impl ReportData {
+    /// The report of a calibration run: [`ReportData::from_result`], plus per-point errors of
+    /// the measured data (error against reach, histogram), the validation statistics when the
+    /// result has none and validation data are given, and the verification (Table V). Without
+    /// data, the per-point errors the result lists are used for the histogram (the reach plot
+    /// needs the joint values).
+    pub fn from_run(run: &RunData) -> Result<ReportData> {
+        let result = run.result;
+        let mut data = ReportData::from_result(result);
+        let mut sets = Vec::new();
+
+        // Calibration (and validation rows of the calibration file).
+        let mut validation_rows: Option<MeasurementSet> = None;
+        match run.calibration {
+            Some(set) => {
+                let cal = rows_where(set, &[SET_PLANE, SET_VALIDATION], false);
+                let e = evaluated(run, &cal, Against::Model)?;
+                sets.push(PointSet {
+                    name: CALIBRATION.into(),
+                    points: e.points,
+                });
+                let val = rows_where(set, &[SET_VALIDATION], true);
+                if !val.rows.is_empty() {
+                    validation_rows = Some(val);
+                }
+            }
+            None => {
+                if let Some(points) = result_points(result, "calibration") {
+                    sets.push(PointSet {
+                        name: CALIBRATION.into(),
+                        points,
+                    });
+                }
+            }
+        }
+
+        // Validation: the rows of the calibration file, then the validation file.
+        if let Some(v) = run.validation {
+            let v = rows_where(v, &[SET_PLANE], false);
+            validation_rows = Some(match validation_rows {
+                Some(mut a) => {
+                    a.rows.extend(v.rows);
+                    a
+                }
+                None => v,
+            });
+        }
+        let mut validation_stats = result.errors.validation;
+        match &validation_rows {
+            Some(v) => {
+                let e = evaluated(run, v, Against::Model)?;
+                if validation_stats.is_none() {
+                    validation_stats = Some(BeforeAfter {
+                        before: e.stats[0],
+                        after: e.stats[1],
+                    });
+                    data.notes
+                        .retain(|n| !n.text.starts_with("No validation set"));
+                    data.notes.push(Note::info(format!(
+                        "The validation statistics are computed here from {} ({} points) with \
+                         the result's tracker frame; the result file has none.",
+                        v.path.display(),
+                        v.rows.len()
+                    )));
+                }
+                sets.push(PointSet {
+                    name: VALIDATION.into(),
+                    points: e.points,
+                });
+            }
+            None => {
+                if let Some(points) = result_points(result, "validation") {
+                    sets.push(PointSet {
+                        name: VALIDATION.into(),
+                        points,
+                    });
+                }
+            }
+        }
+
+        // Verification (Table V).
+        let mut verification = None;
+        if let Some(v) = run.verification {
+            let e = evaluated(run, v, Against::Desired)?;
+            verification = Some(e.stats[0]);
+            sets.push(PointSet {
+                name: VERIFICATION.into(),
+                points: e.points,
+            });
+        }
+
+        data.error_tables = paper_tables(
+            result.errors.calibration,
+            validation_stats,
+            verification,
+            run.with_paper,
+        );
+        let mut histogram = before_after_histogram(&sets, &[CALIBRATION], &[CALIBRATION]);
+        if let Some(v) = sets.iter().find(|s| s.name == VERIFICATION) {
+            histogram[1].label = "After calibration, predicted – calibration points".into();
+            histogram.push(HistogramSeries::new(
+                "After calibration, measured – verification points",
+                v.points.iter().map(|p| p.after_mm).collect(),
+            ));
+        }
+        if histogram.iter().all(|h| h.values_mm.is_empty()) {
+            // No per-point errors at all: leave the figure empty rather than invent values.
+            histogram.clear();
+        }
+        data.histogram = histogram;
+        if sets
+            .iter()
+            .any(|s| s.points.iter().any(|p| p.reach_mm.is_nan()))
+        {
+            data.notes.push(Note::info(
+                "Without the measurement files the error-against-reach plot cannot place the \
+                 points: give the calibration data (and --validate) to see it.",
+            ));
+        }
+        data.point_sets = sets;
+        data.reach = ReachKind::Radial;
+        Ok(data)
+    }
+}
