@@ -3,8 +3,11 @@
 mod calibrate;
 mod common;
 mod compensate;
+mod demo;
 mod evaluate;
 mod fk;
+mod paper_tables;
+mod report;
 mod robot;
 mod simulate;
 
@@ -36,6 +39,11 @@ enum Command {
     Evaluate(evaluate::EvaluateArgs),
     /// Commanded joints that make the real robot reach the nominal positions (compensation).
     Compensate(compensate::CompensateArgs),
+    /// The paper's whole experiment in simulation: its tables beside the paper's, a report, and
+    /// the files of every step.
+    Demo(demo::DemoArgs),
+    /// The HTML report of a calibration result (tables, histogram, per-point errors, parameters).
+    Report(report::ReportArgs),
 }
 
 /// Runs a parsed command line.
@@ -47,5 +55,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Calibrate(a) => calibrate::run(a),
         Command::Evaluate(a) => evaluate::run(a),
         Command::Compensate(a) => compensate::run(a),
+        Command::Demo(a) => demo::run(a),
+        Command::Report(a) => report::run(a),
     }
 }

@@ -1,0 +1,428 @@
+//! `robocal demo`: the paper's whole experiment in simulation, with its tables beside the
+//! paper's, a report, and the files of every step.
+
+use super::paper_tables::{error_table, parameter_table, percent, Column};
+use anyhow::Context;
+use clap::Args;
+use robocal_core::compensation::IkStatus;
+use robocal_core::experiment::{
+    files, run_experiment, Experiment, ExperimentConfig, Phase, PAPER_NOMINAL, PAPER_TRUTH,
+};
+use robocal_core::io::write_all_atomic;
+use robocal_core::registration::InitialFrame;
+use robocal_core::ErrorStats;
+use robocal_report::{paper, ReportData, HISTOGRAM_FILE, HTML_FILE};
+use std::path::{Path, PathBuf};
+
+#[derive(Args, Debug)]
+pub struct DemoArgs {
+    /// Seed of the simulation (poses and tracker noise; the verification uses SEED + 1). The same
+    /// seed gives the same files.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Directory for the report and the files of every step (created if needed; files of the
+    /// same names in it are replaced).
+    #[arg(long, default_value = "robocal-report")]
+    out: PathBuf,
+}
+
+/// A path as the user would type it in a POSIX shell (quoted when needed).
+fn sh(p: &Path) -> String {
+    let s = p.display().to_string();
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_./-+:@%,".contains(c))
+    {
+        s
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// Numbers as `a,b,c` in the shortest form that reads back exactly (small ones as `1e-8`).
+fn list(v: &[f64]) -> String {
+    v.iter()
+        .map(|x| {
+            if *x != 0.0 && x.abs() < 1e-3 {
+                format!("{x:e}")
+            } else {
+                format!("{x}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+pub fn run(a: DemoArgs) -> anyhow::Result<()> {
+    let dir = &a.out;
+    if dir.exists() && !dir.is_dir() {
+        return Err(robocal_core::Error::Io {
+            path: dir.clone(),
+            source: std::io::Error::other("exists and is not a directory"),
+        }
+        .into());
+    }
+    let path = |name: &str| dir.join(name);
+    let mut cfg = ExperimentConfig::paper(a.seed)?;
+    // Record the files as `robocal calibrate` run by hand on them would.
+    cfg.result_settings.insert(
+        "data".into(),
+        path(files::CELL).display().to_string().into(),
+    );
+    cfg.result_settings.insert(
+        "validate".into(),
+        path(files::VALIDATION).display().to_string().into(),
+    );
+
+    let steps = Phase::ALL.len() as u64 + 1;
+    let bar = crate::progress::bar(steps, "demo");
+    let exp = run_experiment(cfg, &mut |phase, _, _| {
+        let k = Phase::ALL.iter().position(|p| *p == phase).unwrap_or(0);
+        bar.set_position(k as u64);
+        bar.set_message(phase.describe());
+    })
+    .context("running the experiment")?;
+    bar.set_position(steps - 1);
+    bar.set_message("writing the report");
+    let report = ReportData::from_experiment(&exp, &dir.display().to_string())?;
+    let rendered = robocal_report::render(&report)?;
+    std::fs::create_dir_all(dir).map_err(|e| robocal_core::Error::Io {
+        path: dir.clone(),
+        source: e,
+    })?;
+    let mut writes: Vec<(PathBuf, &[u8])> = exp
+        .files()
+        .iter()
+        .map(|(name, bytes)| (path(name), bytes.as_slice()))
+        .collect();
+    writes.push((path(HTML_FILE), rendered.html.as_bytes()));
+    writes.push((path(HISTOGRAM_FILE), rendered.histogram_svg.as_bytes()));
+    let refs: Vec<(&Path, &[u8])> = writes.iter().map(|(p, b)| (p.as_path(), *b)).collect();
+    write_all_atomic(&refs)?;
+    bar.finish_and_clear();
+
+    print_run(&exp);
+    print_files(&exp, dir);
+    println!("report: {}", path(HTML_FILE).display());
+    Ok(())
+}
+
+/// Prints `text` wrapped at 100 columns.
+fn para(text: &str) {
+    let mut line = String::new();
+    for w in text.split_whitespace() {
+        if !line.is_empty() && line.len() + 1 + w.len() > 100 {
+            println!("{line}");
+            line.clear();
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(w);
+    }
+    if !line.is_empty() {
+        println!("{line}");
+    }
+}
+
+fn print_run(exp: &Experiment) {
+    let cfg = &exp.config;
+    let s = &cfg.session;
+    let cal = &exp.calibration;
+    println!(
+        "robocal demo: the experiment of Samak et al. (2019) on a simulated KUKA KR 480 R3330, seed {}",
+        s.seed
+    );
+    println!(
+        "  nominal model  {} (Table I, tool T0 of eq. 7): what the controller believes",
+        cfg.nominal.name()
+    );
+    println!(
+        "  true robot     {} (the paper's Table III){}",
+        cfg.truth.name(),
+        if s.gravity.is_some() {
+            ", sagging under gravity:"
+        } else {
+            ""
+        }
+    );
+    if let Some(g) = &s.gravity {
+        println!(
+            "                 joint compliances {} rad/(N m),",
+            list(&g.compliance_rad_per_nm)
+        );
+        println!(
+            "                 link masses {} kg, payload {} kg{}",
+            list(&g.link_masses_kg),
+            g.payload_kg,
+            if exp.session.deflection_mm.is_some() {
+                ":"
+            } else {
+                ""
+            }
+        );
+        if let Some(d) = &exp.session.deflection_mm {
+            let st = ErrorStats::from_norms(d);
+            println!(
+                "                 the tool sags {:.3} mm on average, {:.3} mm at most",
+                st.mean_mm, st.max_mm
+            );
+        }
+    }
+    let t = &s.tracker_frame;
+    println!(
+        "  laser tracker  at x {} y {} z {} mm, A {} B {} C {} deg;",
+        t.x, t.y, t.z, t.a, t.b, t.c
+    );
+    println!(
+        "                 noise {:.3} mm + {:.3} mm/m per axis (1 sigma)",
+        s.noise_mm, s.noise_per_m
+    );
+    println!(
+        "  points         {} plane + {} calibration + {} validation",
+        if s.plane_points { 3 } else { 0 },
+        s.poses,
+        s.validation_poses
+    );
+    println!();
+    match cal.registration.initial {
+        InitialFrame::Plane { n, tilt_deg, .. } => para(&format!(
+            "Measurement frame: initial from the {n} plane points (plane tilt {tilt_deg:.3} deg), \
+             then fitted to the {} calibration points (sum of norms, eq. 11).",
+            cal.calibration.before.len()
+        )),
+        InitialFrame::LeastSquares => para(&format!(
+            "Measurement frame: least-squares fit to the {} calibration points, refined (eq. 11).",
+            cal.calibration.before.len()
+        )),
+    }
+    println!();
+    let e = &exp.result.errors;
+    let mut cols = vec![Column {
+        label: "Calibration points",
+        ours: e.calibration.before,
+        paper: paper::table2_calibration(),
+    }];
+    if let Some(v) = &e.validation {
+        cols.push(Column {
+            label: "Validation points",
+            ours: v.before,
+            paper: paper::table2_validation(),
+        });
+    }
+    print!(
+        "{}",
+        error_table(
+            "Table II. Error before calibration (nominal model, fitted measurement frame)",
+            &cols
+        )
+    );
+    println!();
+    let id = &cal.identifiability;
+    let solver = cal.solver();
+    para(&format!(
+        "Identification (eq. 4, {}): {} parameters, condition number {:.0}; the solver {} after \
+         {} iterations.",
+        cal.settings.objective.name(),
+        id.identified.len(),
+        id.condition_number,
+        solver.termination.describe(),
+        cal.stages
+            .iter()
+            .map(|s| s.report.iterations)
+            .sum::<usize>()
+    ));
+    println!();
+    print!("{}", parameter_table(exp));
+    println!();
+    let mut cols = vec![Column {
+        label: "Calibration points",
+        ours: e.calibration.after,
+        paper: paper::table4_calibration(),
+    }];
+    if let Some(v) = &e.validation {
+        cols.push(Column {
+            label: "Validation points",
+            ours: v.after,
+            paper: paper::table4_validation(),
+        });
+    }
+    print!(
+        "{}",
+        error_table(
+            "Table IV. Error after calibration, predicted (calibrated model, same measurements)",
+            &cols
+        )
+    );
+    println!();
+
+    let n = exp.compensation.len();
+    let converged = exp
+        .compensation
+        .iter()
+        .filter(|c| c.report.status == IkStatus::Converged)
+        .count();
+    let max_change = exp
+        .compensation
+        .iter()
+        .zip(&exp.desired.rows)
+        .flat_map(|(c, d)| c.commanded.iter().zip(&d.q).map(|(a, b)| (a - b).abs()))
+        .fold(0.0, f64::max)
+        .to_degrees();
+    para(&format!(
+        "Compensation (eq. 12-14): the {n} calibration poses solved on the calibrated model; \
+         {converged} of {n} converged, largest joint change {max_change:.4} deg. Verification: \
+         the commanded joints measured again in the same cell (new tracker noise, seed {}).",
+        cfg.verification_seed
+    ));
+    println!();
+    print!(
+        "{}",
+        error_table(
+            "Table V. Error after calibration, measured (compensated calibration poses)",
+            &[
+                Column {
+                    label: "Verification points",
+                    ours: exp.verified(),
+                    paper: paper::table5_verification(),
+                },
+                Column {
+                    label: "Predicted (Table IV)",
+                    ours: exp.predicted(),
+                    paper: paper::table4_calibration(),
+                },
+            ]
+        )
+    );
+    let (v, p, b) = (
+        exp.verified().mean_mm,
+        exp.predicted().mean_mm,
+        exp.before().mean_mm,
+    );
+    para(&format!(
+        "Measured {v:.3} mm against {p:.3} mm predicted ({}; the paper: 0.293 against 0.174 mm, \
+         {}), {:.1} times below the {b:.3} mm before calibration.",
+        percent(v, p),
+        percent(0.293, 0.174),
+        b / v
+    ));
+    println!();
+}
+
+fn print_files(exp: &Experiment, dir: &Path) {
+    let cfg = &exp.config;
+    let s = &cfg.session;
+    let p = |name: &str| sh(&dir.join(name));
+    println!("Files in {}:", dir.display());
+    let n_cal = exp.desired.rows.len();
+    for (names, what) in [
+        (
+            format!("{}, {}", files::CELL, files::VALIDATION),
+            "simulated tracker readings (plane + calibration; validation)".to_owned(),
+        ),
+        (
+            files::CELL_TRUTH.to_owned(),
+            "the truth: true parameters, tracker pose, settings".to_owned(),
+        ),
+        (
+            files::DESIRED.to_owned(),
+            format!("the {n_cal} calibration poses, desired poses of the verification"),
+        ),
+        (
+            files::RESULT.to_owned(),
+            "the calibration result".to_owned(),
+        ),
+        (
+            files::COMMANDED.to_owned(),
+            "compensated joints (eq. 14), desired positions".to_owned(),
+        ),
+        (
+            files::VERIFY.to_owned(),
+            "readings at the compensated joints".to_owned(),
+        ),
+        (
+            format!("{HTML_FILE}, {HISTOGRAM_FILE}"),
+            "the report, the histogram (Fig. 2)".to_owned(),
+        ),
+    ] {
+        println!("  {names:<28} {what}");
+    }
+    let mut gravity = Vec::new();
+    if let Some(g) = &s.gravity {
+        gravity.push(format!("--compliance {}", list(&g.compliance_rad_per_nm)));
+        gravity.push(format!("--link-masses-kg {}", list(&g.link_masses_kg)));
+        gravity.push(format!("--payload-kg {}", g.payload_kg));
+    }
+    let robot = format!("--robot {PAPER_NOMINAL}");
+    para(
+        "Each step by hand, giving the same files again (in the source tree, `cargo run --release \
+         --` stands for `robocal`):",
+    );
+    let mut simulate = vec![
+        "robocal simulate".to_owned(),
+        robot.clone(),
+        format!("--truth {PAPER_TRUTH}"),
+        format!("--poses {}", s.poses),
+        format!("--validation {}", s.validation_poses),
+        format!("--seed {}", s.seed),
+    ];
+    simulate.extend(gravity.iter().cloned());
+    simulate.push(format!("--out {}", p(files::CELL)));
+    simulate.push(format!("--validation-out {}", p(files::VALIDATION)));
+    command(&simulate);
+    command(&[
+        "robocal calibrate".to_owned(),
+        robot.clone(),
+        format!("--data {}", p(files::CELL)),
+        format!("--validate {}", p(files::VALIDATION)),
+        format!("--out {}", p(files::RESULT)),
+    ]);
+    command(&[
+        "robocal compensate".to_owned(),
+        robot.clone(),
+        format!("--params {}", p(files::RESULT)),
+        format!("--joints {}", p(files::DESIRED)),
+        format!("--out {}", p(files::COMMANDED)),
+    ]);
+    let mut verify = vec![
+        "robocal simulate".to_owned(),
+        robot.clone(),
+        format!("--truth {}", p(files::CELL_TRUTH)),
+        format!("--joints {}", p(files::COMMANDED)),
+        format!("--seed {}", cfg.verification_seed),
+    ];
+    verify.extend(gravity.iter().cloned());
+    verify.push(format!("--out {}", p(files::VERIFY)));
+    command(&verify);
+    command(&[
+        "robocal evaluate".to_owned(),
+        robot,
+        format!("--params {}", p(files::RESULT)),
+        format!("--data {}", p(files::VERIFY)),
+    ]);
+    command(&[
+        "robocal report".to_owned(),
+        p(files::RESULT),
+        format!("--verify {}", p(files::VERIFY)),
+        "--paper".to_owned(),
+        format!("--out {}", p("by-hand")),
+    ]);
+}
+
+/// Prints a shell command made of `parts`, continued with `\` on new lines before 100 columns.
+fn command(parts: &[String]) {
+    let mut line = String::from("  ");
+    let mut out = String::new();
+    for (i, part) in parts.iter().enumerate() {
+        if i > 0 && line.len() + 1 + part.len() + 2 > 100 {
+            out.push_str(&line);
+            out.push_str(" \\\n");
+            line = String::from("      ");
+        } else if i > 0 {
+            line.push(' ');
+        }
+        line.push_str(part);
+    }
+    out.push_str(&line);
+    println!("{out}");
+}

@@ -1,0 +1,169 @@
+//! `robocal report`: the HTML report of any calibration result, with the per-point errors of its
+//! measurement files when they are at hand.
+
+use super::evaluate::calibrated_model;
+use crate::exit;
+use anyhow::Context;
+use clap::Args;
+use robocal_core::io::{read_measurements, CalibrationResult, MeasurementSet, Positions};
+use robocal_report::{write_report, ReportData, RunData};
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct ReportArgs {
+    /// The calibration result (`robocal calibrate --out`).
+    #[arg(value_name = "RESULT.json")]
+    result: PathBuf,
+    /// The nominal robot (preset or TOML file) [default: the `--robot` recorded in the result].
+    #[arg(long)]
+    robot: Option<String>,
+    /// The calibration measurements, for each point's error against its reach [default: the
+    /// `--data` file recorded in the result, if it is still there].
+    #[arg(long, value_name = "CAL.csv")]
+    data: Option<PathBuf>,
+    /// Validation measurements [default: the `--validate` file recorded in the result, if it is
+    /// still there]. Gives the validation statistics if the result has none.
+    #[arg(long, value_name = "VAL.csv")]
+    validate: Option<PathBuf>,
+    /// Measurements of compensated poses (`robocal compensate` output measured again): the
+    /// verification, the paper's Table V.
+    #[arg(long, value_name = "VERIFY.csv")]
+    verify: Option<PathBuf>,
+    /// Show the paper's figures (Samak et al. 2019, KR 480 R3330) beside the error tables.
+    #[arg(long)]
+    paper: bool,
+    /// Directory for report.html and histogram.svg (created if needed).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// A string setting recorded in the result by `robocal calibrate`.
+fn recorded<'a>(result: &'a CalibrationResult, key: &str) -> Option<&'a str> {
+    result.extra.get("settings")?.get(key)?.as_str()
+}
+
+/// The file given, or the one the result recorded if it still exists (with a note if not).
+fn file_arg(
+    given: &Option<PathBuf>,
+    result: &CalibrationResult,
+    key: &str,
+    flag: &str,
+) -> Option<PathBuf> {
+    if let Some(p) = given {
+        return Some(p.clone());
+    }
+    let p = PathBuf::from(recorded(result, key)?);
+    if p.is_file() {
+        Some(p)
+    } else {
+        eprintln!(
+            "note: the result names {} as its {flag} file, which is not here; give {flag} FILE \
+             to show its points",
+            p.display()
+        );
+        None
+    }
+}
+
+fn read(path: &Option<PathBuf>, dof: usize, flag: &str) -> anyhow::Result<Option<MeasurementSet>> {
+    let Some(p) = path else {
+        return Ok(None);
+    };
+    let set = read_measurements(p, dof, Positions::Required)
+        .with_context(|| format!("{flag} {}", p.display()))?;
+    for w in &set.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(Some(set))
+}
+
+pub fn run(a: ReportArgs) -> anyhow::Result<()> {
+    let result = CalibrationResult::read(&a.result)?;
+    let robot = match (&a.robot, recorded(&result, "robot_arg")) {
+        (Some(r), _) => r.clone(),
+        (None, Some(r)) => r.to_owned(),
+        (None, None) => {
+            return Err(exit::usage(format!(
+                "{} does not record its robot: give --robot NAME|FILE",
+                a.result.display()
+            )))
+        }
+    };
+    let (nominal, calibrated, result) = calibrated_model(&robot, &a.result).with_context(|| {
+        if a.robot.is_none() {
+            format!("the robot `{robot}` recorded in the result (give --robot to choose another)")
+        } else {
+            format!("--robot {robot}")
+        }
+    })?;
+    let dof = nominal.dof();
+    let data_path = file_arg(&a.data, &result, "data", "--data");
+    let val_path = file_arg(&a.validate, &result, "validate", "--validate");
+    let data = read(&data_path, dof, "--data")?;
+    let validation = read(&val_path, dof, "--validate")?;
+    let verification = read(&a.verify, dof, "--verify")?;
+    let mut report = ReportData::from_run(&RunData {
+        result: &result,
+        nominal: &nominal,
+        calibrated: &calibrated,
+        calibration: data.as_ref(),
+        validation: validation.as_ref(),
+        verification: verification.as_ref(),
+        with_paper: a.paper,
+    })?;
+    report.subtitle = Some(format!(
+        "Result {}{}{}",
+        a.result.display(),
+        data_path.as_ref().map_or(String::new(), |p| format!(
+            "; calibration data {}",
+            p.display()
+        )),
+        a.verify
+            .as_ref()
+            .map_or(String::new(), |p| format!("; verification {}", p.display()))
+    ));
+    report.settings.insert(
+        0,
+        robocal_report::Setting::new("Result file", a.result.display()),
+    );
+    if let Some(v) = &a.verify {
+        report.settings.push(robocal_report::Setting::new(
+            "Verification data",
+            v.display(),
+        ));
+    }
+    let files = write_report(&a.out, &report)?;
+    print_summary(&report);
+    println!(
+        "report: {} (histogram: {})",
+        files.html.display(),
+        files.histogram_svg.display()
+    );
+    Ok(())
+}
+
+fn print_summary(report: &ReportData) {
+    for t in &report.error_tables {
+        let rows: Vec<String> = t
+            .rows
+            .iter()
+            .map(|r| {
+                format!(
+                    "{} mean {:.3} mm (n = {})",
+                    r.label.to_lowercase(),
+                    r.stats.mean_mm,
+                    r.stats.n
+                )
+            })
+            .collect();
+        println!("{}: {}", t.title, rows.join(", "));
+    }
+    let shown: usize = report
+        .point_sets
+        .iter()
+        .map(|s| s.points.iter().filter(|p| p.reach_mm.is_finite()).count())
+        .sum();
+    if shown == 0 {
+        println!("no measurement file: the report has no error-against-reach plot");
+    }
+}
