@@ -1,6 +1,7 @@
-//! The HTML report in a real browser: headless Chromium renders a report of synthetic data to a
-//! PNG, which must show the page's text and both figures (pixels of the "before" and "after"
-//! colours). Skips, saying why, where Chromium is not installed (`.ci/run` installs it).
+//! The HTML report in a real browser: headless Chromium renders a report of synthetic data, and
+//! the report of `robocal demo` (the paper's experiment in simulation), to PNGs, which must show
+//! the page's text and both figures (pixels of the "before" and "after" colours). Skips, saying
+//! why, where Chromium is not installed (`.ci/run` installs it).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -89,6 +90,18 @@ fn decode(png_path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
 
 #[test]
 fn report_renders_in_chromium() {
+    render_and_check(&robocal_report::ReportData::synthetic_example(11));
+}
+
+#[test]
+fn demo_report_renders_in_chromium() {
+    use robocal_core::experiment::{run_experiment, ExperimentConfig};
+    let e = run_experiment(ExperimentConfig::paper(1).unwrap(), &mut |_, _, _| {}).unwrap();
+    render_and_check(&robocal_report::ReportData::from_experiment(&e, "robocal-report").unwrap());
+}
+
+/// Renders `data` in Chromium and checks the screenshot (or skips without Chromium).
+fn render_and_check(data: &robocal_report::ReportData) {
     let Some(chromium) = find_chromium() else {
         eprintln!(
             "skipped: Chromium not found (/usr/bin/chromium or chromium on PATH; \
@@ -98,8 +111,7 @@ fn report_renders_in_chromium() {
     };
     let tmp = tempfile::tempdir().unwrap();
     let profile = tempfile::tempdir().unwrap();
-    let data = robocal_report::ReportData::synthetic_example(11);
-    let files = robocal_report::write_report(&tmp.path().join("report"), &data).unwrap();
+    let files = robocal_report::write_report(&tmp.path().join("report"), data).unwrap();
     let png_path = tmp.path().join("report.png");
     screenshot(
         &chromium,
