@@ -80,21 +80,29 @@ fn validation_statistics_and_per_point_file() {
 }
 
 /// The README's verification workflow with truth = Table III and tracker noise on:
-/// `compensate --joints CAL.csv --out COMMANDED.csv`, measure the commanded joints on the same
-/// virtual cell (here through the library, as `simulate --joints` does), `evaluate --data
-/// VERIFY.csv`, which compares with the desired positions the commanded file carries.
-///
-/// The result file holds the *true* model as the calibrated one (calibration is another issue's
-/// work); switch to a `calibrate` result once it exists. The checks stay: verification at least
-/// 5x below the uncompensated error, and within 20% of the calibrated model's own error on the
-/// calibration points (the paper's claim that simulation predicts verification).
+/// `calibrate --data CAL.csv`, `compensate --joints CAL.csv --out COMMANDED.csv`, measure the
+/// commanded joints on the same virtual cell (here through the library, as `simulate --joints`
+/// does), `evaluate --data VERIFY.csv`, which compares with the desired positions the commanded
+/// file carries. Checks: verification at least 5x below the uncompensated error, and within 20%
+/// of the calibrated model's own error on the calibration points (the paper's claim that
+/// simulation predicts verification).
 #[test]
 fn verification_workflow_gives_table_v() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let t = tracker(true);
-    let res = write_result(d, &t.frame);
     let cal = measured(d, "cal", 75, 2, true);
+    let res = d.join("result.json");
+    let o = robocal(&[
+        "calibrate",
+        "--robot",
+        NOMINAL,
+        "--data",
+        p(&cal),
+        "--out",
+        p(&res),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
     let before = json(&robocal(&[
         "evaluate",
         "--robot",
@@ -140,6 +148,11 @@ fn verification_workflow_gives_table_v() {
     );
     let uncompensated = before["nominal"]["mean_mm"].as_f64().unwrap();
     let predicted = before["calibrated"]["mean_mm"].as_f64().unwrap();
+    // The same prediction as the result's Table IV (evaluate uses the result's tracker frame).
+    let table4 = after["predicted"]["calibration"]["mean_mm"]
+        .as_f64()
+        .unwrap();
+    assert!((predicted - table4).abs() < 1e-9, "{predicted} vs {table4}");
     let verified = after["desired"]["mean_mm"].as_f64().unwrap();
     eprintln!(
         "uncompensated {uncompensated:.4} mm, predicted {predicted:.4}, verified {verified:.4}"
