@@ -206,9 +206,10 @@ impl ReportData {
                 ),
             ),
             Setting::new(
-                "Measurement frame: tracker in the base frame, fitted (x, y, z mm; A, B, C deg)",
+                "Tracker frame (fitted)",
                 format!(
-                    "{:.3}, {:.3}, {:.3}; {:.4}, {:.4}, {:.4}",
+                    "x {:.3}, y {:.3}, z {:.3} mm; A {:.4}, B {:.4}, C {:.4} deg (pose in the \
+                     base frame)",
                     t.x, t.y, t.z, t.a, t.b, t.c
                 ),
             ),

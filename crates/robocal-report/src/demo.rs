@@ -122,9 +122,9 @@ impl ReportData {
                 ),
             ),
             Setting::new(
-                "Tracker, true pose in the base frame",
+                "Tracker (true pose)",
                 format!(
-                    "x {} y {} z {} mm, A {} B {} C {} deg",
+                    "x {}, y {}, z {} mm; A {}, B {}, C {} deg",
                     t.x, t.y, t.z, t.a, t.b, t.c
                 ),
             ),
