@@ -112,7 +112,9 @@ pub struct ExperimentConfig {
     /// The inverse kinematics of the compensation.
     pub ik: DampedLeastSquares,
     /// Keys merged into the result's `settings` (the caller's file names, as `robocal
-    /// calibrate` records them).
+    /// calibrate` records them). By default the result records `robot_arg` = the nominal
+    /// robot's name (a preset name in the paper's experiment; give the file for a robot file),
+    /// `data` = `cell.csv` and `validate` = `validation.csv`.
     pub result_settings: serde_json::Map<String, serde_json::Value>,
 }
 
