@@ -59,7 +59,18 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 .replace("max_iterations", "--max-iterations"),
         )
     })?;
-    let (nominal, cal, _) = calibrated_model(&a.robot, &a.params)?;
+    let input = a.joints.as_ref().or(a.targets.as_ref());
+    let mut inputs = vec![a.params.as_path()];
+    inputs.extend(input.map(|p| p.as_path()));
+    super::common::check_output("--out", &a.out, &inputs)?;
+    let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
+    if let Some(why) = res.partial_reason() {
+        return Err(exit::input(format!(
+            "--params {}: a partial result, not a calibration ({why}); compensation refuses \
+             it: re-run calibrate with a higher --max-iterations",
+            a.params.display()
+        )));
+    }
     let dof = nominal.dof();
     let comp = Compensator::new(&nominal, &cal, solver)?;
     let (input, rows, desired, extra_columns, extra, lines) = if let Some(path) = &a.joints {

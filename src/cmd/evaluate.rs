@@ -57,7 +57,11 @@ pub(super) fn calibrated_model(
 }
 
 pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
+    if let Some(p) = &a.per_point {
+        common::check_output("--per-point", p, &[&a.data, &a.params])?;
+    }
     let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
+    common::warn_partial(&res, &a.params);
     let data = read_measurements(&a.data, nominal.dof(), Positions::Required)
         .with_context(|| format!("--data {}", a.data.display()))?;
     for w in &data.warnings {

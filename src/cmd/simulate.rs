@@ -246,6 +246,11 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
             )));
         }
     }
+    common::check_output("--out", &a.out, &[])?;
+    common::check_output("--out (truth file)", &truth_out, &[])?;
+    if let Some(v) = &a.validation_out {
+        common::check_output("--validation-out", v, &[])?;
+    }
     let nominal = common::robot(&a.robot)?;
     let (truth, truth_tracker) = truth_arg(&a, &nominal)?;
     let cfg = config(&a, &nominal, truth_tracker)?;

@@ -82,10 +82,7 @@ impl MeasurementSet {
 
 /// Reads a measurement CSV for a robot with `dof` joints.
 pub fn read_measurements(path: &Path, dof: usize, positions: Positions) -> Result<MeasurementSet> {
-    let file = std::fs::File::open(path).map_err(|e| Error::Io {
-        path: path.to_owned(),
-        source: e,
-    })?;
+    let file = crate::io::input::open_input(path)?;
     parse_measurements(std::io::BufReader::new(file), path, dof, positions)
 }
 
@@ -261,14 +258,24 @@ pub fn parse_measurements<R: Read>(
     })
 }
 
-fn csv_error(path: &Path, e: csv::Error) -> Error {
+/// A CSV reader's error as a robocal error: an I/O failure (e.g. the path is a directory) as
+/// [`Error::Io`], anything else as [`Error::Parse`] with the line.
+pub(crate) fn csv_error(path: &Path, e: csv::Error) -> Error {
     let line = e.position().map(|p| p.line() as usize);
     let msg = match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..
         } => format!("{len} fields, but the header has {expected_len}"),
         csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_owned(),
-        csv::ErrorKind::Io(io) => io.to_string(),
+        csv::ErrorKind::Io(_) => {
+            return match e.into_kind() {
+                csv::ErrorKind::Io(source) => Error::Io {
+                    path: path.to_owned(),
+                    source,
+                },
+                other => Error::parse(path, line, None, format!("{other:?}")),
+            }
+        }
         _ => e.to_string(),
     };
     Error::parse(path, line, None, msg)
