@@ -33,6 +33,7 @@ pub fn model(robot_arg: &str, params: Option<&Path>) -> anyhow::Result<Model> {
         Some(p) => {
             let res = CalibrationResult::read(p)?;
             let cal = res.calibrated_robot(&nominal, p)?;
+            robocal_core::evaluation::check_result_nominal(&res, &nominal, p)?;
             Some((cal, res))
         }
     };

@@ -180,6 +180,7 @@ impl Calibration {
             "max_iterations": s.solver.max_iterations,
             "step_tolerance_mm": s.solver.step_tolerance_mm,
             "gradient_tolerance": s.solver.gradient_tolerance,
+            "objective_tolerance": s.solver.objective_tolerance,
             "beta": (0..self.nominal.dof())
                 .filter(|&i| self.nominal.beta_enabled(i))
                 .map(|i| format!("beta{}", i + 1))

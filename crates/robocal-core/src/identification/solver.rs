@@ -25,6 +25,12 @@ pub struct SolverOptions {
     /// Converged when, for every parameter, the cosine between its (weighted) Jacobian column and
     /// the (weighted) residual vector is below this (MINPACK's gtol).
     pub gradient_tolerance: f64,
+    /// Converged when an accepted step lowers the objective by less than this fraction of it,
+    /// and the model predicted no more (MINPACK's ftol). The sum of norms creeps towards its
+    /// minimum when some points are fitted exactly (its kinks, smoothed by 1e-6 mm): without this
+    /// test the steps shrink below a micrometre but not below `step_tolerance_mm`, and the
+    /// solver would run into the iteration limit with nothing left to gain.
+    pub objective_tolerance: f64,
     /// Initial damping, relative to `diag(A)`.
     pub initial_lambda: f64,
 }
@@ -35,6 +41,7 @@ impl Default for SolverOptions {
             max_iterations: 200,
             step_tolerance_mm: 1e-9,
             gradient_tolerance: 1e-10,
+            objective_tolerance: 1e-7,
             initial_lambda: 1e-3,
         }
     }
@@ -48,6 +55,9 @@ pub enum Termination {
     ConvergedStep,
     /// The gradient vanished (relative to `gradient_tolerance`), or the fit is exact.
     ConvergedGradient,
+    /// An accepted step lowered the objective by less than `objective_tolerance` (relative), and
+    /// the model predicted no more.
+    ConvergedObjective,
     /// `max_iterations` reached before convergence.
     MaxIterations,
     /// Numerical failure (non-finite values, no descent direction); see the message.
@@ -59,7 +69,9 @@ impl Termination {
     pub fn converged(&self) -> bool {
         matches!(
             self,
-            Termination::ConvergedStep | Termination::ConvergedGradient
+            Termination::ConvergedStep
+                | Termination::ConvergedGradient
+                | Termination::ConvergedObjective
         )
     }
 
@@ -68,6 +80,9 @@ impl Termination {
         match self {
             Termination::ConvergedStep => "converged (step below tolerance)".into(),
             Termination::ConvergedGradient => "converged (gradient below tolerance)".into(),
+            Termination::ConvergedObjective => {
+                "converged (objective change below tolerance)".into()
+            }
             Termination::MaxIterations => "stopped at the iteration limit".into(),
             Termination::Failed(m) => format!("failed: {m}"),
         }
@@ -159,6 +174,7 @@ pub fn solve(
             // majorizer: reliable far from it and for exact fits).
             let mut best_step = f64::INFINITY;
             let mut accepted = false;
+            let mut small_change = false;
             for use_newton in [true, false] {
                 let model = match (use_newton, &acc.h) {
                     (true, Some(h)) => h,
@@ -181,6 +197,8 @@ pub fn solve(
                 let pred = acc.b.dot(&delta) - 0.5 * delta.dot(&(model * &delta));
                 let gain = (acc.objective - f_new) / pred;
                 if f_new.is_finite() && pred > 0.0 && gain > 1e-4 {
+                    let tol = opts.objective_tolerance * acc.objective.abs();
+                    small_change = acc.objective - f_new <= tol && pred <= tol;
                     lambda *= (1.0 - (2.0 * gain - 1.0).powi(3)).max(1.0 / 3.0);
                     accepted = true;
                     break;
@@ -193,6 +211,10 @@ pub fn solve(
                 nu = 2.0;
                 if report.last_step_mm <= opts.step_tolerance_mm {
                     report.termination = Termination::ConvergedStep;
+                    break 'outer;
+                }
+                if small_change {
+                    report.termination = Termination::ConvergedObjective;
                     break 'outer;
                 }
                 acc = problem.accumulate(robot, loss, level);

@@ -41,6 +41,33 @@ pub fn read_text(path: &Path) -> Result<String> {
     })
 }
 
+/// Deserializes JSON `text` read from `path`, naming on failure the line and the field (its path,
+/// e.g. `parameters.a2.calibrated`) of the first problem. `what` names the kind of file in the
+/// message (`not a robocal result: ...`).
+pub fn parse_json<T: serde::de::DeserializeOwned>(
+    text: &str,
+    path: &Path,
+    what: &str,
+) -> Result<T> {
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let de = &mut serde_json::Deserializer::from_str(text);
+    let value: T = serde_path_to_error::deserialize(de).map_err(|e| json_error(e, path, what))?;
+    Ok(value)
+}
+
+fn json_error(e: serde_path_to_error::Error<serde_json::Error>, path: &Path, what: &str) -> Error {
+    // The path up to the last known segment (`?` stands for a key not read yet).
+    let field = e.path().to_string();
+    let field = field.split(".?").next().unwrap_or("").trim_end_matches('?');
+    let field = (!field.is_empty() && field != ".").then(|| field.to_owned());
+    let inner = e.into_inner();
+    let line = (inner.line() > 0).then_some(inner.line());
+    let msg = inner.to_string();
+    // serde_json appends " at line L column C"; the line is reported separately.
+    let msg = msg.split(" at line ").next().unwrap_or(&msg).to_owned();
+    Error::parse(path, line, field.as_deref(), format!("not a {what}: {msg}"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -58,6 +85,17 @@ mod tests {
         assert!(matches!(e, Error::Parse { line: Some(2), .. }), "{e}");
         assert!(e.to_string().contains("not valid UTF-8"), "{e}");
         std::fs::write(&p, "\u{feff}x\r\n").unwrap();
+        let e = parse_json::<std::collections::BTreeMap<String, Vec<f64>>>(
+            "{\"a\": [1, 2],\n \"b\": [3, \"x\"]}",
+            &p,
+            "list",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains(":2: field `b[1]`: not a list: invalid type"),
+            "{e}"
+        );
         assert_eq!(read_text(&p).unwrap(), "x\r\n");
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -242,9 +242,12 @@ pub fn parse_measurements<R: Read>(
         .iter()
         .flat_map(|r| r.q.iter())
         .fold(0.0f64, |m, v| m.max(v.to_degrees().abs()));
-    if rows.len() >= 3 && max_abs_deg > 0.0 && max_abs_deg <= std::f64::consts::PI + 1e-9 {
+    // Radians of any joint range (up to a full turn each way) are within ±2π; a real session in
+    // degrees moves some joint further than 6.3 degrees.
+    if rows.len() >= 3 && max_abs_deg > 0.0 && max_abs_deg <= std::f64::consts::TAU + 1e-9 {
         warnings.push(format!(
-            "{}: every joint value is within ±{:.3}; they look like radians, but files hold degrees",
+            "{}: every joint value is within ±{:.3} (±2π); they look like radians, but files \
+             hold degrees",
             path.display(),
             max_abs_deg
         ));

@@ -132,14 +132,7 @@ impl CalibrationResult {
 
     /// Parses result JSON; `path` is used in messages.
     pub fn parse(text: &str, path: &Path) -> Result<CalibrationResult> {
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let r: CalibrationResult = serde_json::from_str(text).map_err(|e| {
-            let line = (e.line() > 0).then_some(e.line());
-            let msg = e.to_string();
-            // serde_json appends " at line L column C"; the line is reported separately.
-            let msg = msg.split(" at line ").next().unwrap_or(&msg).to_owned();
-            Error::parse(path, line, None, format!("not a robocal result: {msg}"))
-        })?;
+        let r: CalibrationResult = crate::io::input::parse_json(text, path, "robocal result")?;
         for (name, p) in &r.parameters {
             if !p.nominal.is_finite() || !p.calibrated.is_finite() {
                 return Err(Error::parse(
@@ -184,21 +177,21 @@ impl CalibrationResult {
             .get("solver")
             .and_then(|s| s.get("converged"))
             .and_then(|c| c.as_bool());
-        if status == Some(STATUS_PARTIAL) || converged == Some(false) {
-            let why = self
-                .extra
-                .get("partial_reason")
-                .and_then(|r| r.as_str())
-                .or_else(|| {
-                    self.extra
-                        .get("solver")
-                        .and_then(|s| s.get("termination"))
-                        .and_then(|t| t.as_str())
-                })
-                .unwrap_or("the solver did not converge");
-            return Some(why.to_owned());
+        if status != Some(STATUS_PARTIAL) && converged != Some(false) {
+            return None;
         }
-        None
+        let reason = self.extra.get("partial_reason").and_then(|r| r.as_str());
+        let termination = self
+            .extra
+            .get("solver")
+            .and_then(|s| s.get("termination"))
+            .and_then(|t| t.as_str());
+        Some(match (reason, converged, termination) {
+            (Some(r), _, _) => r.to_owned(),
+            (None, Some(false), Some(t)) => format!("the solver {t}"),
+            (None, Some(false), None) => "the solver did not converge".to_owned(),
+            _ => format!("marked \"status\": \"{STATUS_PARTIAL}\""),
+        })
     }
 
     /// The tracker frame as a rigid transform.

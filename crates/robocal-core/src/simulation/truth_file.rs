@@ -93,13 +93,7 @@ impl TruthFile {
     /// Reads a truth file, naming the file and line on malformed JSON.
     pub fn read(path: &Path) -> Result<TruthFile> {
         let text = crate::io::input::read_text(path)?;
-        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-        serde_json::from_str(text).map_err(|e| {
-            let line = (e.line() > 0).then_some(e.line());
-            let msg = e.to_string();
-            let msg = msg.split(" at line ").next().unwrap_or(&msg).to_owned();
-            Error::parse(path, line, None, format!("not a robocal truth file: {msg}"))
-        })
+        crate::io::input::parse_json(&text, path, "robocal truth file")
     }
 
     /// The true robot: `nominal` with every parameter set to its true value. Fails, naming the
