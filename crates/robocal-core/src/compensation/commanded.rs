@@ -93,47 +93,113 @@ pub fn write_commanded(
             "row counts of results, desired joints and extra columns differ",
         ));
     }
-    let io = |e: std::io::Error| Error::Io {
-        path: path.to_owned(),
-        source: e,
-    };
-    let mut out = AtomicFile::create(path)?;
-    {
-        let mut w = csv::Writer::from_writer(&mut out);
-        let mut header = commanded_header(dof, desired_joints.is_some());
-        header.extend(extra_columns.iter().cloned());
-        w.write_record(&header)
-            .map_err(|e| io(std::io::Error::other(e)))?;
-        let mut f: Vec<String> = Vec::with_capacity(header.len());
-        for (k, c) in rows.iter().enumerate() {
-            f.clear();
-            f.extend(
-                c.commanded
-                    .iter()
-                    .map(|v| format!("{:.10}", v.to_degrees())),
-            );
-            f.push(c.report.status.as_str().to_owned());
-            f.push(format!("{:.3e}", c.report.residual_mm));
-            f.push(c.report.iterations.to_string());
-            f.push(
-                c.report
-                    .limited_joints()
-                    .map(|i| format!("q{}", i + 1))
-                    .collect::<Vec<_>>()
-                    .join(" "),
-            );
-            f.extend(c.desired_position.iter().map(|v| format!("{v:.9}")));
-            if let Some(d) = desired_joints {
-                f.extend(d[k].iter().map(|v| format!("{:.10}", v.to_degrees())));
-            }
-            f.extend(extra_rows[k].iter().cloned());
-            w.write_record(&f)
-                .map_err(|e| io(std::io::Error::other(e)))?;
-        }
-        w.flush().map_err(io)?;
+    let mut w = CommandedWriter::create(path, dof, desired_joints.is_some(), extra_columns)?;
+    for (k, c) in rows.iter().enumerate() {
+        w.write(c, desired_joints.map(|d| d[k].as_slice()), extra_rows[k])?;
     }
-    out.flush().map_err(io)?;
-    out.commit()
+    w.commit()
+}
+
+/// A commanded file written row by row (for inputs too large to hold), made visible only by
+/// [`CommandedWriter::commit`]; dropped without it, nothing is written.
+pub struct CommandedWriter {
+    path: std::path::PathBuf,
+    w: csv::Writer<AtomicFile>,
+    dof: usize,
+    with_desired_joints: bool,
+    extra: usize,
+    fields: Vec<String>,
+}
+
+impl CommandedWriter {
+    /// Starts the file: the header for `dof` joints, with or without the desired joints, and the
+    /// input's `extra_columns`.
+    pub fn create(
+        path: &Path,
+        dof: usize,
+        with_desired_joints: bool,
+        extra_columns: &[String],
+    ) -> Result<Self> {
+        let mut header = commanded_header(dof, with_desired_joints);
+        header.extend(extra_columns.iter().cloned());
+        let mut w = csv::Writer::from_writer(AtomicFile::create(path)?);
+        w.write_record(&header).map_err(|e| csv_io(path, e))?;
+        Ok(CommandedWriter {
+            path: path.to_owned(),
+            w,
+            dof,
+            with_desired_joints,
+            extra: extra_columns.len(),
+            fields: Vec::with_capacity(header.len()),
+        })
+    }
+
+    /// Writes one row: the compensation, the desired joints (rad; exactly when the file was
+    /// created with them) and the input's extra values.
+    pub fn write(
+        &mut self,
+        c: &Compensation,
+        desired_joints: Option<&[f64]>,
+        extra: &[String],
+    ) -> Result<()> {
+        let lengths_ok = c.commanded.len() == self.dof
+            && extra.len() == self.extra
+            && match desired_joints {
+                Some(d) => self.with_desired_joints && d.len() == self.dof,
+                None => !self.with_desired_joints,
+            };
+        if !lengths_ok {
+            return Err(Error::invalid(
+                "commanded file",
+                "a row does not match the header (joints, desired joints or extra columns)",
+            ));
+        }
+        let f = &mut self.fields;
+        f.clear();
+        f.extend(
+            c.commanded
+                .iter()
+                .map(|v| format!("{:.10}", v.to_degrees())),
+        );
+        f.push(c.report.status.as_str().to_owned());
+        f.push(format!("{:.3e}", c.report.residual_mm));
+        f.push(c.report.iterations.to_string());
+        f.push(
+            c.report
+                .limited_joints()
+                .map(|i| format!("q{}", i + 1))
+                .collect::<Vec<_>>()
+                .join(" "),
+        );
+        f.extend(c.desired_position.iter().map(|v| format!("{v:.9}")));
+        if let Some(d) = desired_joints {
+            f.extend(d.iter().map(|v| format!("{:.10}", v.to_degrees())));
+        }
+        f.extend(extra.iter().cloned());
+        self.w.write_record(&*f).map_err(|e| csv_io(&self.path, e))
+    }
+
+    /// Completes the file: renames it into place.
+    pub fn commit(self) -> Result<()> {
+        let path = self.path;
+        let io = |e: std::io::Error| Error::Io {
+            path: path.clone(),
+            source: e,
+        };
+        let mut out = self
+            .w
+            .into_inner()
+            .map_err(|e| io(std::io::Error::other(e.to_string())))?;
+        out.flush().map_err(io)?;
+        out.commit()
+    }
+}
+
+fn csv_io(path: &Path, e: csv::Error) -> Error {
+    Error::Io {
+        path: path.to_owned(),
+        source: std::io::Error::other(e),
+    }
 }
 
 /// Counts of each status in `rows`, in [`IkStatus::ALL`] order.

@@ -7,7 +7,7 @@ pub mod result;
 
 pub use atomic::{write_all_atomic, write_atomic, AtomicFile};
 pub use measurements::{
-    parse_measurements, read_measurements, write_measurements, Measurement, MeasurementSet,
-    Positions,
+    parse_measurements, read_measurements, write_measurements, Measurement, MeasurementReader,
+    MeasurementSet, Positions,
 };
 pub use result::CalibrationResult;

@@ -93,7 +93,12 @@ impl TruthFile {
     /// Reads a truth file, naming the file and line on malformed JSON.
     pub fn read(path: &Path) -> Result<TruthFile> {
         let text = crate::io::input::read_text(path)?;
-        crate::io::input::parse_json(&text, path, "robocal truth file")
+        Self::parse(&text, path)
+    }
+
+    /// Parses truth-file JSON; `path` is used in messages (file, line and field).
+    pub fn parse(text: &str, path: &Path) -> Result<TruthFile> {
+        crate::io::input::parse_json(text, path, "robocal truth file")
     }
 
     /// The true robot: `nominal` with every parameter set to its true value. Fails, naming the
