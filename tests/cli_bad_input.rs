@@ -15,8 +15,12 @@ use std::path::Path;
 enum Run {
     /// `calibrate --data F`
     Cal,
+    /// `calibrate --validate F`
+    CalVal,
     /// `evaluate --data F --per-point D/per_point.csv`
     Eval,
+    /// `evaluate --data F --against desired`
+    EvalDesired,
     /// `compensate --joints F`
     CompJ,
     /// `compensate --targets F`
@@ -45,130 +49,63 @@ enum Run {
 
 use Run::*;
 
-const EVERY: [Run; 14] = [
-    Cal, Eval, CompJ, CompT, SimJ, Show, FkRobot, CalRobot, SimRobot, FkParams, ShowParams,
-    EvalParams, CompParams, SimTruth,
+const EVERY: [Run; 16] = [
+    Cal,
+    CalVal,
+    Eval,
+    EvalDesired,
+    CompJ,
+    CompT,
+    SimJ,
+    Show,
+    FkRobot,
+    CalRobot,
+    SimRobot,
+    FkParams,
+    ShowParams,
+    EvalParams,
+    CompParams,
+    SimTruth,
 ];
 
+/// The command line of `run` with the bad file `f`: a template whose words `F` (the bad file),
+/// `DATA`, `RESULT`, `JOINTS` (the fixture's good files), `OUT.json`, `OUT.csv` and `PP.csv`
+/// (outputs in the case directory `d`) are replaced.
 fn args(run: Run, f: &str, d: &Path, fx: &Fixture) -> Vec<String> {
-    let out_json = d.join("out.json");
-    let out_csv = d.join("out.csv");
-    let pp = d.join("per_point.csv");
-    let (data, res, joints) = (p(&fx.data), p(&fx.result), p(&fx.joints));
-    let zero = "0,-90,90,0,45,0";
-    let v: Vec<&str> = match run {
-        Cal => vec![
-            "calibrate",
-            "--robot",
-            KUKA,
-            "--data",
-            f,
-            "--out",
-            p(&out_json),
-        ],
-        Eval => vec![
-            "evaluate",
-            "--robot",
-            KUKA,
-            "--params",
-            res,
-            "--data",
-            f,
-            "--per-point",
-            p(&pp),
-        ],
-        CompJ => vec![
-            "compensate",
-            "--robot",
-            KUKA,
-            "--params",
-            res,
-            "--joints",
-            f,
-            "--out",
-            p(&out_csv),
-        ],
-        CompT => vec![
-            "compensate",
-            "--robot",
-            KUKA,
-            "--params",
-            res,
-            "--targets",
-            f,
-            "--out",
-            p(&out_csv),
-        ],
-        SimJ => vec![
-            "simulate",
-            "--robot",
-            KUKA,
-            "--truth",
-            TRUTH,
-            "--joints",
-            f,
-            "--out",
-            p(&out_csv),
-        ],
-        Show => vec!["robot", "show", f],
-        FkRobot => vec!["fk", "--robot", f, "--joints", zero],
-        CalRobot => vec![
-            "calibrate",
-            "--robot",
-            f,
-            "--data",
-            data,
-            "--out",
-            p(&out_json),
-        ],
-        SimRobot => vec![
-            "simulate",
-            "--robot",
-            f,
-            "--truth",
-            TRUTH,
-            "--poses",
-            "5",
-            "--out",
-            p(&out_csv),
-        ],
-        FkParams => vec!["fk", "--robot", KUKA, "--params", f, "--joints", zero],
-        ShowParams => vec!["robot", "show", KUKA, "--params", f],
-        EvalParams => vec![
-            "evaluate",
-            "--robot",
-            KUKA,
-            "--params",
-            f,
-            "--data",
-            data,
-            "--per-point",
-            p(&pp),
-        ],
-        CompParams => vec![
-            "compensate",
-            "--robot",
-            KUKA,
-            "--params",
-            f,
-            "--joints",
-            joints,
-            "--out",
-            p(&out_csv),
-        ],
-        SimTruth => vec![
-            "simulate",
-            "--robot",
-            KUKA,
-            "--truth",
-            f,
-            "--poses",
-            "5",
-            "--out",
-            p(&out_csv),
-        ],
+    let template = match run {
+        Cal => "calibrate --robot KUKA --data F --out OUT.json",
+        CalVal => "calibrate --robot KUKA --data DATA --validate F --out OUT.json",
+        Eval => "evaluate --robot KUKA --params RESULT --data F --per-point PP.csv",
+        EvalDesired => "evaluate --robot KUKA --params RESULT --data F --against desired",
+        CompJ => "compensate --robot KUKA --params RESULT --joints F --out OUT.csv",
+        CompT => "compensate --robot KUKA --params RESULT --targets F --out OUT.csv",
+        SimJ => "simulate --robot KUKA --truth TRUTH --joints F --out OUT.csv",
+        Show => "robot show F",
+        FkRobot => "fk --robot F --joints 0,-90,90,0,45,0",
+        CalRobot => "calibrate --robot F --data DATA --out OUT.json",
+        SimRobot => "simulate --robot F --truth TRUTH --poses 5 --out OUT.csv",
+        FkParams => "fk --robot KUKA --params F --joints 0,-90,90,0,45,0",
+        ShowParams => "robot show KUKA --params F",
+        EvalParams => "evaluate --robot KUKA --params F --data DATA --per-point PP.csv",
+        CompParams => "compensate --robot KUKA --params F --joints JOINTS --out OUT.csv",
+        SimTruth => "simulate --robot KUKA --truth F --poses 5 --out OUT.csv",
     };
-    v.into_iter().map(str::to_owned).collect()
+    let out = |name: &str| p(&d.join(name)).to_owned();
+    template
+        .split(' ')
+        .map(|w| match w {
+            "F" => f.to_owned(),
+            "KUKA" => KUKA.to_owned(),
+            "TRUTH" => TRUTH.to_owned(),
+            "DATA" => p(&fx.data).to_owned(),
+            "RESULT" => p(&fx.result).to_owned(),
+            "JOINTS" => p(&fx.joints).to_owned(),
+            "OUT.json" => out("out.json"),
+            "OUT.csv" => out("out.csv"),
+            "PP.csv" => out("per_point.csv"),
+            w => w.to_owned(),
+        })
+        .collect()
 }
 
 /// One bad input file.
@@ -185,8 +122,8 @@ struct Case {
     wants: &'static [&'static str],
 }
 
-const MEASURED: &[Run] = &[Cal, Eval];
-const JOINT_FILES: &[Run] = &[Cal, Eval, CompJ, SimJ];
+const MEASURED: &[Run] = &[Cal, CalVal, Eval];
+const JOINT_FILES: &[Run] = &[Cal, CalVal, Eval, CompJ, SimJ];
 const ROBOT_FILE: &[Run] = &[Show, FkRobot, CalRobot, SimRobot];
 const RESULT: &[Run] = &[FkParams, ShowParams, EvalParams, CompParams];
 
@@ -266,6 +203,12 @@ const CASES: &[Case] = &[
            wants: &["12 calibration points for 26 identifiable parameters"] },
     Case { file: "commanded.csv", make: |f| b(format!("status,{}", f.text(&f.joints).replace('\n', "\nconverged,").trim_end_matches("converged,"))),
            runs: &[CompJ], code: 3, wants: &["{F}:1: field `status`", "output of compensate has a column of this name"] },
+    Case { file: "no-desired.csv", make: |f| b(f.text(&f.data)), runs: &[EvalDesired], code: 3,
+           wants: &["{F}:1: field `x_desired`: missing column: comparing with desired positions needs x_desired,y_desired,z_desired"] },
+    Case { file: "half-desired.csv", make: |f| b(f.text(&f.data).replacen(",id,set", ",x_desired,set", 1)), runs: &[EvalDesired], code: 3,
+           wants: &["{F}:1: field `y_desired`: missing column"] },
+    Case { file: "text-desired.csv", make: |_| b("q1,q2,q3,q4,q5,q6,x,y,z,x_desired,y_desired,z_desired\n0,0,0,0,0,0,1,2,3,P1,2,3\n"), runs: &[EvalDesired], code: 3,
+           wants: &["{F}:2: field `x_desired`: `P1` is not a finite number"] },
     // ---- targets CSV (compensate --targets) ----
     Case { file: "t-no-z.csv", make: |_| b("x,y\n1,2\n"), runs: &[CompT], code: 3,
            wants: &["{F}:1: field `z`: missing column (targets need x,y,z"] },
