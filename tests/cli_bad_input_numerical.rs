@@ -308,8 +308,9 @@ fn a_solver_that_does_not_converge_fails_and_its_partial_result_is_marked() {
 #[test]
 fn few_points_still_converge() {
     // 30 points for 26 parameters: the sum of norms fits some points exactly and creeps towards
-    // its minimum; these data sets ran into the 200-iteration limit before the solver had an
-    // objective-change test.
+    // its minimum; these data sets ran into the old 200-iteration limit, still moving by less
+    // than a micrometre, before the solver had an objective-change test (seed 10 needs 349
+    // iterations to a relative change of 1e-9).
     let dir = tempfile::tempdir().unwrap();
     for seed in ["10", "12"] {
         let data = dir.path().join(format!("few{seed}.csv"));
@@ -340,8 +341,9 @@ fn few_points_still_converge() {
         assert!(o.status.success(), "seed {seed}: {}", stderr(&o));
         let j = read_json(&out);
         assert_eq!(j["solver"]["converged"], true);
+        assert_eq!(j["status"], "calibrated");
         assert!(
-            j["solver"]["iterations"].as_u64().unwrap() < 200,
+            j["solver"]["iterations"].as_u64().unwrap() < 1000,
             "{}",
             j["solver"]
         );

@@ -59,7 +59,7 @@ pub struct CalibrateArgs {
     rank_tol: f64,
     /// Iteration limit of the solver. If the solver stops there without converging, the command
     /// fails (exit code 5) and writes nothing, unless --keep-partial is given.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = 1000)]
     max_iterations: usize,
     /// When the solver does not converge, still write the result, marked `"status": "partial"`
     /// (the exit code stays 5; `compensate` refuses such a file, other commands warn).
