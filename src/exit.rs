@@ -60,6 +60,24 @@ pub fn numerical(message: impl Into<String>) -> anyhow::Error {
     .into()
 }
 
+/// The message of an error and its causes, outermost first, joined by `: `. A cause whose text
+/// the message already ends with is left out (an I/O error is part of its wrapper's text:
+/// `FILE: No such file or directory`, not `FILE: No such file...: No such file...`).
+pub fn message(e: &anyhow::Error) -> String {
+    let mut s = String::new();
+    for cause in e.chain() {
+        let c = cause.to_string();
+        if s.ends_with(&c) {
+            continue;
+        }
+        if !s.is_empty() {
+            s.push_str(": ");
+        }
+        s.push_str(&c);
+    }
+    s
+}
+
 /// The exit code for an error: the first robocal error in its chain decides.
 pub fn code_for(e: &anyhow::Error) -> i32 {
     use robocal_core::Error as E;

@@ -15,7 +15,7 @@ fn main() {
     match cmd::run(cli) {
         Ok(()) => {}
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", exit::message(&e));
             std::process::exit(exit::code_for(&e));
         }
     }

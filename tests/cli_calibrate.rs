@@ -381,7 +381,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
             s(&missing),
         ],
         &missing,
-        2,
+        4,
         &["does not exist"],
     );
 }

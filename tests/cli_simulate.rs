@@ -388,7 +388,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
             "--robot kuka-kr480-r3330 --poses 5".into(),
             vec![("--truth", &bad_truth)],
             3,
-            "bad.truth.json:2: not a robocal truth file",
+            "bad.truth.json:2: field `robot`: not a robocal truth file",
         ),
         (
             "--robot kuka-kr480-r3330 --truth random --poses 5 --length-error-mm -1".into(),

@@ -56,9 +56,14 @@ pub struct CalibrateArgs {
     /// Relative rank threshold of the identifiability analysis.
     #[arg(long, default_value_t = DEFAULT_RANK_TOLERANCE, value_name = "TOL")]
     rank_tol: f64,
-    /// Iteration limit of the solver.
-    #[arg(long, default_value_t = 200)]
+    /// Iteration limit of the solver. If the solver stops there without converging, the command
+    /// fails (exit code 5) and writes nothing, unless --keep-partial is given.
+    #[arg(long, default_value_t = 1000)]
     max_iterations: usize,
+    /// When the solver does not converge, still write the result, marked `"status": "partial"`
+    /// (the exit code stays 5; `compensate` refuses such a file, other commands warn).
+    #[arg(long)]
+    keep_partial: bool,
     /// Where to write the result JSON.
     #[arg(long)]
     out: PathBuf,
@@ -155,15 +160,9 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     }
     let fix = param_list(&robot, &a.fix, "--fix")?;
     let free = param_list(&robot, &a.free, "--free")?;
-    if let Some(parent) = a.out.parent().filter(|p| !p.as_os_str().is_empty()) {
-        if !parent.is_dir() {
-            return Err(exit::usage(format!(
-                "--out {}: directory {} does not exist",
-                a.out.display(),
-                parent.display()
-            )));
-        }
-    }
+    let mut inputs = vec![a.data.as_path()];
+    inputs.extend(a.validate.as_deref());
+    common::check_output("--out", &a.out, &inputs)?;
     let data = read(&a.data, &robot)?;
     let mut validation = data.validation.clone();
     if let Some(v) = &a.validate {
@@ -247,7 +246,8 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     );
     bar.finish_and_clear();
     let cal = result.with_context(|| format!("calibrating from {}", a.data.display()))?;
-    print_report(&cal);
+    let converged = cal.solver().termination.converged();
+    print_report(&cal, converged);
     if cal.registration.stats.mean_mm > 50.0 {
         eprintln!(
             "warning: the nominal model misses the measured points by {:.1} mm on average \
@@ -262,16 +262,38 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     if let Some(v) = &a.validate {
         extra.insert("validate".into(), json!(v.display().to_string()));
     }
-    let res = cal.to_result(extra);
-    res.write(&a.out)?;
-    println!("result written to {}", a.out.display());
-    if !cal.solver().termination.converged() {
-        eprintln!(
-            "warning: the solver {}; the result may not be the minimum (raise --max-iterations)",
-            cal.solver().termination.describe()
-        );
+    let mut res = cal.to_result(extra);
+    if converged {
+        res.write(&a.out)?;
+        println!("result written to {}", a.out.display());
+        return Ok(());
     }
-    Ok(())
+    // Not converged: not a calibration. Fail; keep the partial result only if asked, marked.
+    let why = format!(
+        "the solver {} after {} iteration(s) (--max-iterations {})",
+        cal.solver().termination.describe(),
+        cal.stages
+            .iter()
+            .map(|s| s.report.iterations)
+            .sum::<usize>(),
+        a.max_iterations
+    );
+    if a.keep_partial {
+        res.extra.insert("partial_reason".into(), json!(why));
+        res.write(&a.out)?;
+        Err(exit::numerical(format!(
+            "{why}: the parameters above are a partial result, not a calibration; written to {} \
+             marked \"status\": \"partial\" (--keep-partial)",
+            a.out.display()
+        )))
+    } else {
+        Err(exit::numerical(format!(
+            "{why}: the parameters above are a partial result, not a calibration; nothing \
+             written to {} (raise --max-iterations, or use --keep-partial to \
+             write the partial result, marked as such)",
+            a.out.display()
+        )))
+    }
 }
 
 /// Appends the points of `b` to `a` (validation points from two sources).
@@ -311,7 +333,12 @@ fn stats_table(title: &str, cols: &[(&str, ErrorStats)]) -> String {
     s
 }
 
-fn print_report(c: &Calibration) {
+fn print_report(c: &Calibration, converged: bool) {
+    let partial = if converged {
+        ""
+    } else {
+        " -- PARTIAL: the solver did not converge; not a calibration"
+    };
     let reg = &c.registration;
     let tf = robocal_core::io::result::FrameVec::from_frame(&reg.frame);
     println!();
@@ -371,7 +398,9 @@ fn print_report(c: &Calibration) {
     }
     println!();
     let fixed = |p: Param| c.covariance.std_of(p).is_none();
-    println!("Table III. Calibrated parameters of the robot (* fixed at its nominal value)");
+    println!(
+        "Table III. Calibrated parameters of the robot (* fixed at its nominal value){partial}"
+    );
     print!(
         "{}",
         layout(&c.calibrated, &|p| {
@@ -436,7 +465,7 @@ fn print_report(c: &Calibration) {
     print!(
         "{}",
         stats_table(
-            "Table IV. Error after calibration (calibrated model)",
+            &format!("Table IV. Error after calibration (calibrated model){partial}"),
             &after_cols
         )
     );

@@ -5,9 +5,9 @@ use super::evaluate::calibrated_model;
 use crate::exit;
 use anyhow::Context;
 use clap::Args;
-use robocal_core::compensation::commanded::{check_extra_columns, status_counts, write_commanded};
+use robocal_core::compensation::commanded::{check_extra_columns, CommandedWriter};
 use robocal_core::compensation::{read_targets, Compensation, IkStatus};
-use robocal_core::io::{read_measurements, Positions};
+use robocal_core::io::{MeasurementReader, Positions};
 use robocal_core::{Compensator, DampedLeastSquares};
 use std::path::PathBuf;
 
@@ -59,48 +59,67 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 .replace("max_iterations", "--max-iterations"),
         )
     })?;
-    let (nominal, cal, _) = calibrated_model(&a.robot, &a.params)?;
+    let input = a.joints.as_ref().or(a.targets.as_ref());
+    let mut inputs = vec![a.params.as_path()];
+    inputs.extend(input.map(|p| p.as_path()));
+    super::common::check_output("--out", &a.out, &inputs)?;
+    let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
+    if let Some(why) = res.partial_reason() {
+        return Err(exit::input(format!(
+            "--params {}: a partial result, not a calibration ({why}); compensation refuses \
+             it: re-run calibrate with a higher --max-iterations",
+            a.params.display()
+        )));
+    }
     let dof = nominal.dof();
     let comp = Compensator::new(&nominal, &cal, solver)?;
-    let (input, rows, desired, extra_columns, extra, lines) = if let Some(path) = &a.joints {
-        let set = read_measurements(path, dof, Positions::Optional)
-            .with_context(|| format!("--joints {}", path.display()))?;
-        for w in &set.warnings {
-            eprintln!("warning: {w}");
-        }
-        check_extra_columns(path, dof, &set.extra_columns)?;
-        if set.has_positions() {
+    let pb = crate::progress::spinner("compensating");
+    let mut tally = Tally::default();
+    let mut q = vec![0.0; dof];
+    // Rows are solved and written one at a time: only the summary is kept, so files of any
+    // length fit in memory.
+    let (input, writer) = if let Some(path) = &a.joints {
+        let context = || format!("--joints {}", path.display());
+        let mut reader =
+            MeasurementReader::open(path, dof, Positions::Optional).with_context(context)?;
+        check_extra_columns(path, dof, reader.extra_columns())?;
+        if reader.has_positions() {
             eprintln!(
                 "note: {}: the x,y,z columns (measured positions) are not used or carried",
                 path.display()
             );
         }
-        let outside: Vec<String> = set
-            .rows
-            .iter()
-            .filter_map(|r| {
-                let o = nominal.joints_outside_limits(&r.q);
-                (!o.is_empty()).then(|| {
-                    let js: Vec<String> = o.iter().map(|i| format!("q{}", i + 1)).collect();
-                    format!("line {} ({})", r.line, js.join(" "))
-                })
-            })
-            .collect();
-        if !outside.is_empty() {
+        let mut w = CommandedWriter::create(&a.out, dof, true, reader.extra_columns())?;
+        let mut outside = Listing::default();
+        while let Some(r) = reader.next_row().with_context(context)? {
+            nominal.check_joints(&r.q, &format!("{}:{}", path.display(), r.line))?;
+            let o = nominal.joints_outside_limits(&r.q);
+            if !o.is_empty() {
+                let js: Vec<String> = o.iter().map(|i| format!("q{}", i + 1)).collect();
+                outside.push(format!("line {} ({})", r.line, js.join(" ")));
+            }
+            let (p, report) = comp.compensate(&r.q, &mut q);
+            let c = Compensation {
+                desired_position: p,
+                commanded: q.clone(),
+                report,
+            };
+            tally.add(r.line, &c, Some(&r.q));
+            w.write(&c, Some(&r.q), &r.extra)?;
+            tally.tick(&pb);
+        }
+        for warning in reader.finish().with_context(context)? {
+            eprintln!("warning: {warning}");
+        }
+        if outside.count > 0 {
             eprintln!(
                 "warning: {} desired pose(s) outside the joint limits; solved from the nearest \
                  pose within them: {}",
-                outside.len(),
-                abbreviate(&outside)
+                outside.count,
+                outside.text()
             );
         }
-        let desired: Vec<Vec<f64>> = set.rows.iter().map(|r| r.q.clone()).collect();
-        let pb = crate::progress::bar(desired.len() as u64, "compensating");
-        let rows = comp.compensate_all(&desired, &mut |d, _| pb.set_position(d as u64))?;
-        pb.finish_and_clear();
-        let extra: Vec<Vec<String>> = set.rows.iter().map(|r| r.extra.clone()).collect();
-        let lines: Vec<usize> = set.rows.iter().map(|r| r.line).collect();
-        (path, rows, Some(desired), set.extra_columns, extra, lines)
+        (path, w)
     } else {
         let path = a
             .targets
@@ -109,52 +128,129 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         let set =
             read_targets(path, dof).with_context(|| format!("--targets {}", path.display()))?;
         check_extra_columns(path, dof, &set.extra_columns)?;
-        let pb = crate::progress::bar(set.rows.len() as u64, "reaching");
-        let rows = comp.reach_all(&set.rows, &mut |d, _| pb.set_position(d as u64))?;
-        pb.finish_and_clear();
-        let extra: Vec<Vec<String>> = set.rows.iter().map(|r| r.extra.clone()).collect();
-        let lines: Vec<usize> = set.rows.iter().map(|r| r.line).collect();
-        (path, rows, None, set.extra_columns, extra, lines)
+        let mut w = CommandedWriter::create(&a.out, dof, false, &set.extra_columns)?;
+        for t in &set.rows {
+            if let Some(s) = &t.seed {
+                cal.check_joints(s, &format!("{}:{}", path.display(), t.line))?;
+            }
+            let report = comp.reach(&t.p, t.seed.as_deref(), &mut q);
+            let c = Compensation {
+                desired_position: t.p,
+                commanded: q.clone(),
+                report,
+            };
+            tally.add(t.line, &c, None);
+            w.write(&c, None, &t.extra)?;
+            tally.tick(&pb);
+        }
+        (path, w)
     };
+    pb.finish_and_clear();
 
-    let failed: Vec<String> = rows
-        .iter()
-        .zip(&lines)
-        .filter(|(c, _)| !c.report.status.is_converged())
-        .map(|(c, l)| describe_failure(*l, c))
-        .collect();
-    if !failed.is_empty() {
+    if tally.failed.count > 0 {
         if a.strict {
+            // The writer is dropped: nothing is written.
             return Err(exit::numerical(format!(
                 "--strict: {} of {} row(s) of {} did not converge; nothing written:\n  {}",
-                failed.len(),
-                rows.len(),
+                tally.failed.count,
+                tally.rows,
                 input.display(),
-                failed.join("\n  ")
+                tally.failed.lines().join("\n  ")
             )));
         }
-        for f in failed.iter().take(LISTED) {
+        for f in &tally.failed.items {
             eprintln!("warning: {}: {f}", input.display());
         }
-        if failed.len() > LISTED {
+        if tally.failed.count > LISTED {
             eprintln!(
                 "warning: ... and {} more (see the status column of {})",
-                failed.len() - LISTED,
+                tally.failed.count - LISTED,
                 a.out.display()
             );
         }
     }
-    let extra_refs: Vec<&[String]> = extra.iter().map(|v| v.as_slice()).collect();
-    write_commanded(
-        &a.out,
-        dof,
-        &rows,
-        desired.as_deref(),
-        &extra_columns,
-        &extra_refs,
-    )?;
-    print_summary(&a, input, &rows, desired.as_deref(), &lines);
+    writer.commit()?;
+    print_summary(&a, input, &tally);
     Ok(())
+}
+
+/// The first [`LISTED`] of a kind of row, and how many there are.
+#[derive(Default)]
+struct Listing {
+    count: usize,
+    items: Vec<String>,
+}
+
+impl Listing {
+    fn push(&mut self, item: String) {
+        self.count += 1;
+        if self.items.len() < LISTED {
+            self.items.push(item);
+        }
+    }
+
+    /// The listed items, and a last line for the rest.
+    fn lines(&self) -> Vec<String> {
+        let mut v = self.items.clone();
+        if self.count > v.len() {
+            v.push(format!("... and {} more", self.count - v.len()));
+        }
+        v
+    }
+
+    fn text(&self) -> String {
+        let mut s = self.items.join(", ");
+        if self.count > self.items.len() {
+            s.push_str(&format!(", ... ({} more)", self.count - self.items.len()));
+        }
+        s
+    }
+}
+
+/// What the summary needs, gathered row by row.
+#[derive(Default)]
+struct Tally {
+    rows: usize,
+    counts: [usize; 4],
+    failed: Listing,
+    max_residual_converged: f64,
+    max_residual: f64,
+    iterations: usize,
+    max_iterations: usize,
+    /// The largest joint change among converged rows: (degrees, line, joint).
+    max_change: Option<(f64, usize, usize)>,
+}
+
+impl Tally {
+    fn add(&mut self, line: usize, c: &Compensation, desired: Option<&[f64]>) {
+        let r = &c.report;
+        self.rows += 1;
+        if let Some(k) = IkStatus::ALL.iter().position(|s| *s == r.status) {
+            self.counts[k] += 1;
+        }
+        self.max_residual = self.max_residual.max(r.residual_mm);
+        self.iterations += r.iterations;
+        self.max_iterations = self.max_iterations.max(r.iterations);
+        if !r.status.is_converged() {
+            self.failed.push(describe_failure(line, c));
+            return;
+        }
+        self.max_residual_converged = self.max_residual_converged.max(r.residual_mm);
+        if let Some(d) = desired {
+            for (i, (qc, qd)) in c.commanded.iter().zip(d).enumerate() {
+                let ch = (qc - qd).abs().to_degrees();
+                if !matches!(self.max_change, Some(b) if b.0 >= ch) {
+                    self.max_change = Some((ch, line, i));
+                }
+            }
+        }
+    }
+
+    fn tick(&self, pb: &indicatif::ProgressBar) {
+        if self.rows % 4096 == 0 {
+            pb.set_message(format!("compensating: {} rows", self.rows));
+        }
+    }
 }
 
 fn describe_failure(line: usize, c: &Compensation) -> String {
@@ -177,27 +273,8 @@ fn describe_failure(line: usize, c: &Compensation) -> String {
     )
 }
 
-fn abbreviate(items: &[String]) -> String {
-    let mut s = items
-        .iter()
-        .take(LISTED)
-        .cloned()
-        .collect::<Vec<_>>()
-        .join(", ");
-    if items.len() > LISTED {
-        s.push_str(&format!(", ... ({} more)", items.len() - LISTED));
-    }
-    s
-}
-
-fn print_summary(
-    a: &CompensateArgs,
-    input: &std::path::Path,
-    rows: &[Compensation],
-    desired: Option<&[Vec<f64>]>,
-    lines: &[usize],
-) {
-    let mode = if desired.is_some() {
+fn print_summary(a: &CompensateArgs, input: &std::path::Path, t: &Tally) {
+    let mode = if a.joints.is_some() {
         "desired poses; target = nominal tool position (eq. 13)"
     } else {
         "Cartesian targets (base frame)"
@@ -205,49 +282,23 @@ fn print_summary(
     println!(
         "{}: {} {mode}; solved on the calibrated model of {}",
         input.display(),
-        rows.len(),
+        t.rows,
         a.params.display()
     );
-    for (s, n) in status_counts(rows) {
+    for (s, n) in IkStatus::ALL.iter().zip(t.counts) {
         println!("  {:<14} {n:>8}", s.as_str());
     }
-    let max_all = rows
-        .iter()
-        .map(|c| c.report.residual_mm)
-        .fold(0.0, f64::max);
-    let conv: Vec<&Compensation> = rows
-        .iter()
-        .filter(|c| c.report.status.is_converged())
-        .collect();
-    let max_conv = conv
-        .iter()
-        .map(|c| c.report.residual_mm)
-        .fold(0.0, f64::max);
     println!(
         "  residual       max {:.3e} mm over converged rows, {:.3e} mm over all (tolerance {:e} mm)",
-        max_conv, max_all, a.tolerance_mm
+        t.max_residual_converged, t.max_residual, a.tolerance_mm
     );
-    let it_max = rows.iter().map(|c| c.report.iterations).max().unwrap_or(0);
-    let it_mean =
-        rows.iter().map(|c| c.report.iterations).sum::<usize>() as f64 / rows.len().max(1) as f64;
-    println!("  iterations     mean {it_mean:.1}, max {it_max}");
-    if let Some(d) = desired {
-        // The largest joint correction among converged rows.
-        let mut best: Option<(f64, usize, usize)> = None;
-        for (k, c) in rows.iter().enumerate() {
-            if !c.report.status.is_converged() {
-                continue;
-            }
-            for (i, (qc, qd)) in c.commanded.iter().zip(&d[k]).enumerate() {
-                let ch = (qc - qd).abs().to_degrees();
-                if !matches!(best, Some(b) if b.0 >= ch) {
-                    best = Some((ch, lines[k], i));
-                }
-            }
-        }
-        if let Some((ch, line, i)) = best {
-            println!("  joint change   max {ch:.4} deg (line {line}, q{})", i + 1);
-        }
+    let it_mean = t.iterations as f64 / t.rows.max(1) as f64;
+    println!(
+        "  iterations     mean {it_mean:.1}, max {}",
+        t.max_iterations
+    );
+    if let Some((ch, line, i)) = t.max_change {
+        println!("  joint change   max {ch:.4} deg (line {line}, q{})", i + 1);
     }
-    println!("wrote {} ({} rows)", a.out.display(), rows.len());
+    println!("wrote {} ({} rows)", a.out.display(), t.rows);
 }

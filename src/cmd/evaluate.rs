@@ -5,8 +5,10 @@
 use super::common;
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use robocal_core::evaluation::{self, Against, Evaluation, Reference};
-use robocal_core::io::{read_measurements, CalibrationResult, MeasurementSet, Positions};
+use robocal_core::evaluation::{self, Against, Evaluator, PerPointWriter, Reference};
+use robocal_core::io::{
+    CalibrationResult, Measurement, MeasurementReader, MeasurementSet, Positions,
+};
 use robocal_core::{ErrorStats, Robot};
 
 use std::path::{Path, PathBuf};
@@ -57,39 +59,78 @@ pub(super) fn calibrated_model(
 }
 
 pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
-    let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
-    let data = read_measurements(&a.data, nominal.dof(), Positions::Required)
-        .with_context(|| format!("--data {}", a.data.display()))?;
-    for w in &data.warnings {
-        eprintln!("warning: {w}");
+    if let Some(p) = &a.per_point {
+        common::check_output("--per-point", p, &[&a.data, &a.params])?;
     }
+    let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
+    common::warn_partial(&res, &a.params);
     let against = match a.against {
         AgainstArg::Auto => Against::Auto,
         AgainstArg::Model => Against::Model,
         AgainstArg::Desired => Against::Desired,
     };
-    let ev = evaluation::evaluate(&nominal, &cal, &res.tracker_frame(), &data, against)?;
-    if let Some(p) = &a.per_point {
-        ev.write_per_point(p, &data)?;
+    // Row by row: only the error norms are kept (16 bytes per row), so files of any length fit.
+    let context = || format!("--data {}", a.data.display());
+    let mut reader = MeasurementReader::open(&a.data, nominal.dof(), Positions::Required)
+        .with_context(context)?;
+    let header = reader.header();
+    let frame = res.tracker_frame();
+    let ev = Evaluator::new(&nominal, &cal, &frame, &header, against)?;
+    let names = ev.series();
+    let mut per_point = match &a.per_point {
+        Some(p) => Some(PerPointWriter::create(
+            p,
+            &header,
+            [names[0].0, names[1].0],
+        )?),
+        None => None,
+    };
+    let mut norms = [Vec::new(), Vec::new()];
+    let mut not_converged = Statuses::new(&header);
+    while let Some(r) = reader.next_row().with_context(context)? {
+        let e = ev.errors(&r)?;
+        norms[0].push(e[0].norm());
+        norms[1].push(e[1].norm());
+        if let Some(w) = &mut per_point {
+            w.write(&r, &e)?;
+        }
+        not_converged.note(&r);
     }
-    note_statuses(&data);
+    for w in reader.finish().with_context(context)? {
+        eprintln!("warning: {w}");
+    }
+    if let Some(w) = per_point {
+        w.commit()?;
+    }
+    not_converged.report();
+    let n = norms[0].len();
+    let series: Vec<Series> = names
+        .iter()
+        .zip(&norms)
+        .map(|(&(name, description), norms)| Series {
+            name,
+            description,
+            stats: ErrorStats::from_norms(norms),
+        })
+        .collect();
+    let reference = ev.reference();
     if a.json {
         let mut o = serde_json::Map::new();
         o.insert("data".into(), a.data.display().to_string().into());
         o.insert("params".into(), a.params.display().to_string().into());
         o.insert(
             "reference".into(),
-            match ev.reference {
+            match reference {
                 Reference::Model => "model",
                 Reference::Desired => "desired",
             }
             .into(),
         );
-        o.insert("n".into(), data.rows.len().into());
-        for s in &ev.series {
+        o.insert("n".into(), n.into());
+        for s in &series {
             o.insert(s.name.into(), serde_json::to_value(s.stats)?);
         }
-        if ev.reference == Reference::Desired {
+        if reference == Reference::Desired {
             o.insert(
                 "predicted".into(),
                 serde_json::json!({
@@ -103,29 +144,62 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         }
         println!("{}", serde_json::to_string_pretty(&o)?);
     } else {
-        print_table(&a, &data, &ev, &res);
+        print_table(&a, n, reference, &series, &res);
     }
     Ok(())
 }
 
-/// Tells the user about rows of a commanded file whose compensation did not converge.
-fn note_statuses(data: &MeasurementSet) {
-    if !data.extra_columns.iter().any(|c| c == "status") {
-        return;
+/// One series' name, description and statistics.
+struct Series {
+    name: &'static str,
+    description: &'static str,
+    stats: ErrorStats,
+}
+
+/// Rows listed one by one in the note about rows that did not converge in compensation.
+const LISTED: usize = 20;
+
+/// Rows of a commanded file whose compensation did not converge (`status` column).
+struct Statuses {
+    column: Option<usize>,
+    count: usize,
+    listed: Vec<String>,
+}
+
+impl Statuses {
+    fn new(header: &MeasurementSet) -> Statuses {
+        Statuses {
+            column: header.extra_columns.iter().position(|c| c == "status"),
+            count: 0,
+            listed: Vec::new(),
+        }
     }
-    let bad: Vec<String> = data
-        .rows
-        .iter()
-        .filter_map(|r| {
-            let s = data.extra_value(r, "status")?;
-            (s != "converged").then(|| format!("line {} ({s})", r.line))
-        })
-        .collect();
-    if !bad.is_empty() {
+
+    fn note(&mut self, r: &Measurement) {
+        let Some(k) = self.column else { return };
+        let s = &r.extra[k];
+        if s != "converged" {
+            self.count += 1;
+            if self.listed.len() < LISTED {
+                self.listed.push(format!("line {} ({s})", r.line));
+            }
+        }
+    }
+
+    /// Tells the user about them.
+    fn report(&self) {
+        if self.count == 0 {
+            return;
+        }
+        let more = if self.count > self.listed.len() {
+            format!(", ... ({} more)", self.count - self.listed.len())
+        } else {
+            String::new()
+        };
         eprintln!(
-            "note: {} row(s) were not converged in compensation; their errors are included: {}",
-            bad.len(),
-            bad.join(", ")
+            "note: {} row(s) were not converged in compensation; their errors are included: {}{more}",
+            self.count,
+            self.listed.join(", ")
         );
     }
 }
@@ -150,8 +224,14 @@ fn cell(v: f64) -> String {
     }
 }
 
-fn print_table(a: &EvaluateArgs, data: &MeasurementSet, ev: &Evaluation, res: &CalibrationResult) {
-    let what = match ev.reference {
+fn print_table(
+    a: &EvaluateArgs,
+    n: usize,
+    reference: Reference,
+    series: &[Series],
+    res: &CalibrationResult,
+) {
+    let what = match reference {
         Reference::Model => "validation: measured points against the models at the measured joints",
         Reference::Desired => {
             "verification: measured commanded poses against their desired positions (Table V)"
@@ -160,27 +240,24 @@ fn print_table(a: &EvaluateArgs, data: &MeasurementSet, ev: &Evaluation, res: &C
     println!(
         "{}: {} points; {what}; tracker frame of {}",
         a.data.display(),
-        data.rows.len(),
+        n,
         a.params.display()
     );
-    match ev.reference {
+    match reference {
         Reference::Model => {
-            for s in &ev.series {
+            for s in series {
                 println!("  {:<11} {}", s.name, s.description);
             }
             println!();
-            println!(
-                "{:<14} {:>12} {:>12}",
-                "", ev.series[0].name, ev.series[1].name
-            );
+            println!("{:<14} {:>12} {:>12}", "", series[0].name, series[1].name);
             for (label, f) in STAT_ROWS {
                 println!(
                     "{label:<14}{}{}",
-                    cell(f(&ev.series[0].stats)),
-                    cell(f(&ev.series[1].stats))
+                    cell(f(&series[0].stats)),
+                    cell(f(&series[1].stats))
                 );
             }
-            let (b, c) = (ev.series[0].stats.mean_mm, ev.series[1].stats.mean_mm);
+            let (b, c) = (series[0].stats.mean_mm, series[1].stats.mean_mm);
             if b > 0.0 {
                 println!(
                     "mean error {} by {:.1}% with the calibrated model",
@@ -214,7 +291,7 @@ fn print_table(a: &EvaluateArgs, data: &MeasurementSet, ev: &Evaluation, res: &C
                 };
                 print!(
                     "{label:<14}{}{}",
-                    cell(f(&ev.series[0].stats)),
+                    cell(f(&series[0].stats)),
                     cell(pred(&cal))
                 );
                 if let Some(v) = &val {
@@ -222,7 +299,7 @@ fn print_table(a: &EvaluateArgs, data: &MeasurementSet, ev: &Evaluation, res: &C
                 }
                 println!();
             }
-            let (m, p) = (ev.series[0].stats.mean_mm, cal.mean_mm);
+            let (m, p) = (series[0].stats.mean_mm, cal.mean_mm);
             if p > 0.0 {
                 println!(
                     "verification mean {m:.4} mm vs {p:.4} mm predicted on the calibration points \
@@ -233,6 +310,6 @@ fn print_table(a: &EvaluateArgs, data: &MeasurementSet, ev: &Evaluation, res: &C
         }
     }
     if let Some(p) = &a.per_point {
-        println!("wrote {} ({} rows)", p.display(), data.rows.len());
+        println!("wrote {} ({n} rows)", p.display());
     }
 }

@@ -31,11 +31,16 @@ pub fn run(c: RobotCmd) -> anyhow::Result<()> {
         }
         RobotCmd::Show(a) => {
             let m = common::model(&a.robot, a.params.as_deref())?;
+            if let (Some((_, res)), Some(p)) = (&m.calibrated, &a.params) {
+                common::warn_partial(res, p);
+            }
             let r = m.active();
-            let label = if m.calibrated.is_some() {
-                "calibrated parameters"
-            } else {
-                "parameters"
+            let label = match &m.calibrated {
+                Some((_, res)) if res.partial_reason().is_some() => {
+                    "PARTIAL parameters (the solver did not converge; not a calibration)"
+                }
+                Some(_) => "calibrated parameters",
+                None => "parameters",
             };
             println!(
                 "{} ({} joints, {}), {label}:",

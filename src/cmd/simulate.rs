@@ -246,6 +246,11 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
             )));
         }
     }
+    common::check_output("--out", &a.out, &[])?;
+    common::check_output("--out (truth file)", &truth_out, &[])?;
+    if let Some(v) = &a.validation_out {
+        common::check_output("--validation-out", v, &[])?;
+    }
     let nominal = common::robot(&a.robot)?;
     let (truth, truth_tracker) = truth_arg(&a, &nominal)?;
     let cfg = config(&a, &nominal, truth_tracker)?;
@@ -266,8 +271,9 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
             b.set_position(done as u64);
         }
     };
-    let sim = match &joints {
-        Some(j) => simulate_joints(&nominal, &truth, &cfg, j, &mut progress)?,
+    let sim = match joints {
+        // The joint file is dropped as soon as it is measured (large files: memory).
+        Some(j) => simulate_joints(&nominal, &truth, &cfg, &j, &mut progress)?,
         None => simulate(&nominal, &truth, &cfg, &mut progress)?,
     };
     if let Some(b) = &bar {
@@ -275,12 +281,15 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     }
 
     // Split the validation rows off if asked; every row's file, in row order, for the truth file.
-    let (main, val) = match &a.validation_out {
-        Some(_) => (
+    let split = a.validation_out.as_ref().map(|_| {
+        (
             sim.select(SET_VALIDATION, false),
-            Some(sim.select(SET_VALIDATION, true)),
-        ),
-        None => (sim.measurements.clone(), None),
+            sim.select(SET_VALIDATION, true),
+        )
+    });
+    let (main, val) = match &split {
+        Some((m, v)) => (m, Some(v)),
+        None => (&sim.measurements, None),
     };
     let m = &sim.measurements;
     let set_col = m.extra_columns.iter().position(|c| c == "set");
@@ -300,10 +309,10 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         path: p.to_owned(),
         source: e,
     };
-    let main_csv = measurements_csv(&main).map_err(|e| io(&a.out, e))?;
+    let main_csv = measurements_csv(main).map_err(|e| io(&a.out, e))?;
     let json = truth_file.to_json()?;
     let mut writes: Vec<(&Path, Vec<u8>)> = vec![(a.out.as_path(), main_csv)];
-    if let (Some(p), Some(v)) = (&a.validation_out, &val) {
+    if let (Some(p), Some(v)) = (&a.validation_out, val) {
         writes.push((p.as_path(), measurements_csv(v).map_err(|e| io(p, e))?));
     }
     writes.push((truth_out.as_path(), json.into_bytes()));

@@ -19,11 +19,10 @@ use crate::compensation::commanded::{desired_joint_column, DESIRED_POSITION_COLU
 use crate::error::{Error, Result};
 use crate::frame::Frame;
 use crate::io::result::CalibrationResult;
-use crate::io::{AtomicFile, Measurement, MeasurementSet};
+use crate::io::{Measurement, MeasurementSet};
 use crate::model::Robot;
 use crate::stats::ErrorStats;
-use nalgebra::{Point3, Vector3};
-use std::io::Write;
+use nalgebra::Vector3;
 use std::path::Path;
 
 /// What the measured points are compared with.
@@ -102,59 +101,20 @@ pub fn evaluate(
             ),
         ));
     }
-    let reference = match against {
-        Against::Model => Reference::Model,
-        Against::Desired => Reference::Desired,
-        Against::Auto => {
-            if has_desired_columns(data) {
-                Reference::Desired
-            } else {
-                Reference::Model
-            }
-        }
-    };
-    let mut actual = Vec::with_capacity(data.rows.len());
+    let ev = Evaluator::new(nominal, calibrated, tracker_frame, data, against)?;
+    let mut errors = [
+        Vec::with_capacity(data.rows.len()),
+        Vec::with_capacity(data.rows.len()),
+    ];
     for r in &data.rows {
-        let Some(m) = r.p else {
-            return Err(Error::parse(
-                &data.path,
-                Some(r.line),
-                None,
-                "no measured position (x,y,z)",
-            ));
-        };
-        actual.push((tracker_frame * Point3::from(m)).coords);
+        let [a, b] = ev.errors(r)?;
+        errors[0].push(a);
+        errors[1].push(b);
     }
-    let errors_of = |reference: &dyn Fn(&Measurement) -> Result<Vector3<f64>>| {
-        data.rows
-            .iter()
-            .zip(&actual)
-            .map(|(r, a)| Ok(a - reference(r)?))
-            .collect::<Result<Vec<_>>>()
-    };
-    let cal = Series::new(
-        "calibrated",
-        match reference {
-            Reference::Model => "measured - calibrated model at the measured joints",
-            Reference::Desired => "measured - calibrated model at the commanded joints",
-        },
-        errors_of(&|r| Ok(calibrated.tool_position(&r.q)))?,
-    );
-    let first = match reference {
-        Reference::Model => Series::new(
-            "nominal",
-            "measured - nominal model at the measured joints",
-            errors_of(&|r| Ok(nominal.tool_position(&r.q)))?,
-        ),
-        Reference::Desired => {
-            let source = DesiredSource::find(data, nominal.dof())?;
-            Series::new(
-                "desired",
-                "measured - desired position (eq. 13)",
-                errors_of(&|r| source.position(data, r, nominal))?,
-            )
-        }
-    };
+    let [e0, e1] = errors;
+    let [(n0, d0), (n1, d1)] = ev.series();
+    let (first, cal) = (Series::new(n0, d0, e0), Series::new(n1, d1, e1));
+    let reference = ev.reference();
     Ok(Evaluation {
         reference,
         lines: data.rows.iter().map(|r| r.line).collect(),
@@ -244,51 +204,11 @@ impl Evaluation {
     /// Writes the per-point errors atomically: `line`, `q1..qn` (degrees), the input's extra
     /// columns, then for each series `dx_<name>,dy_<name>,dz_<name>,norm_<name>` (mm, base frame).
     pub fn write_per_point(&self, path: &Path, data: &MeasurementSet) -> Result<()> {
-        let mut header = vec!["line".to_owned()];
-        header.extend((1..=data.dof).map(|i| format!("q{i}")));
-        let own_start = header.len();
-        for s in &self.series {
-            for c in ["dx", "dy", "dz", "norm"] {
-                header.push(format!("{c}_{}", s.name));
-            }
+        let mut w = PerPointWriter::create(path, data, [self.series[0].name, self.series[1].name])?;
+        for (k, r) in data.rows.iter().enumerate() {
+            w.write(r, &[self.series[0].errors[k], self.series[1].errors[k]])?;
         }
-        if let Some(c) = data.extra_columns.iter().find(|c| header.contains(c)) {
-            return Err(Error::parse(
-                &data.path,
-                Some(1),
-                Some(c),
-                "the per-point output has a column of this name; rename or remove it",
-            ));
-        }
-        let own: Vec<String> = header.drain(own_start..).collect();
-        header.extend(data.extra_columns.iter().cloned());
-        header.extend(own);
-        let io = |e: std::io::Error| Error::Io {
-            path: path.to_owned(),
-            source: e,
-        };
-        let mut out = AtomicFile::create(path)?;
-        {
-            let mut w = csv::Writer::from_writer(&mut out);
-            w.write_record(&header)
-                .map_err(|e| io(std::io::Error::other(e)))?;
-            let mut f: Vec<String> = Vec::with_capacity(header.len());
-            for (k, r) in data.rows.iter().enumerate() {
-                f.clear();
-                f.push(r.line.to_string());
-                f.extend(r.q.iter().map(|v| format!("{:.9}", v.to_degrees())));
-                f.extend(r.extra.iter().cloned());
-                for s in &self.series {
-                    let e = s.errors[k];
-                    f.extend([e.x, e.y, e.z, e.norm()].iter().map(|v| format!("{v:.6}")));
-                }
-                w.write_record(&f)
-                    .map_err(|e| io(std::io::Error::other(e)))?;
-            }
-            w.flush().map_err(io)?;
-        }
-        out.flush().map_err(io)?;
-        out.commit()
+        w.commit()
     }
 }
 
@@ -326,6 +246,9 @@ pub fn check_result_nominal(
     }
     Ok(())
 }
+
+mod stream;
+pub use stream::{Evaluator, PerPointWriter};
 
 #[cfg(test)]
 mod tests;

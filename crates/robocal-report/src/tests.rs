@@ -370,7 +370,9 @@ mod runs {
         assert!(r.html.contains("cannot place the points"));
         assert!(!r.html.contains("Paper: Samak"));
         assert!(data.identifiability.as_ref().unwrap().fixed.len() == 10);
-        assert_eq!(data.solver.as_ref().unwrap().iterations, Some(12));
+        let iterations = e.result.extra["solver"]["iterations"].as_u64().unwrap() as usize;
+        assert!(iterations > 0);
+        assert_eq!(data.solver.as_ref().unwrap().iterations, Some(iterations));
     }
 
     #[test]

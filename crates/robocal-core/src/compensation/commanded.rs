@@ -87,23 +87,17 @@ pub fn write_commanded(
     extra_columns: &[String],
     extra_rows: &[&[String]],
 ) -> Result<()> {
-    let bytes = commanded_csv(dof, rows, desired_joints, extra_columns, extra_rows).map_err(
-        |e| match e {
-            Error::Io { source, .. } => Error::Io {
-                path: path.to_owned(),
-                source,
-            },
-            other => other,
-        },
-    )?;
-    let mut out = AtomicFile::create(path)?;
-    out.write_all(&bytes)
-        .and_then(|_| out.flush())
-        .map_err(|e| Error::Io {
-            path: path.to_owned(),
-            source: e,
-        })?;
-    out.commit()
+    if extra_rows.len() != rows.len() || desired_joints.is_some_and(|d| d.len() != rows.len()) {
+        return Err(Error::invalid(
+            "commanded file",
+            "row counts of results, desired joints and extra columns differ",
+        ));
+    }
+    let mut w = CommandedWriter::create(path, dof, desired_joints.is_some(), extra_columns)?;
+    for (k, c) in rows.iter().enumerate() {
+        w.write(c, desired_joints.map(|d| d[k].as_slice()), extra_rows[k])?;
+    }
+    w.commit()
 }
 
 /// The text [`write_commanded`] writes, for callers that write several files together
@@ -122,17 +116,129 @@ pub fn commanded_csv(
             "row counts of results, desired joints and extra columns differ",
         ));
     }
-    let io = |e: std::io::Error| Error::Io {
-        path: "commanded file".into(),
-        source: e,
-    };
-    let mut w = csv::Writer::from_writer(Vec::new());
-    let mut header = commanded_header(dof, desired_joints.is_some());
-    header.extend(extra_columns.iter().cloned());
-    w.write_record(&header)
-        .map_err(|e| io(std::io::Error::other(e)))?;
-    let mut f: Vec<String> = Vec::with_capacity(header.len());
+    let mut w = CommandedWriter::in_memory(
+        Path::new("commanded file"),
+        dof,
+        desired_joints.is_some(),
+        extra_columns,
+    )?;
     for (k, c) in rows.iter().enumerate() {
+        w.write(c, desired_joints.map(|d| d[k].as_slice()), extra_rows[k])?;
+    }
+    w.into_bytes()
+}
+
+/// A commanded file written row by row (for inputs too large to hold). Into a file
+/// ([`CommandedWriter::create`]) it becomes visible only by [`CommandedWriter::commit`]; dropped
+/// without it, nothing is written. Into memory ([`CommandedWriter::in_memory`]) it gives the text
+/// for callers that write several files together.
+pub struct CommandedWriter<W: Write = AtomicFile> {
+    path: std::path::PathBuf,
+    w: csv::Writer<W>,
+    dof: usize,
+    with_desired_joints: bool,
+    extra: usize,
+    fields: Vec<String>,
+}
+
+impl CommandedWriter<AtomicFile> {
+    /// Starts the file: the header for `dof` joints, with or without the desired joints, and the
+    /// input's `extra_columns`.
+    pub fn create(
+        path: &Path,
+        dof: usize,
+        with_desired_joints: bool,
+        extra_columns: &[String],
+    ) -> Result<Self> {
+        Self::start(
+            AtomicFile::create(path)?,
+            path,
+            dof,
+            with_desired_joints,
+            extra_columns,
+        )
+    }
+
+    /// Completes the file: renames it into place.
+    pub fn commit(self) -> Result<()> {
+        let path = self.path;
+        let io = |e: std::io::Error| Error::Io {
+            path: path.clone(),
+            source: e,
+        };
+        let mut out = self
+            .w
+            .into_inner()
+            .map_err(|e| io(std::io::Error::other(e.to_string())))?;
+        out.flush().map_err(io)?;
+        out.commit()
+    }
+}
+
+impl CommandedWriter<Vec<u8>> {
+    /// Starts the text in memory (`path` only names it in messages).
+    pub fn in_memory(
+        path: &Path,
+        dof: usize,
+        with_desired_joints: bool,
+        extra_columns: &[String],
+    ) -> Result<Self> {
+        Self::start(Vec::new(), path, dof, with_desired_joints, extra_columns)
+    }
+
+    /// The complete text.
+    pub fn into_bytes(self) -> Result<Vec<u8>> {
+        let path = self.path;
+        self.w.into_inner().map_err(|e| Error::Io {
+            path,
+            source: std::io::Error::other(e.to_string()),
+        })
+    }
+}
+
+impl<W: Write> CommandedWriter<W> {
+    fn start(
+        sink: W,
+        path: &Path,
+        dof: usize,
+        with_desired_joints: bool,
+        extra_columns: &[String],
+    ) -> Result<Self> {
+        let mut header = commanded_header(dof, with_desired_joints);
+        header.extend(extra_columns.iter().cloned());
+        let mut w = csv::Writer::from_writer(sink);
+        w.write_record(&header).map_err(|e| csv_io(path, e))?;
+        Ok(CommandedWriter {
+            path: path.to_owned(),
+            w,
+            dof,
+            with_desired_joints,
+            extra: extra_columns.len(),
+            fields: Vec::with_capacity(header.len()),
+        })
+    }
+
+    /// Writes one row: the compensation, the desired joints (rad; exactly when the file was
+    /// created with them) and the input's extra values.
+    pub fn write(
+        &mut self,
+        c: &Compensation,
+        desired_joints: Option<&[f64]>,
+        extra: &[String],
+    ) -> Result<()> {
+        let lengths_ok = c.commanded.len() == self.dof
+            && extra.len() == self.extra
+            && match desired_joints {
+                Some(d) => self.with_desired_joints && d.len() == self.dof,
+                None => !self.with_desired_joints,
+            };
+        if !lengths_ok {
+            return Err(Error::invalid(
+                "commanded file",
+                "a row does not match the header (joints, desired joints or extra columns)",
+            ));
+        }
+        let f = &mut self.fields;
         f.clear();
         f.extend(
             c.commanded
@@ -151,14 +257,18 @@ pub fn commanded_csv(
         );
         f.extend(c.desired_position.iter().map(|v| format!("{v:.9}")));
         if let Some(d) = desired_joints {
-            f.extend(d[k].iter().map(|v| format!("{:.10}", v.to_degrees())));
+            f.extend(d.iter().map(|v| format!("{:.10}", v.to_degrees())));
         }
-        f.extend(extra_rows[k].iter().cloned());
-        w.write_record(&f)
-            .map_err(|e| io(std::io::Error::other(e)))?;
+        f.extend(extra.iter().cloned());
+        self.w.write_record(&*f).map_err(|e| csv_io(&self.path, e))
     }
-    w.into_inner()
-        .map_err(|e| io(std::io::Error::other(e.to_string())))
+}
+
+fn csv_io(path: &Path, e: csv::Error) -> Error {
+    Error::Io {
+        path: path.to_owned(),
+        source: std::io::Error::other(e),
+    }
 }
 
 /// Counts of each status in `rows`, in [`IkStatus::ALL`] order.

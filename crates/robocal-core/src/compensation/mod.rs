@@ -17,7 +17,7 @@ mod dls;
 mod targets;
 
 pub use dls::DampedLeastSquares;
-pub use targets::{read_targets, Target, TargetSet};
+pub use targets::{parse_targets, read_targets, Target, TargetSet};
 
 use crate::error::{Error, Result};
 use crate::model::{Robot, MAX_JOINTS};

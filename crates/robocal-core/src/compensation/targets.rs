@@ -32,10 +32,7 @@ pub struct TargetSet {
 
 /// Reads a target file for a robot with `dof` joints.
 pub fn read_targets(path: &Path, dof: usize) -> Result<TargetSet> {
-    let file = std::fs::File::open(path).map_err(|e| Error::Io {
-        path: path.to_owned(),
-        source: e,
-    })?;
+    let file = crate::io::input::open_input(path)?;
     parse_targets(std::io::BufReader::new(file), path, dof)
 }
 
@@ -44,17 +41,7 @@ pub fn parse_targets<R: std::io::Read>(reader: R, path: &Path, dof: usize) -> Re
     let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
         Error::parse(path, line, field, msg)
     };
-    let csv_err = |e: csv::Error| {
-        let line = e.position().map(|p| p.line() as usize);
-        let msg = match e.kind() {
-            csv::ErrorKind::UnequalLengths {
-                expected_len, len, ..
-            } => format!("{len} fields, but the header has {expected_len}"),
-            csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_owned(),
-            _ => e.to_string(),
-        };
-        Error::parse(path, line, None, msg)
-    };
+    let csv_err = |e: csv::Error| crate::io::measurements::csv_error(path, e);
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::All)

@@ -180,6 +180,7 @@ impl Calibration {
             "max_iterations": s.solver.max_iterations,
             "step_tolerance_mm": s.solver.step_tolerance_mm,
             "gradient_tolerance": s.solver.gradient_tolerance,
+            "objective_tolerance": s.solver.objective_tolerance,
             "beta": (0..self.nominal.dof())
                 .filter(|&i| self.nominal.beta_enabled(i))
                 .map(|i| format!("beta{}", i + 1))
@@ -248,6 +249,18 @@ impl Calibration {
             points["validation"] = points_json(v);
         }
         extra.insert("points".into(), points);
+        // A result is a calibration only when the solver converged; otherwise it is marked
+        // partial so that no reader takes it for one.
+        let termination = &self.solver().termination;
+        if termination.converged() {
+            extra.insert("status".into(), json!(crate::io::result::STATUS_CALIBRATED));
+        } else {
+            extra.insert("status".into(), json!(crate::io::result::STATUS_PARTIAL));
+            extra.insert(
+                "partial_reason".into(),
+                json!(format!("the solver {}", termination.describe())),
+            );
+        }
         CalibrationResult {
             robot: RobotInfo {
                 name: self.nominal.name().to_owned(),

@@ -25,6 +25,14 @@ pub struct SolverOptions {
     /// Converged when, for every parameter, the cosine between its (weighted) Jacobian column and
     /// the (weighted) residual vector is below this (MINPACK's gtol).
     pub gradient_tolerance: f64,
+    /// Converged when an accepted step lowered the objective by less than this fraction of it and
+    /// the model predicted no more (MINPACK's ftol), or when the next step, lightly damped
+    /// (lambda at most `initial_lambda`), is predicted to gain less (checked before the step is
+    /// taken, so that a solve restarted at the solution does not move). The sum of norms creeps towards its minimum when some points are fitted
+    /// exactly (its kinks, smoothed by 1e-6 mm): without this test the steps shrink below a
+    /// micrometre but not below `step_tolerance_mm`, and the solver runs into the iteration
+    /// limit with nothing left to gain.
+    pub objective_tolerance: f64,
     /// Initial damping, relative to `diag(A)`.
     pub initial_lambda: f64,
 }
@@ -32,9 +40,10 @@ pub struct SolverOptions {
 impl Default for SolverOptions {
     fn default() -> Self {
         SolverOptions {
-            max_iterations: 200,
+            max_iterations: 1000,
             step_tolerance_mm: 1e-9,
             gradient_tolerance: 1e-10,
+            objective_tolerance: 1e-9,
             initial_lambda: 1e-3,
         }
     }
@@ -48,6 +57,9 @@ pub enum Termination {
     ConvergedStep,
     /// The gradient vanished (relative to `gradient_tolerance`), or the fit is exact.
     ConvergedGradient,
+    /// The objective changes by less than `objective_tolerance` (relative): an accepted step
+    /// gained less and the model predicted no more, or the next step is predicted to gain less.
+    ConvergedObjective,
     /// `max_iterations` reached before convergence.
     MaxIterations,
     /// Numerical failure (non-finite values, no descent direction); see the message.
@@ -59,7 +71,9 @@ impl Termination {
     pub fn converged(&self) -> bool {
         matches!(
             self,
-            Termination::ConvergedStep | Termination::ConvergedGradient
+            Termination::ConvergedStep
+                | Termination::ConvergedGradient
+                | Termination::ConvergedObjective
         )
     }
 
@@ -68,6 +82,9 @@ impl Termination {
         match self {
             Termination::ConvergedStep => "converged (step below tolerance)".into(),
             Termination::ConvergedGradient => "converged (gradient below tolerance)".into(),
+            Termination::ConvergedObjective => {
+                "converged (objective change below tolerance)".into()
+            }
             Termination::MaxIterations => "stopped at the iteration limit".into(),
             Termination::Failed(m) => format!("failed: {m}"),
         }
@@ -154,11 +171,13 @@ pub fn solve(
         for j in 0..k {
             d[j] = d[j].max(acc.a[(j, j)]).max(f64::MIN_POSITIVE);
         }
+        let mut first_try = true;
         loop {
             // Newton's model first (fast near the minimum), then the reweighted one (a
             // majorizer: reliable far from it and for exact fits).
             let mut best_step = f64::INFINITY;
             let mut accepted = false;
+            let mut small_change = false;
             for use_newton in [true, false] {
                 let model = match (use_newton, &acc.h) {
                     (true, Some(h)) => h,
@@ -168,6 +187,15 @@ pub fn solve(
                 if !damped_solve(model, &d, lambda, &acc.b, &mut m, &mut delta) {
                     continue;
                 }
+                let pred = acc.b.dot(&delta) - 0.5 * delta.dot(&(model * &delta));
+                if first_try
+                    && lambda <= opts.initial_lambda
+                    && pred <= opts.objective_tolerance * acc.objective.abs()
+                {
+                    report.termination = Termination::ConvergedObjective;
+                    break 'outer;
+                }
+                first_try = false;
                 let step = (0..k)
                     .map(|j| delta[j].abs() * col_rms[j])
                     .fold(0.0, f64::max);
@@ -178,9 +206,10 @@ pub fn solve(
                 problem.apply(&mut trial, &x_new);
                 let f_new = problem.objective(&trial, loss);
                 report.evaluations += 1;
-                let pred = acc.b.dot(&delta) - 0.5 * delta.dot(&(model * &delta));
                 let gain = (acc.objective - f_new) / pred;
                 if f_new.is_finite() && pred > 0.0 && gain > 1e-4 {
+                    let tol = opts.objective_tolerance * acc.objective.abs();
+                    small_change = acc.objective - f_new <= tol && pred <= tol;
                     lambda *= (1.0 - (2.0 * gain - 1.0).powi(3)).max(1.0 / 3.0);
                     accepted = true;
                     break;
@@ -193,6 +222,10 @@ pub fn solve(
                 nu = 2.0;
                 if report.last_step_mm <= opts.step_tolerance_mm {
                     report.termination = Termination::ConvergedStep;
+                    break 'outer;
+                }
+                if small_change {
+                    report.termination = Termination::ConvergedObjective;
                     break 'outer;
                 }
                 acc = problem.accumulate(robot, loss, level);

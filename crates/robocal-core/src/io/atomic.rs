@@ -62,16 +62,22 @@ impl AtomicFile {
         &self.target
     }
 
-    /// Flushes, syncs and renames the temporary file over the target.
+    /// Flushes, syncs and renames the temporary file over the target. On failure the temporary
+    /// file is removed and the target is left as it was.
     pub fn commit(mut self) -> Result<()> {
-        let mut w = self.file.take().expect("not yet committed");
-        w.flush().map_err(|e| io_err(&self.target, e))?;
-        let f = w
-            .into_inner()
-            .map_err(|e| io_err(&self.target, e.into_error()))?;
-        f.sync_all().map_err(|e| io_err(&self.target, e))?;
-        drop(f);
-        std::fs::rename(&self.tmp, &self.target).map_err(|e| io_err(&self.target, e))
+        let Some(mut w) = self.file.take() else {
+            return Ok(());
+        };
+        let done = w
+            .flush()
+            .and_then(|()| w.into_inner().map_err(|e| e.into_error()))
+            .and_then(|f| f.sync_all())
+            .and_then(|()| std::fs::rename(&self.tmp, &self.target));
+        if let Err(e) = done {
+            let _ = std::fs::remove_file(&self.tmp);
+            return Err(io_err(&self.target, e));
+        }
+        Ok(())
     }
 }
 
@@ -125,6 +131,25 @@ mod tests {
             .to_string();
         assert!(e.contains("/nonexistent-dir-robocal/x.csv"), "{e}");
         assert!(e.contains("does not exist"), "{e}");
+    }
+
+    #[test]
+    fn failed_rename_leaves_no_temporary_file() {
+        let dir = std::env::temp_dir().join(format!("robocal-atomic-mv-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("r.json");
+        let mut f = AtomicFile::create(&p).unwrap();
+        f.write_all(b"new").unwrap();
+        // The target turns into a non-empty directory before the commit: rename fails.
+        std::fs::create_dir_all(p.join("x")).unwrap();
+        let e = f.commit().unwrap_err().to_string();
+        assert!(e.contains("r.json"), "{e}");
+        let names: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, vec![std::ffi::OsString::from("r.json")]);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

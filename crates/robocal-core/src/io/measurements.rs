@@ -82,11 +82,7 @@ impl MeasurementSet {
 
 /// Reads a measurement CSV for a robot with `dof` joints.
 pub fn read_measurements(path: &Path, dof: usize, positions: Positions) -> Result<MeasurementSet> {
-    let file = std::fs::File::open(path).map_err(|e| Error::Io {
-        path: path.to_owned(),
-        source: e,
-    })?;
-    parse_measurements(std::io::BufReader::new(file), path, dof, positions)
+    MeasurementReader::open(path, dof, positions)?.read_all()
 }
 
 fn is_joint_column(name: &str) -> Option<usize> {
@@ -104,171 +100,277 @@ pub fn parse_measurements<R: Read>(
     dof: usize,
     positions: Positions,
 ) -> Result<MeasurementSet> {
-    let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
-        Error::parse(path, line, field, msg)
-    };
-    let mut rdr = csv::ReaderBuilder::new()
-        .has_headers(true)
-        .trim(csv::Trim::All)
-        .flexible(false)
-        .from_reader(reader);
-    let headers = rdr
-        .headers()
-        .map_err(|e| csv_error(path, e))?
-        .iter()
-        .map(|h| h.trim_start_matches('\u{feff}').to_owned())
-        .collect::<Vec<_>>();
-    if headers.is_empty() || headers.iter().all(|h| h.is_empty()) {
-        return Err(perr(
-            Some(1),
-            None,
-            format!("empty file: expected a header row with q1..q{dof} and x,y,z"),
-        ));
+    MeasurementReader::new(reader, path, dof, positions)?.read_all()
+}
+
+/// A measurement (or joint) file read one row at a time, so that files of millions of rows need
+/// no more memory than one row: the header is checked by [`MeasurementReader::new`], each
+/// [`MeasurementReader::next_row`] parses and checks one row, and [`MeasurementReader::finish`]
+/// rejects a file without rows and returns the warnings. [`read_measurements`] is this reader
+/// collecting every row.
+pub struct MeasurementReader<R: Read> {
+    rdr: csv::Reader<R>,
+    path: PathBuf,
+    dof: usize,
+    headers: Vec<String>,
+    q_col: Vec<usize>,
+    xyz_col: Option<[usize; 3]>,
+    extra: Vec<usize>,
+    extra_columns: Vec<String>,
+    record: csv::StringRecord,
+    rows: usize,
+    max_abs_deg: f64,
+}
+
+impl MeasurementReader<std::io::BufReader<std::fs::File>> {
+    /// Opens a measurement file for a robot with `dof` joints and checks its header.
+    pub fn open(path: &Path, dof: usize, positions: Positions) -> Result<Self> {
+        let file = crate::io::input::open_input(path)?;
+        MeasurementReader::new(std::io::BufReader::new(file), path, dof, positions)
     }
-    let mut q_col = vec![None; dof];
-    let mut xyz_col = [None; 3];
-    let mut extra = Vec::new();
-    let mut extra_columns = Vec::new();
-    for (k, h) in headers.iter().enumerate() {
-        if h.is_empty() {
+}
+
+impl<R: Read> MeasurementReader<R> {
+    /// Reads and checks the header of measurement CSV text; `path` is used in messages.
+    pub fn new(reader: R, path: &Path, dof: usize, positions: Positions) -> Result<Self> {
+        let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
+            Error::parse(path, line, field, msg)
+        };
+        let mut rdr = csv::ReaderBuilder::new()
+            .has_headers(true)
+            .trim(csv::Trim::All)
+            .flexible(false)
+            .from_reader(reader);
+        let headers = rdr
+            .headers()
+            .map_err(|e| csv_error(path, e))?
+            .iter()
+            .map(|h| h.trim_start_matches('\u{feff}').to_owned())
+            .collect::<Vec<_>>();
+        if headers.is_empty() || headers.iter().all(|h| h.is_empty()) {
             return Err(perr(
                 Some(1),
                 None,
-                format!("column {} has an empty name", k + 1),
+                format!("empty file: expected a header row with q1..q{dof} and x,y,z"),
             ));
         }
-        if headers[..k].contains(h) {
-            return Err(perr(Some(1), Some(h), "column appears twice".into()));
-        }
-        if let Some(j) = is_joint_column(h) {
-            if j == 0 || j > dof {
+        let mut q_col = vec![None; dof];
+        let mut xyz_col = [None; 3];
+        let mut extra = Vec::new();
+        let mut extra_columns = Vec::new();
+        for (k, h) in headers.iter().enumerate() {
+            if h.is_empty() {
                 return Err(perr(
                     Some(1),
-                    Some(h),
-                    format!(
-                        "the robot has {dof} joints (q1..q{dof}); this file has a column `{h}`"
-                    ),
+                    None,
+                    format!("column {} has an empty name", k + 1),
                 ));
             }
-            q_col[j - 1] = Some(k);
-            continue;
-        }
-        let axis = ["x", "y", "z"].iter().position(|a| a == h);
-        match (axis, positions) {
-            (Some(a), Positions::Required | Positions::Optional) => xyz_col[a] = Some(k),
-            _ => {
-                extra.push(k);
-                extra_columns.push(h.clone());
+            if headers[..k].contains(h) {
+                return Err(perr(Some(1), Some(h), "column appears twice".into()));
+            }
+            if let Some(j) = is_joint_column(h) {
+                if j == 0 || j > dof {
+                    return Err(perr(
+                        Some(1),
+                        Some(h),
+                        format!(
+                            "the robot has {dof} joints (q1..q{dof}); this file has a column `{h}`"
+                        ),
+                    ));
+                }
+                q_col[j - 1] = Some(k);
+                continue;
+            }
+            let axis = ["x", "y", "z"].iter().position(|a| a == h);
+            match (axis, positions) {
+                (Some(a), Positions::Required | Positions::Optional) => xyz_col[a] = Some(k),
+                _ => {
+                    extra.push(k);
+                    extra_columns.push(h.clone());
+                }
             }
         }
+        let mut q = Vec::with_capacity(dof);
+        for (j, c) in q_col.iter().enumerate() {
+            match c {
+                Some(c) => q.push(*c),
+                None => {
+                    return Err(perr(
+                        Some(1),
+                        Some(&format!("q{}", j + 1)),
+                        format!(
+                            "missing column (the robot has {dof} joints: q1..q{dof}; header is \
+                             `{}`)",
+                            headers.join(",")
+                        ),
+                    ))
+                }
+            }
+        }
+        let n_xyz = xyz_col.iter().filter(|c| c.is_some()).count();
+        let xyz_col = match xyz_col {
+            [Some(x), Some(y), Some(z)] => Some([x, y, z]),
+            _ if positions == Positions::Required || n_xyz > 0 => {
+                let a = xyz_col.iter().position(Option::is_none).unwrap_or(0);
+                return Err(perr(
+                    Some(1),
+                    Some(["x", "y", "z"][a]),
+                    "missing column (measured positions need x,y,z in mm)".into(),
+                ));
+            }
+            _ => None,
+        };
+        Ok(MeasurementReader {
+            rdr,
+            path: path.to_owned(),
+            dof,
+            headers,
+            q_col: q,
+            xyz_col,
+            extra,
+            extra_columns,
+            record: csv::StringRecord::new(),
+            rows: 0,
+            max_abs_deg: 0.0,
+        })
     }
-    if let Some(j) = q_col.iter().position(Option::is_none) {
-        return Err(perr(
-            Some(1),
-            Some(&format!("q{}", j + 1)),
-            format!(
-                "missing column (the robot has {dof} joints: q1..q{dof}; header is `{}`)",
-                headers.join(",")
-            ),
-        ));
+
+    /// Names of the columns other than `q1..qn` and `x,y,z`, in file order.
+    pub fn extra_columns(&self) -> &[String] {
+        &self.extra_columns
     }
-    let n_xyz = xyz_col.iter().filter(|c| c.is_some()).count();
-    if positions == Positions::Required || n_xyz > 0 {
-        if let Some(a) = xyz_col.iter().position(Option::is_none) {
-            return Err(perr(
-                Some(1),
-                Some(["x", "y", "z"][a]),
-                "missing column (measured positions need x,y,z in mm)".into(),
-            ));
+
+    /// Whether the file has `x,y,z` columns (and reads them).
+    pub fn has_positions(&self) -> bool {
+        self.xyz_col.is_some()
+    }
+
+    /// The file's description without rows (path, joint count, extra columns): what row-wise
+    /// consumers need to interpret a row.
+    pub fn header(&self) -> MeasurementSet {
+        MeasurementSet {
+            path: self.path.clone(),
+            dof: self.dof,
+            extra_columns: self.extra_columns.clone(),
+            rows: Vec::new(),
+            warnings: Vec::new(),
         }
     }
-    let has_xyz = n_xyz == 3;
-    let mut rows = Vec::new();
-    let mut record = csv::StringRecord::new();
-    loop {
-        match rdr.read_record(&mut record) {
-            Ok(false) => break,
-            Ok(true) => {}
-            Err(e) => return Err(csv_error(path, e)),
+
+    /// The next data row (blank rows are skipped), `None` at the end of the file. Fails naming
+    /// the line and the column of a malformed cell.
+    pub fn next_row(&mut self) -> Result<Option<Measurement>> {
+        loop {
+            match self.rdr.read_record(&mut self.record) {
+                Ok(false) => return Ok(None),
+                Ok(true) => {}
+                Err(e) => return Err(csv_error(&self.path, e)),
+            }
+            if !self.record.iter().all(|f| f.is_empty()) {
+                break;
+            }
         }
-        let line = record.position().map(|p| p.line() as usize).unwrap_or(0);
-        if record.iter().all(|f| f.is_empty()) {
-            continue;
-        }
+        let line = self
+            .record
+            .position()
+            .map(|p| p.line() as usize)
+            .unwrap_or(0);
         let num = |k: usize| -> Result<f64> {
-            let s = &record[k];
-            let field = Some(headers[k].as_str());
+            let s = &self.record[k];
+            let field = Some(self.headers[k].as_str());
+            let perr = |msg: String| Error::parse(&self.path, Some(line), field, msg);
             if s.is_empty() {
-                return Err(perr(Some(line), field, "empty cell".into()));
+                return Err(perr("empty cell".into()));
             }
             let v: f64 = s
                 .parse()
-                .map_err(|_| perr(Some(line), field, format!("`{s}` is not a number")))?;
+                .map_err(|_| perr(format!("`{s}` is not a number")))?;
             if !v.is_finite() {
-                return Err(perr(
-                    Some(line),
-                    field,
-                    format!("`{s}` is not a finite number"),
-                ));
+                return Err(perr(format!("`{s}` is not a finite number")));
             }
             Ok(v)
         };
-        let mut q = Vec::with_capacity(dof);
-        for c in &q_col {
-            q.push(num(c.expect("checked"))?.to_radians());
+        let mut q = Vec::with_capacity(self.dof);
+        for &c in &self.q_col {
+            let v = num(c)?;
+            self.max_abs_deg = self.max_abs_deg.max(v.abs());
+            q.push(v.to_radians());
         }
-        let p = if has_xyz {
-            Some(Vector3::new(
-                num(xyz_col[0].expect("checked"))?,
-                num(xyz_col[1].expect("checked"))?,
-                num(xyz_col[2].expect("checked"))?,
-            ))
-        } else {
-            None
+        let p = match self.xyz_col {
+            Some([x, y, z]) => Some(Vector3::new(num(x)?, num(y)?, num(z)?)),
+            None => None,
         };
-        rows.push(Measurement {
+        self.rows += 1;
+        Ok(Some(Measurement {
             line,
             q,
             p,
-            extra: extra.iter().map(|&k| record[k].to_owned()).collect(),
-        });
+            extra: self
+                .extra
+                .iter()
+                .map(|&k| self.record[k].to_owned())
+                .collect(),
+        }))
     }
-    if rows.is_empty() {
-        return Err(perr(
-            None,
-            None,
-            "no data rows after the header".to_string(),
-        ));
+
+    /// Ends the reading: fails if the file had no data rows; returns the warnings (e.g. joint
+    /// values that look like radians).
+    pub fn finish(self) -> Result<Vec<String>> {
+        if self.rows == 0 {
+            return Err(Error::parse(
+                &self.path,
+                None,
+                None,
+                "no data rows after the header".to_string(),
+            ));
+        }
+        let mut warnings = Vec::new();
+        // Radians of any joint range (up to a full turn each way) are within ±2π; a real session
+        // in degrees moves some joint further than 6.3 degrees.
+        if self.rows >= 3
+            && self.max_abs_deg > 0.0
+            && self.max_abs_deg <= std::f64::consts::TAU + 1e-9
+        {
+            warnings.push(format!(
+                "{}: every joint value is within ±{:.3} (±2π); they look like radians, but files \
+                 hold degrees",
+                self.path.display(),
+                self.max_abs_deg
+            ));
+        }
+        Ok(warnings)
     }
-    let mut warnings = Vec::new();
-    let max_abs_deg = rows
-        .iter()
-        .flat_map(|r| r.q.iter())
-        .fold(0.0f64, |m, v| m.max(v.to_degrees().abs()));
-    if rows.len() >= 3 && max_abs_deg > 0.0 && max_abs_deg <= std::f64::consts::PI + 1e-9 {
-        warnings.push(format!(
-            "{}: every joint value is within ±{:.3}; they look like radians, but files hold degrees",
-            path.display(),
-            max_abs_deg
-        ));
+
+    /// Reads every remaining row into a [`MeasurementSet`].
+    pub fn read_all(mut self) -> Result<MeasurementSet> {
+        let mut set = self.header();
+        while let Some(r) = self.next_row()? {
+            set.rows.push(r);
+        }
+        set.warnings = self.finish()?;
+        Ok(set)
     }
-    Ok(MeasurementSet {
-        path: path.to_owned(),
-        dof,
-        extra_columns,
-        rows,
-        warnings,
-    })
 }
 
-fn csv_error(path: &Path, e: csv::Error) -> Error {
+/// A CSV reader's error as a robocal error: an I/O failure (e.g. the path is a directory) as
+/// [`Error::Io`], anything else as [`Error::Parse`] with the line.
+pub(crate) fn csv_error(path: &Path, e: csv::Error) -> Error {
     let line = e.position().map(|p| p.line() as usize);
     let msg = match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..
         } => format!("{len} fields, but the header has {expected_len}"),
         csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_owned(),
-        csv::ErrorKind::Io(io) => io.to_string(),
+        csv::ErrorKind::Io(_) => {
+            return match e.into_kind() {
+                csv::ErrorKind::Io(source) => Error::Io {
+                    path: path.to_owned(),
+                    source,
+                },
+                other => Error::parse(path, line, None, format!("{other:?}")),
+            }
+        }
         _ => e.to_string(),
     };
     Error::parse(path, line, None, msg)

@@ -1,12 +1,13 @@
 //! File formats: measurement CSV, atomic output, calibration results.
 
 pub mod atomic;
+pub mod input;
 pub mod measurements;
 pub mod result;
 
 pub use atomic::{write_all_atomic, write_atomic, AtomicFile};
 pub use measurements::{
-    parse_measurements, read_measurements, write_measurements, Measurement, MeasurementSet,
-    Positions,
+    parse_measurements, read_measurements, write_measurements, Measurement, MeasurementReader,
+    MeasurementSet, Positions,
 };
 pub use result::CalibrationResult;

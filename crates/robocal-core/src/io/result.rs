@@ -12,6 +12,12 @@ use indexmap::IndexMap;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// The value of a result's `status` key when the solver converged: a calibration.
+pub const STATUS_CALIBRATED: &str = "calibrated";
+/// The value of a result's `status` key when the solver did not converge and the result was kept
+/// anyway (`robocal calibrate --keep-partial`): not a calibration.
+pub const STATUS_PARTIAL: &str = "partial";
+
 /// Which robot a result belongs to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RobotInfo {
@@ -120,23 +126,13 @@ pub struct CalibrationResult {
 impl CalibrationResult {
     /// Reads a result file, naming the file and line on malformed JSON or missing keys.
     pub fn read(path: &Path) -> Result<CalibrationResult> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: path.to_owned(),
-            source: e,
-        })?;
+        let text = crate::io::input::read_text(path)?;
         Self::parse(&text, path)
     }
 
     /// Parses result JSON; `path` is used in messages.
     pub fn parse(text: &str, path: &Path) -> Result<CalibrationResult> {
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let r: CalibrationResult = serde_json::from_str(text).map_err(|e| {
-            let line = (e.line() > 0).then_some(e.line());
-            let msg = e.to_string();
-            // serde_json appends " at line L column C"; the line is reported separately.
-            let msg = msg.split(" at line ").next().unwrap_or(&msg).to_owned();
-            Error::parse(path, line, None, format!("not a robocal result: {msg}"))
-        })?;
+        let r: CalibrationResult = crate::io::input::parse_json(text, path, "robocal result")?;
         for (name, p) in &r.parameters {
             if !p.nominal.is_finite() || !p.calibrated.is_finite() {
                 return Err(Error::parse(
@@ -168,6 +164,34 @@ impl CalibrationResult {
             .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
         s.push('\n');
         crate::io::atomic::write_atomic(path, s.as_bytes())
+    }
+
+    /// Why this result is not a finished calibration, if it is not: its `status` is
+    /// [`STATUS_PARTIAL`] (`partial_reason` says why), or its solver report says it did not
+    /// converge (`solver.converged` = false). `None` for a calibration, and for files without
+    /// these keys.
+    pub fn partial_reason(&self) -> Option<String> {
+        let status = self.extra.get("status").and_then(|s| s.as_str());
+        let converged = self
+            .extra
+            .get("solver")
+            .and_then(|s| s.get("converged"))
+            .and_then(|c| c.as_bool());
+        if status != Some(STATUS_PARTIAL) && converged != Some(false) {
+            return None;
+        }
+        let reason = self.extra.get("partial_reason").and_then(|r| r.as_str());
+        let termination = self
+            .extra
+            .get("solver")
+            .and_then(|s| s.get("termination"))
+            .and_then(|t| t.as_str());
+        Some(match (reason, converged, termination) {
+            (Some(r), _, _) => r.to_owned(),
+            (None, Some(false), Some(t)) => format!("the solver {t}"),
+            (None, Some(false), None) => "the solver did not converge".to_owned(),
+            _ => format!("marked \"status\": \"{STATUS_PARTIAL}\""),
+        })
     }
 
     /// The tracker frame as a rigid transform.

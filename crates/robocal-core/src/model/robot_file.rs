@@ -67,10 +67,7 @@ pub fn load_robot(arg: &str) -> Result<Robot> {
 
 /// Reads a TOML robot description.
 pub fn load_robot_file(path: &Path) -> Result<Robot> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-        path: path.to_owned(),
-        source: e,
-    })?;
+    let text = crate::io::input::read_text(path)?;
     parse_robot_toml(&text, path)
 }
 

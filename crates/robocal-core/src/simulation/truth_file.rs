@@ -92,17 +92,13 @@ impl TruthFile {
 
     /// Reads a truth file, naming the file and line on malformed JSON.
     pub fn read(path: &Path) -> Result<TruthFile> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::Io {
-            path: path.to_owned(),
-            source: e,
-        })?;
-        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
-        serde_json::from_str(text).map_err(|e| {
-            let line = (e.line() > 0).then_some(e.line());
-            let msg = e.to_string();
-            let msg = msg.split(" at line ").next().unwrap_or(&msg).to_owned();
-            Error::parse(path, line, None, format!("not a robocal truth file: {msg}"))
-        })
+        let text = crate::io::input::read_text(path)?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses truth-file JSON; `path` is used in messages (file, line and field).
+    pub fn parse(text: &str, path: &Path) -> Result<TruthFile> {
+        crate::io::input::parse_json(text, path, "robocal truth file")
     }
 
     /// The true robot: `nominal` with every parameter set to its true value. Fails, naming the
@@ -121,6 +117,41 @@ impl TruthFile {
                     nominal.dof()
                 ),
             ));
+        }
+        if self.robot.convention != nominal.convention().as_str() {
+            return Err(bad(
+                "robot.convention",
+                format!(
+                    "truth robot `{}` uses {} parameters, the nominal robot `{}` uses {}",
+                    self.robot.name,
+                    self.robot.convention,
+                    nominal.name(),
+                    nominal.convention().as_str()
+                ),
+            ));
+        }
+        // The file's nominal values must be this robot's: a truth file made for another robot of
+        // the same shape would otherwise simulate nonsense.
+        for p in nominal.params() {
+            let name = p.name();
+            let Some(e) = self.parameters.get(&name) else {
+                continue;
+            };
+            let mine = nominal.get_display(p);
+            if !e.nominal.is_finite() || (e.nominal - mine).abs() > 1e-6 + 1e-9 * mine.abs() {
+                return Err(bad(
+                    &format!("parameters.{name}.nominal"),
+                    format!(
+                        "the truth file was made for a nominal robot (`{}`) with {name} = {} {}, \
+                         but robot `{}` has {mine} {}: wrong --robot or wrong truth file",
+                        self.nominal,
+                        e.nominal,
+                        e.unit.as_str(),
+                        nominal.name(),
+                        p.unit().as_str()
+                    ),
+                ));
+            }
         }
         let mut r = nominal.clone();
         r.set_name(self.robot.name.clone());
@@ -205,6 +236,16 @@ mod tests {
         unknown.parameters.insert("a9".into(), entry);
         let e = unknown.truth_robot(&nominal, p).unwrap_err().to_string();
         assert!(e.contains("parameters.a9"), "{e}");
+
+        let mut conv = tf.clone();
+        conv.robot.convention = "dh".into();
+        let e = conv.truth_robot(&nominal, p).unwrap_err().to_string();
+        assert!(e.contains("robot.convention"), "{e}");
+
+        let mut shifted = tf.clone();
+        shifted.parameters.get_mut("a2").unwrap().nominal += 1.0;
+        let e = shifted.truth_robot(&nominal, p).unwrap_err().to_string();
+        assert!(e.contains("parameters.a2.nominal"), "{e}");
 
         let mut other = tf.clone();
         other.robot.dof = 7;

@@ -1,0 +1,186 @@
+//! Row-by-row evaluation, for data sets too large to hold: [`Evaluator`] computes one row's
+//! errors (eq. 3) under both references, [`PerPointWriter`] writes them as they come. A caller
+//! keeps only the error norms (8 bytes per row and series) for the statistics.
+//! [`super::evaluate`] and [`super::Evaluation::write_per_point`] are these two over a whole set.
+
+use super::{has_desired_columns, Against, DesiredSource, Reference};
+use crate::error::{Error, Result};
+use crate::frame::Frame;
+use crate::io::{AtomicFile, Measurement, MeasurementSet};
+use crate::model::Robot;
+use nalgebra::{Point3, Vector3};
+use std::io::Write;
+use std::path::Path;
+
+/// Computes the errors of measured rows of one file (see the module docs of
+/// [`crate::evaluation`]).
+pub struct Evaluator<'a> {
+    nominal: &'a Robot,
+    calibrated: &'a Robot,
+    tracker_frame: &'a Frame,
+    header: &'a MeasurementSet,
+    reference: Reference,
+    desired: Option<DesiredSource>,
+}
+
+impl<'a> Evaluator<'a> {
+    /// An evaluator for the rows of a file described by `header` (path, joint count and extra
+    /// columns; its rows are not used): checks the joint count and, for [`Against::Desired`],
+    /// that the file has desired columns.
+    pub fn new(
+        nominal: &'a Robot,
+        calibrated: &'a Robot,
+        tracker_frame: &'a Frame,
+        header: &'a MeasurementSet,
+        against: Against,
+    ) -> Result<Evaluator<'a>> {
+        if nominal.dof() != header.dof || calibrated.dof() != header.dof {
+            return Err(Error::invalid(
+                header.path.display().to_string(),
+                format!(
+                    "read for {} joints, the robot has {}",
+                    header.dof,
+                    nominal.dof()
+                ),
+            ));
+        }
+        let reference = match against {
+            Against::Model => Reference::Model,
+            Against::Desired => Reference::Desired,
+            Against::Auto if has_desired_columns(header) => Reference::Desired,
+            Against::Auto => Reference::Model,
+        };
+        let desired = match reference {
+            Reference::Desired => Some(DesiredSource::find(header, nominal.dof())?),
+            Reference::Model => None,
+        };
+        Ok(Evaluator {
+            nominal,
+            calibrated,
+            tracker_frame,
+            header,
+            reference,
+            desired,
+        })
+    }
+
+    /// The reference chosen.
+    pub fn reference(&self) -> Reference {
+        self.reference
+    }
+
+    /// The two series' names and descriptions: `nominal` or `desired`, then `calibrated`.
+    pub fn series(&self) -> [(&'static str, &'static str); 2] {
+        match self.reference {
+            Reference::Model => [
+                ("nominal", "measured - nominal model at the measured joints"),
+                (
+                    "calibrated",
+                    "measured - calibrated model at the measured joints",
+                ),
+            ],
+            Reference::Desired => [
+                ("desired", "measured - desired position (eq. 13)"),
+                (
+                    "calibrated",
+                    "measured - calibrated model at the commanded joints",
+                ),
+            ],
+        }
+    }
+
+    /// The errors `P_act - P_ref` (mm, base frame) of one row under both series.
+    pub fn errors(&self, r: &Measurement) -> Result<[Vector3<f64>; 2]> {
+        let Some(m) = r.p else {
+            return Err(Error::parse(
+                &self.header.path,
+                Some(r.line),
+                None,
+                "no measured position (x,y,z)",
+            ));
+        };
+        let actual = (self.tracker_frame * Point3::from(m)).coords;
+        let first = match &self.desired {
+            None => self.nominal.tool_position(&r.q),
+            Some(source) => source.position(self.header, r, self.nominal)?,
+        };
+        Ok([actual - first, actual - self.calibrated.tool_position(&r.q)])
+    }
+}
+
+/// The per-point error file, written row by row and made visible only by
+/// [`PerPointWriter::commit`]: `line`, `q1..qn` (degrees), the input's extra columns, then for
+/// each series `dx_<name>,dy_<name>,dz_<name>,norm_<name>` (mm, base frame).
+pub struct PerPointWriter {
+    path: std::path::PathBuf,
+    w: csv::Writer<AtomicFile>,
+    fields: Vec<String>,
+}
+
+impl PerPointWriter {
+    /// Starts the file at `path` for the rows of the file `header` describes and the series
+    /// named `names`. Fails if an extra column of the input has the name of an output column.
+    pub fn create(path: &Path, header: &MeasurementSet, names: [&str; 2]) -> Result<Self> {
+        let mut head = vec!["line".to_owned()];
+        head.extend((1..=header.dof).map(|i| format!("q{i}")));
+        let own_start = head.len();
+        for name in names {
+            for c in ["dx", "dy", "dz", "norm"] {
+                head.push(format!("{c}_{name}"));
+            }
+        }
+        if let Some(c) = header.extra_columns.iter().find(|c| head.contains(c)) {
+            return Err(Error::parse(
+                &header.path,
+                Some(1),
+                Some(c),
+                "the per-point output has a column of this name; rename or remove it",
+            ));
+        }
+        let own: Vec<String> = head.drain(own_start..).collect();
+        head.extend(header.extra_columns.iter().cloned());
+        head.extend(own);
+        let mut w = csv::Writer::from_writer(AtomicFile::create(path)?);
+        w.write_record(&head).map_err(|e| csv_io(path, e))?;
+        Ok(PerPointWriter {
+            path: path.to_owned(),
+            w,
+            fields: Vec::with_capacity(head.len()),
+        })
+    }
+
+    /// Writes one row and its errors (in the series order of [`PerPointWriter::create`]).
+    pub fn write(&mut self, r: &Measurement, errors: &[Vector3<f64>; 2]) -> Result<()> {
+        let f = &mut self.fields;
+        f.clear();
+        f.push(r.line.to_string());
+        f.extend(r.q.iter().map(|v| format!("{:.9}", v.to_degrees())));
+        f.extend(r.extra.iter().cloned());
+        for e in errors {
+            f.extend([e.x, e.y, e.z, e.norm()].iter().map(|v| format!("{v:.6}")));
+        }
+        self.w.write_record(&*f).map_err(|e| csv_io(&self.path, e))
+    }
+
+    /// Completes the file: renames it into place.
+    pub fn commit(self) -> Result<()> {
+        let path = self.path;
+        let mut out = self
+            .w
+            .into_inner()
+            .map_err(|e| io_err(&path, std::io::Error::other(e.to_string())))?;
+        out.flush().map_err(|e| io_err(&path, e))?;
+        out.commit()
+    }
+}
+
+fn io_err(path: &Path, e: std::io::Error) -> Error {
+    Error::Io {
+        path: path.to_owned(),
+        source: e,
+    }
+}
+
+fn csv_io(path: &Path, e: csv::Error) -> Error {
+    io_err(path, std::io::Error::other(e))
+}
