@@ -11,6 +11,7 @@ mod tables;
 use clap::Parser;
 
 fn main() {
+    reset_sigpipe();
     let cli = cmd::Cli::parse();
     match cmd::run(cli) {
         Ok(()) => {}
@@ -20,3 +21,17 @@ fn main() {
         }
     }
 }
+
+/// Rust ignores SIGPIPE, so printing to a closed pipe (`robocal demo | head`) would panic; restore
+/// the default action so the program ends quietly, as Unix tools do.
+#[cfg(unix)]
+fn reset_sigpipe() {
+    // SAFETY: called first thing in main, before any other thread exists; SIG_DFL is a valid
+    // disposition for SIGPIPE.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
+#[cfg(not(unix))]
+fn reset_sigpipe() {}

@@ -192,3 +192,26 @@ fn unknown_preset_and_missing_file() {
     assert_eq!(o.status.code(), Some(4));
     assert!(stderr(&o).contains("missing/robot.toml"), "{}", stderr(&o));
 }
+
+/// `robocal ... | head`: a closed stdout ends the program quietly (SIGPIPE), never with a panic.
+#[cfg(unix)]
+#[test]
+fn closed_stdout_is_not_a_panic() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_robocal"))
+        .args(["robot", "show", "kuka-kr480-r3330"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let e = stderr(&o);
+    assert!(!e.contains("panicked"), "{e}");
+    assert!(
+        o.status.success() || o.status.signal() == Some(13),
+        "{:?}: {e}",
+        o.status
+    );
+}
