@@ -3,6 +3,7 @@
 
 use super::common;
 use crate::exit;
+use crate::tables::{layout, num};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use robocal_core::identification::{
@@ -469,70 +470,4 @@ fn print_report(c: &Calibration, converged: bool) {
             &after_cols
         )
     );
-}
-
-/// A number with `decimals` decimals, without a minus sign on zero.
-fn num(v: f64, decimals: usize) -> String {
-    let s = format!("{v:.decimals$}");
-    if s.trim_start_matches('-')
-        .chars()
-        .all(|c| c == '0' || c == '.')
-    {
-        s.trim_start_matches('-').to_owned()
-    } else {
-        s
-    }
-}
-
-/// The layout of the paper's Table III (rows per joint: alpha, d, a, phi and beta where enabled;
-/// columns B and T with x, y, z in mm and A, B, C in degrees), each cell given by `cell`.
-fn layout(robot: &Robot, cell: &dyn Fn(Param) -> String) -> String {
-    use std::fmt::Write;
-    let n = robot.dof();
-    let any_beta = (0..n).any(|i| robot.beta_enabled(i));
-    let mut s = String::new();
-    let _ = write!(
-        s,
-        "{:>3} {:>13} {:>13} {:>13} {:>13}",
-        "i", "alpha (deg)", "d (mm)", "a (mm)", "phi (deg)"
-    );
-    if any_beta {
-        let _ = write!(s, " {:>13}", "beta (deg)");
-    }
-    let _ = writeln!(s, " {:>13} {:>13}", "B", "T");
-    let units = ["mm", "mm", "mm", "deg", "deg", "deg"];
-    for i in 0..n.max(6) {
-        if i < n {
-            let _ = write!(s, "{:>3}", i + 1);
-            for p in [Param::Alpha(i), Param::D(i), Param::A(i), Param::Phi(i)] {
-                let _ = write!(s, " {:>13}", cell(p));
-            }
-            if any_beta {
-                let b = if robot.beta_enabled(i) {
-                    cell(Param::Beta(i))
-                } else {
-                    String::new()
-                };
-                let _ = write!(s, " {b:>13}");
-            }
-        } else {
-            let _ = write!(
-                s,
-                "{:>3}{}",
-                "",
-                " ".repeat(14 * if any_beta { 5 } else { 4 })
-            );
-        }
-        if i < 6 {
-            let _ = write!(
-                s,
-                " {:>13} {:>13}  ({})",
-                cell(Param::Base(i)),
-                cell(Param::Tool(i)),
-                units[i]
-            );
-        }
-        s.push('\n');
-    }
-    s
 }

@@ -1,25 +1,10 @@
 //! Text tables of `robocal demo`: our figures beside the paper's (Tables II to V).
 
+use crate::tables::num;
 use robocal_core::experiment::Experiment;
 use robocal_core::{ErrorStats, Unit};
 use robocal_report::PaperStats;
 use std::fmt::Write;
-
-/// A number with `d` decimals, without a minus sign on zero.
-fn num(v: f64, d: usize) -> String {
-    if !v.is_finite() {
-        return "-".into();
-    }
-    let s = format!("{v:.d$}");
-    if s.trim_start_matches('-')
-        .chars()
-        .all(|c| c == '0' || c == '.')
-    {
-        s.trim_start_matches('-').to_owned()
-    } else {
-        s
-    }
-}
 
 /// One column group of an error table: a label, our statistics, the paper's.
 pub struct Column<'a> {
