@@ -3,6 +3,7 @@
 //! columns are carried through. Every rejection names the file, the line and the column.
 
 use crate::error::{Error, Result};
+use crate::io::columns::{csv_reader, next_record, ColumnLayout};
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
 
@@ -41,109 +42,38 @@ pub fn parse_targets<R: std::io::Read>(reader: R, path: &Path, dof: usize) -> Re
     let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
         Error::parse(path, line, field, msg)
     };
-    let csv_err = |e: csv::Error| crate::io::measurements::csv_error(path, e);
-    let mut rdr = csv::ReaderBuilder::new()
-        .has_headers(true)
-        .trim(csv::Trim::All)
-        .from_reader(reader);
-    let headers: Vec<String> = rdr
-        .headers()
-        .map_err(csv_err)?
-        .iter()
-        .map(|h| h.trim_start_matches('\u{feff}').to_owned())
-        .collect();
-    if headers.iter().all(|h| h.is_empty()) {
-        return Err(perr(
-            Some(1),
-            None,
-            "empty file: expected a header row with x,y,z (and optionally q1..qn)".into(),
-        ));
-    }
-    let mut xyz = [None; 3];
-    let mut qcol = vec![None; dof];
-    let mut extra = Vec::new();
-    let mut extra_columns = Vec::new();
-    for (k, h) in headers.iter().enumerate() {
-        if h.is_empty() {
-            return Err(perr(
-                Some(1),
-                None,
-                format!("column {} has an empty name", k + 1),
-            ));
-        }
-        if headers[..k].contains(h) {
-            return Err(perr(Some(1), Some(h), "column appears twice".into()));
-        }
-        if let Some(a) = ["x", "y", "z"].iter().position(|a| a == h) {
-            xyz[a] = Some(k);
-        } else if let Some(j) = h
-            .strip_prefix('q')
-            .filter(|s| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()))
-            .and_then(|s| s.parse::<usize>().ok())
-        {
-            if j == 0 || j > dof {
-                return Err(perr(
-                    Some(1),
-                    Some(h),
-                    format!("the robot has {dof} joints (q1..q{dof})"),
-                ));
-            }
-            qcol[j - 1] = Some(k);
-        } else {
-            extra.push(k);
-            extra_columns.push(h.clone());
-        }
-    }
-    if let Some(a) = xyz.iter().position(Option::is_none) {
+    let mut rdr = csv_reader(reader);
+    let layout = ColumnLayout::read(&mut rdr, path, dof, true, "x,y,z (and optionally q1..qn)")?;
+    let [Some(x), Some(y), Some(z)] = layout.xyz else {
+        let a = layout.xyz.iter().position(Option::is_none).unwrap_or(0);
         return Err(perr(
             Some(1),
             Some(["x", "y", "z"][a]),
             "missing column (targets need x,y,z in mm, robot base frame)".into(),
         ));
-    }
-    let nq = qcol.iter().filter(|c| c.is_some()).count();
+    };
+    let nq = layout.q.iter().filter(|c| c.is_some()).count();
     if nq > 0 && nq < dof {
-        let j = qcol.iter().position(Option::is_none).expect("some missing");
+        let j = layout.q.iter().position(Option::is_none).unwrap_or(0);
         return Err(perr(
             Some(1),
             Some(&format!("q{}", j + 1)),
             format!("missing column: a start configuration needs all of q1..q{dof}"),
         ));
     }
+    let q_cols: Vec<usize> = layout.q.iter().flatten().copied().collect();
     let mut rows = Vec::new();
     let mut rec = csv::StringRecord::new();
-    while rdr.read_record(&mut rec).map_err(csv_err)? {
-        let line = rec.position().map(|p| p.line() as usize).unwrap_or(0);
-        if rec.iter().all(|f| f.is_empty()) {
-            continue;
-        }
-        let num = |k: usize| -> Result<f64> {
-            let s = &rec[k];
-            let field = Some(headers[k].as_str());
-            if s.is_empty() {
-                return Err(perr(Some(line), field, "empty cell".into()));
-            }
-            match s.parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(v),
-                Ok(_) => Err(perr(
-                    Some(line),
-                    field,
-                    format!("`{s}` is not a finite number"),
-                )),
-                Err(_) => Err(perr(Some(line), field, format!("`{s}` is not a number"))),
-            }
-        };
-        let p = Vector3::new(
-            num(xyz[0].expect("checked"))?,
-            num(xyz[1].expect("checked"))?,
-            num(xyz[2].expect("checked"))?,
-        );
-        let seed = if nq == dof {
-            let mut q = Vec::with_capacity(dof);
-            for c in &qcol {
-                q.push(num(c.expect("checked"))?.to_radians());
-            }
-            Some(q)
+    while let Some(line) = next_record(&mut rdr, &mut rec, path)? {
+        let num = |k: usize| layout.number(&rec, k, path, line);
+        let p = Vector3::new(num(x)?, num(y)?, num(z)?);
+        let seed = if q_cols.len() == dof {
+            Some(
+                q_cols
+                    .iter()
+                    .map(|&c| num(c).map(f64::to_radians))
+                    .collect::<Result<Vec<f64>>>()?,
+            )
         } else {
             None
         };
@@ -151,7 +81,7 @@ pub fn parse_targets<R: std::io::Read>(reader: R, path: &Path, dof: usize) -> Re
             line,
             p,
             seed,
-            extra: extra.iter().map(|&k| rec[k].to_owned()).collect(),
+            extra: layout.extra_values(&rec),
         });
     }
     if rows.is_empty() {
@@ -159,7 +89,7 @@ pub fn parse_targets<R: std::io::Read>(reader: R, path: &Path, dof: usize) -> Re
     }
     Ok(TargetSet {
         path: path.to_owned(),
-        extra_columns,
+        extra_columns: layout.extra_columns,
         rows,
     })
 }

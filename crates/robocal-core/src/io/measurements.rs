@@ -6,6 +6,7 @@
 //! mark are accepted. Every rejection names the file, the line and the column.
 
 use crate::error::{Error, Result};
+use crate::io::columns::{csv_reader, next_record, ColumnLayout};
 use nalgebra::Vector3;
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -85,14 +86,6 @@ pub fn read_measurements(path: &Path, dof: usize, positions: Positions) -> Resul
     MeasurementReader::open(path, dof, positions)?.read_all()
 }
 
-fn is_joint_column(name: &str) -> Option<usize> {
-    let num = name.strip_prefix('q')?;
-    if num.is_empty() || !num.bytes().all(|b| b.is_ascii_digit()) {
-        return None;
-    }
-    num.parse().ok()
-}
-
 /// Parses measurement CSV text from any reader; `path` is used in messages.
 pub fn parse_measurements<R: Read>(
     reader: R,
@@ -112,11 +105,9 @@ pub struct MeasurementReader<R: Read> {
     rdr: csv::Reader<R>,
     path: PathBuf,
     dof: usize,
-    headers: Vec<String>,
+    layout: ColumnLayout,
     q_col: Vec<usize>,
     xyz_col: Option<[usize; 3]>,
-    extra: Vec<usize>,
-    extra_columns: Vec<String>,
     record: csv::StringRecord,
     rows: usize,
     max_abs_deg: f64,
@@ -136,61 +127,15 @@ impl<R: Read> MeasurementReader<R> {
         let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
             Error::parse(path, line, field, msg)
         };
-        let mut rdr = csv::ReaderBuilder::new()
-            .has_headers(true)
-            .trim(csv::Trim::All)
-            .flexible(false)
-            .from_reader(reader);
-        let headers = rdr
-            .headers()
-            .map_err(|e| csv_error(path, e))?
-            .iter()
-            .map(|h| h.trim_start_matches('\u{feff}').to_owned())
-            .collect::<Vec<_>>();
-        if headers.is_empty() || headers.iter().all(|h| h.is_empty()) {
-            return Err(perr(
-                Some(1),
-                None,
-                format!("empty file: expected a header row with q1..q{dof} and x,y,z"),
-            ));
-        }
-        let mut q_col = vec![None; dof];
-        let mut xyz_col = [None; 3];
-        let mut extra = Vec::new();
-        let mut extra_columns = Vec::new();
-        for (k, h) in headers.iter().enumerate() {
-            if h.is_empty() {
-                return Err(perr(
-                    Some(1),
-                    None,
-                    format!("column {} has an empty name", k + 1),
-                ));
-            }
-            if headers[..k].contains(h) {
-                return Err(perr(Some(1), Some(h), "column appears twice".into()));
-            }
-            if let Some(j) = is_joint_column(h) {
-                if j == 0 || j > dof {
-                    return Err(perr(
-                        Some(1),
-                        Some(h),
-                        format!(
-                            "the robot has {dof} joints (q1..q{dof}); this file has a column `{h}`"
-                        ),
-                    ));
-                }
-                q_col[j - 1] = Some(k);
-                continue;
-            }
-            let axis = ["x", "y", "z"].iter().position(|a| a == h);
-            match (axis, positions) {
-                (Some(a), Positions::Required | Positions::Optional) => xyz_col[a] = Some(k),
-                _ => {
-                    extra.push(k);
-                    extra_columns.push(h.clone());
-                }
-            }
-        }
+        let mut rdr = csv_reader(reader);
+        let layout = ColumnLayout::read(
+            &mut rdr,
+            path,
+            dof,
+            positions != Positions::Ignored,
+            &format!("q1..q{dof} and x,y,z"),
+        )?;
+        let (q_col, xyz_col, headers) = (&layout.q, layout.xyz, &layout.headers);
         let mut q = Vec::with_capacity(dof);
         for (j, c) in q_col.iter().enumerate() {
             match c {
@@ -225,11 +170,9 @@ impl<R: Read> MeasurementReader<R> {
             rdr,
             path: path.to_owned(),
             dof,
-            headers,
             q_col: q,
             xyz_col,
-            extra,
-            extra_columns,
+            layout,
             record: csv::StringRecord::new(),
             rows: 0,
             max_abs_deg: 0.0,
@@ -238,7 +181,7 @@ impl<R: Read> MeasurementReader<R> {
 
     /// Names of the columns other than `q1..qn` and `x,y,z`, in file order.
     pub fn extra_columns(&self) -> &[String] {
-        &self.extra_columns
+        &self.layout.extra_columns
     }
 
     /// Whether the file has `x,y,z` columns (and reads them).
@@ -252,7 +195,7 @@ impl<R: Read> MeasurementReader<R> {
         MeasurementSet {
             path: self.path.clone(),
             dof: self.dof,
-            extra_columns: self.extra_columns.clone(),
+            extra_columns: self.layout.extra_columns.clone(),
             rows: Vec::new(),
             warnings: Vec::new(),
         }
@@ -261,36 +204,10 @@ impl<R: Read> MeasurementReader<R> {
     /// The next data row (blank rows are skipped), `None` at the end of the file. Fails naming
     /// the line and the column of a malformed cell.
     pub fn next_row(&mut self) -> Result<Option<Measurement>> {
-        loop {
-            match self.rdr.read_record(&mut self.record) {
-                Ok(false) => return Ok(None),
-                Ok(true) => {}
-                Err(e) => return Err(csv_error(&self.path, e)),
-            }
-            if !self.record.iter().all(|f| f.is_empty()) {
-                break;
-            }
-        }
-        let line = self
-            .record
-            .position()
-            .map(|p| p.line() as usize)
-            .unwrap_or(0);
-        let num = |k: usize| -> Result<f64> {
-            let s = &self.record[k];
-            let field = Some(self.headers[k].as_str());
-            let perr = |msg: String| Error::parse(&self.path, Some(line), field, msg);
-            if s.is_empty() {
-                return Err(perr("empty cell".into()));
-            }
-            let v: f64 = s
-                .parse()
-                .map_err(|_| perr(format!("`{s}` is not a number")))?;
-            if !v.is_finite() {
-                return Err(perr(format!("`{s}` is not a finite number")));
-            }
-            Ok(v)
+        let Some(line) = next_record(&mut self.rdr, &mut self.record, &self.path)? else {
+            return Ok(None);
         };
+        let num = |k: usize| self.layout.number(&self.record, k, &self.path, line);
         let mut q = Vec::with_capacity(self.dof);
         for &c in &self.q_col {
             let v = num(c)?;
@@ -306,11 +223,7 @@ impl<R: Read> MeasurementReader<R> {
             line,
             q,
             p,
-            extra: self
-                .extra
-                .iter()
-                .map(|&k| self.record[k].to_owned())
-                .collect(),
+            extra: self.layout.extra_values(&self.record),
         }))
     }
 
@@ -351,29 +264,6 @@ impl<R: Read> MeasurementReader<R> {
         set.warnings = self.finish()?;
         Ok(set)
     }
-}
-
-/// A CSV reader's error as a robocal error: an I/O failure (e.g. the path is a directory) as
-/// [`Error::Io`], anything else as [`Error::Parse`] with the line.
-pub(crate) fn csv_error(path: &Path, e: csv::Error) -> Error {
-    let line = e.position().map(|p| p.line() as usize);
-    let msg = match e.kind() {
-        csv::ErrorKind::UnequalLengths {
-            expected_len, len, ..
-        } => format!("{len} fields, but the header has {expected_len}"),
-        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_owned(),
-        csv::ErrorKind::Io(_) => {
-            return match e.into_kind() {
-                csv::ErrorKind::Io(source) => Error::Io {
-                    path: path.to_owned(),
-                    source,
-                },
-                other => Error::parse(path, line, None, format!("{other:?}")),
-            }
-        }
-        _ => e.to_string(),
-    };
-    Error::parse(path, line, None, msg)
 }
 
 /// Writes a measurement (or joint) CSV atomically: `q1..qn` in degrees, then `x,y,z` in mm if

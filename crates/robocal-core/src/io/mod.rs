@@ -1,6 +1,7 @@
 //! File formats: measurement CSV, atomic output, calibration results.
 
 pub mod atomic;
+pub(crate) mod columns;
 pub mod input;
 pub mod measurements;
 pub mod result;
