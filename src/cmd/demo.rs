@@ -11,7 +11,7 @@ use robocal_core::experiment::{
 use robocal_core::io::write_all_atomic;
 use robocal_core::registration::InitialFrame;
 use robocal_core::ErrorStats;
-use robocal_report::{paper, ReportData, HISTOGRAM_FILE, HTML_FILE};
+use robocal_report::{number_list, paper, ReportData, HISTOGRAM_FILE, HTML_FILE};
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -37,20 +37,6 @@ fn sh(p: &Path) -> String {
     } else {
         format!("'{}'", s.replace('\'', r"'\''"))
     }
-}
-
-/// Numbers as `a,b,c` in the shortest form that reads back exactly (small ones as `1e-8`).
-fn list(v: &[f64]) -> String {
-    v.iter()
-        .map(|x| {
-            if *x != 0.0 && x.abs() < 1e-3 {
-                format!("{x:e}")
-            } else {
-                format!("{x}")
-            }
-        })
-        .collect::<Vec<_>>()
-        .join(",")
 }
 
 pub fn run(a: DemoArgs) -> anyhow::Result<()> {
@@ -149,11 +135,11 @@ fn print_run(exp: &Experiment) {
     if let Some(g) = &s.gravity {
         println!(
             "                 joint compliances {} rad/(N m),",
-            list(&g.compliance_rad_per_nm)
+            number_list(&g.compliance_rad_per_nm, ",")
         );
         println!(
             "                 link masses {} kg, payload {} kg{}",
-            list(&g.link_masses_kg),
+            number_list(&g.link_masses_kg, ","),
             g.payload_kg,
             if exp.session.deflection_mm.is_some() {
                 ":"
@@ -349,8 +335,14 @@ fn print_files(exp: &Experiment, dir: &Path) {
     }
     let mut gravity = Vec::new();
     if let Some(g) = &s.gravity {
-        gravity.push(format!("--compliance {}", list(&g.compliance_rad_per_nm)));
-        gravity.push(format!("--link-masses-kg {}", list(&g.link_masses_kg)));
+        gravity.push(format!(
+            "--compliance {}",
+            number_list(&g.compliance_rad_per_nm, ",")
+        ));
+        gravity.push(format!(
+            "--link-masses-kg {}",
+            number_list(&g.link_masses_kg, ",")
+        ));
         gravity.push(format!("--payload-kg {}", g.payload_kg));
     }
     let robot = format!("--robot {PAPER_NOMINAL}");

@@ -8,21 +8,6 @@ use robocal_core::compensation::IkStatus;
 use robocal_core::experiment::Experiment;
 use robocal_core::Result;
 
-/// A list of numbers as `a, b, c` in the shortest form that reads back exactly (small ones in
-/// scientific notation).
-fn list(v: &[f64]) -> String {
-    v.iter()
-        .map(|x| {
-            if *x != 0.0 && x.abs() < 1e-3 {
-                format!("{x:e}")
-            } else {
-                format!("{x}")
-            }
-        })
-        .collect::<Vec<_>>()
-        .join(", ")
-}
-
 impl ReportData {
     /// The report of a simulated experiment. `dir` names where its files are (shown in the
     /// settings).
@@ -146,8 +131,8 @@ impl ReportData {
                 "Gravity deflection",
                 format!(
                     "compliances {} rad/(N·m); link masses {} kg; payload {} kg{sag}",
-                    list(&g.compliance_rad_per_nm),
-                    list(&g.link_masses_kg),
+                    crate::numfmt::number_list(&g.compliance_rad_per_nm, ", "),
+                    crate::numfmt::number_list(&g.link_masses_kg, ", "),
                     g.payload_kg
                 ),
             ));

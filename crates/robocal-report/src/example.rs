@@ -83,14 +83,6 @@ impl ReportData {
         let point_sets = vec![cal, val, ver];
         let histogram = before_after_histogram(&point_sets, &["Calibration"], &["Calibration"]);
 
-        let nominal = [
-            [0.0, 1045.0, 0.0, 0.0],
-            [-90.0, 0.0, 500.0, 0.0],
-            [0.0, 0.0, 1300.0, -90.0],
-            [-90.0, 1525.0, -55.0, 0.0],
-            [90.0, 0.0, 0.0, 0.0],
-            [-90.0, 290.0, 0.0, 180.0],
-        ];
         let fixed_reason = |name: &str| -> Option<&'static str> {
             Some(match name {
                 "alpha1" | "a1" | "d1" | "phi1" => "absorbed by the base frame",
@@ -100,27 +92,13 @@ impl ReportData {
                 _ => return None,
             })
         };
-        let mut parameters = Vec::new();
-        for (i, row) in nominal.iter().enumerate() {
-            for (k, kind) in ["alpha", "d", "a", "phi"].iter().enumerate() {
-                let name = format!("{kind}{}", i + 1);
-                let unit = if k == 0 || k == 3 {
-                    Unit::Deg
-                } else {
-                    Unit::Mm
-                };
-                parameters.push((name, unit, row[k]));
-            }
-        }
-        for (k, axis) in ["x", "y", "z", "a", "b", "c"].iter().enumerate() {
-            let unit = if k < 3 { Unit::Mm } else { Unit::Deg };
-            parameters.push((format!("base_{axis}"), unit, 0.0));
-        }
-        let tool = [42.4163, -70.9065, 239.5558, -0.038, 0.237, 0.054];
-        for (k, axis) in ["x", "y", "z", "a", "b", "c"].iter().enumerate() {
-            let unit = if k < 3 { Unit::Mm } else { Unit::Deg };
-            parameters.push((format!("tool_{axis}"), unit, tool[k]));
-        }
+        // The paper's Table I robot; tool_* are corrections to T0 (nominal zero), as in results.
+        let robot = robocal_core::preset("kuka-kr480-r3330").expect("built-in preset");
+        let parameters: Vec<(String, Unit, f64)> = robot
+            .params()
+            .into_iter()
+            .map(|p| (p.name(), p.unit(), robot.get_display(p)))
+            .collect();
         let parameters: Vec<ParamRow> = parameters
             .into_iter()
             .map(|(name, unit, nominal)| {

@@ -54,6 +54,7 @@ pub use data::{
     SolverSummary,
 };
 pub use histogram::{histogram_svg, HistogramFigure};
+pub use numfmt::number_list;
 pub use run::RunData;
 pub use scatter::{scatter_svg, ScatterFigure};
 

@@ -4,6 +4,21 @@
 /// The dash shown for a missing or non-finite figure.
 pub const DASH: &str = "–";
 
+/// Numbers joined by `sep` in the shortest form that reads back exactly (small ones in scientific
+/// notation, e.g. `1e-8`): for settings shown to a reader and for command lines.
+pub fn number_list(v: &[f64], sep: &str) -> String {
+    v.iter()
+        .map(|x| {
+            if *x != 0.0 && x.abs() < 1e-3 {
+                format!("{x:e}")
+            } else {
+                format!("{x}")
+            }
+        })
+        .collect::<Vec<_>>()
+        .join(sep)
+}
+
 /// `v` with `d` decimals; a dash when not finite. Uses a true minus sign.
 pub fn fixed(v: f64, d: usize) -> String {
     if !v.is_finite() {

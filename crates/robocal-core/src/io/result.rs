@@ -264,15 +264,10 @@ impl CalibrationResult {
             .params()
             .into_iter()
             .map(|p| {
-                let nom = if nominal.has_param(p) {
-                    nominal.get_display(p)
-                } else {
-                    0.0
-                };
                 (
                     p.name(),
                     ParamEntry {
-                        nominal: nom,
+                        nominal: nominal.get_display_or_zero(p),
                         calibrated: calibrated.get_display(p),
                         unit: p.unit(),
                         fixed: false,

@@ -395,6 +395,17 @@ impl Robot {
         p.unit().from_internal(self.get(p))
     }
 
+    /// A parameter's value in display units, or zero when this model lacks it (a Hayati tilt
+    /// that is not enabled is zero by definition): for comparing two models of the same shape
+    /// whose parameter lists differ only in such extensions.
+    pub fn get_display_or_zero(&self, p: Param) -> f64 {
+        if self.has_param(p) {
+            self.get_display(p)
+        } else {
+            0.0
+        }
+    }
+
     /// Sets a parameter from display units (mm or degrees).
     pub fn set_display(&mut self, p: Param, value: f64) {
         self.set(p, p.unit().to_internal(value))

@@ -132,14 +132,7 @@ pub fn parameter_differences(nominal: &Robot, truth: &Robot) -> Vec<(Param, f64)
     truth
         .params()
         .into_iter()
-        .map(|p| {
-            let nom = if nominal.has_param(p) {
-                nominal.get_display(p)
-            } else {
-                0.0
-            };
-            (p, truth.get_display(p) - nom)
-        })
+        .map(|p| (p, truth.get_display(p) - nominal.get_display_or_zero(p)))
         .filter(|(_, d)| *d != 0.0)
         .collect()
 }
