@@ -13,6 +13,13 @@ pub const INPUT: i32 = 3;
 pub const IO: i32 = 4;
 /// A numerical failure: no convergence, too few points, unidentifiable model.
 pub const NUMERICAL: i32 = 5;
+/// A fit that converged but cannot be right (the plausibility gate: units, handedness, wrong
+/// robot, parameter moves beyond calibration): nothing written unless explicitly accepted.
+#[allow(dead_code)]
+pub const IMPLAUSIBLE: i32 = 6;
+/// Interrupted by SIGINT/SIGTERM (128 + signal number for SIGINT, as shells report it).
+#[allow(dead_code)]
+pub const INTERRUPTED: i32 = 130;
 
 /// An error raised by the CLI itself with an explicit exit code.
 #[derive(Debug)]

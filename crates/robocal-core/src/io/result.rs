@@ -17,6 +17,12 @@ pub const STATUS_CALIBRATED: &str = "calibrated";
 /// The value of a result's `status` key when the solver did not converge and the result was kept
 /// anyway (`robocal calibrate --keep-partial`): not a calibration.
 pub const STATUS_PARTIAL: &str = "partial";
+/// The value of a result's `status` key when the fit converged but failed the plausibility gate
+/// and was kept on explicit request: not to be used for compensation unless the user accepts it
+/// again there.
+pub const STATUS_IMPLAUSIBLE: &str = "implausible";
+/// Every `status` robocal writes; a reader refuses any other.
+pub const KNOWN_STATUSES: [&str; 3] = [STATUS_CALIBRATED, STATUS_PARTIAL, STATUS_IMPLAUSIBLE];
 
 /// Which robot a result belongs to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
