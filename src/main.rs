@@ -1,24 +1,19 @@
 //! `robocal`: calibrate industrial robots from laser-tracker measurements.
 //!
-//! This binary is the command-line front end: argument parsing, files, progress and printing.
-//! The work is done by the `robocal-core` library.
+//! This binary is a thin wrapper over the `robocal` library (the command-line front end); the work
+//! is done by the `robocal-core` library.
 
-mod cmd;
-mod exit;
-mod progress;
-mod tables;
-
-use clap::Parser;
+use robocal::exit;
 
 fn main() {
     reset_sigpipe();
-    let cli = cmd::Cli::parse();
-    match cmd::run(cli) {
-        Ok(()) => {}
-        Err(e) => {
-            eprintln!("error: {}", exit::message(&e));
-            std::process::exit(exit::code_for(&e));
+    if let Err(e) = robocal::run_from(std::env::args_os()) {
+        if let Some(clap_err) = e.downcast_ref::<clap::Error>() {
+            // clap prints usage errors, --help and --version itself, with its own exit codes.
+            clap_err.exit();
         }
+        eprintln!("error: {}", exit::message(&e));
+        std::process::exit(exit::code_for(&e));
     }
 }
 
