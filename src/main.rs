@@ -5,6 +5,7 @@
 
 mod cmd;
 mod exit;
+mod interrupt;
 mod progress;
 mod tables;
 
@@ -12,13 +13,13 @@ use clap::Parser;
 
 fn main() {
     reset_sigpipe();
+    interrupt::install();
     let cli = cmd::Cli::parse();
     match cmd::run(cli) {
-        Ok(()) => {}
-        Err(e) => {
-            eprintln!("error: {}", exit::message(&e));
-            std::process::exit(exit::code_for(&e));
-        }
+        Ok(()) => interrupt::exit(exit::OK, || {}),
+        Err(e) => interrupt::exit(exit::code_for(&e), || {
+            eprintln!("error: {}", exit::message(&e))
+        }),
     }
 }
 
