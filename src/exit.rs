@@ -1,7 +1,6 @@
 //! Exit codes (documented in README.md).
 
 /// Success.
-#[allow(dead_code)]
 pub const OK: i32 = 0;
 /// An unexpected internal failure.
 pub const INTERNAL: i32 = 1;
@@ -18,7 +17,7 @@ pub const NUMERICAL: i32 = 5;
 #[allow(dead_code)]
 pub const IMPLAUSIBLE: i32 = 6;
 /// Interrupted by SIGINT/SIGTERM (128 + signal number for SIGINT, as shells report it).
-#[allow(dead_code)]
+#[cfg_attr(not(unix), allow(dead_code))]
 pub const INTERRUPTED: i32 = 130;
 
 /// An error raised by the CLI itself with an explicit exit code.

@@ -1,19 +1,30 @@
 //! `robocal`: calibrate industrial robots from laser-tracker measurements.
 //!
 //! This binary is a thin wrapper over the `robocal` library (the command-line front end); the work
-//! is done by the `robocal-core` library.
+//! is done by the `robocal-core` library. It adds what only a process has: the SIGPIPE action and
+//! the SIGINT/SIGTERM handler that removes unfinished temporary files.
+
+mod interrupt;
 
 use robocal::exit;
 
 fn main() {
     reset_sigpipe();
-    if let Err(e) = robocal::run_from(std::env::args_os()) {
-        if let Some(clap_err) = e.downcast_ref::<clap::Error>() {
-            // clap prints usage errors, --help and --version itself, with its own exit codes.
-            clap_err.exit();
+    interrupt::install();
+    match robocal::run_from(std::env::args_os()) {
+        Ok(()) => interrupt::exit(exit::OK, || {}),
+        Err(e) => {
+            if let Some(clap_err) = e.downcast_ref::<clap::Error>() {
+                // clap prints usage errors, --help and --version itself, with its own exit codes.
+                let code = clap_err.exit_code();
+                interrupt::exit(code, || {
+                    let _ = clap_err.print();
+                });
+            }
+            interrupt::exit(exit::code_for(&e), || {
+                eprintln!("error: {}", exit::message(&e))
+            })
         }
-        eprintln!("error: {}", exit::message(&e));
-        std::process::exit(exit::code_for(&e));
     }
 }
 

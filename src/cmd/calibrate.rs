@@ -1,7 +1,8 @@
 //! `robocal calibrate`: registration of the measurement frame and identification of the
 //! calibrated parameters (paper, sections II.C and III).
 
-use super::common;
+use super::io_plan::IoPlan;
+use super::{common, limits};
 use crate::exit;
 use crate::tables::{layout, num};
 use anyhow::Context;
@@ -57,7 +58,7 @@ pub struct CalibrateArgs {
     /// Relative rank threshold of the identifiability analysis.
     #[arg(long, default_value_t = DEFAULT_RANK_TOLERANCE, value_name = "TOL")]
     rank_tol: f64,
-    /// Iteration limit of the solver. If the solver stops there without converging, the command
+    /// Iteration limit of the solver (1 to 1000000). If the solver stops there without converging, the command
     /// fails (exit code 5) and writes nothing, unless --keep-partial is given.
     #[arg(long, default_value_t = 1000)]
     max_iterations: usize,
@@ -150,6 +151,13 @@ fn read(path: &Path, robot: &Robot) -> anyhow::Result<robocal_core::identificati
 }
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
+    limits::count(
+        "--max-iterations",
+        a.max_iterations,
+        1,
+        limits::MAX_CALIBRATION_ITERATIONS,
+        "a solver that has not converged by then will not",
+    )?;
     let mut robot = common::robot(&a.robot)?;
     let betas = apply_beta(&mut robot, &a.beta)?;
     if betas.is_empty() && a.beta.trim() == "parallel" {
@@ -161,9 +169,16 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     }
     let fix = param_list(&robot, &a.fix, "--fix")?;
     let free = param_list(&robot, &a.free, "--free")?;
-    let mut inputs = vec![a.data.as_path()];
-    inputs.extend(a.validate.as_deref());
-    common::check_output("--out", &a.out, &inputs)?;
+    IoPlan::new()
+        .robot("--robot", &a.robot)
+        .input("--data", &a.data)
+        .input_opt("--validate", a.validate.as_deref())
+        .output(
+            "--out",
+            &a.out,
+            "the result is a file that later commands read, and the tables go to standard output",
+        )
+        .check()?;
     let data = read(&a.data, &robot)?;
     let mut validation = data.validation.clone();
     if let Some(v) = &a.validate {

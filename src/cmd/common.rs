@@ -73,41 +73,6 @@ pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
     Ok(q)
 }
 
-/// Checks an output path before any work: its directory must exist, it must not be a directory,
-/// and it must not be one of the `inputs` (a failed or finished run must never destroy its own
-/// input). Exit code 4 (I/O) for the first two, 2 (usage) for the last.
-pub fn check_output(flag: &str, out: &Path, inputs: &[&Path]) -> anyhow::Result<()> {
-    let io = |msg: String| -> anyhow::Error {
-        anyhow::Error::from(robocal_core::Error::Io {
-            path: out.to_owned(),
-            source: std::io::Error::other(msg),
-        })
-        .context(flag.to_owned())
-    };
-    if out.is_dir() {
-        return Err(io("is a directory, expected a file path".into()));
-    }
-    let dir = match out.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if !dir.is_dir() {
-        return Err(io(format!("directory {} does not exist", dir.display())));
-    }
-    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => a == b,
-    };
-    if let Some(i) = inputs.iter().find(|i| same(out, i)) {
-        return Err(crate::exit::usage(format!(
-            "{flag} {}: this is also an input ({}); write the output to another file",
-            out.display(),
-            i.display()
-        )));
-    }
-    Ok(())
-}
-
 /// Warns (stderr) when a result file is a partial result (`calibrate --keep-partial` after the
 /// solver did not converge), which is not a calibration.
 pub fn warn_partial(res: &CalibrationResult, path: &Path) {

@@ -2,6 +2,8 @@
 //! eq. 12-14), for desired joint vectors or for Cartesian targets.
 
 use super::evaluate::calibrated_model;
+use super::io_plan::IoPlan;
+use super::limits;
 use crate::exit;
 use anyhow::Context;
 use clap::Args;
@@ -28,13 +30,14 @@ pub struct CompensateArgs {
     /// (degrees) to start from; without them, several start configurations are tried.
     #[arg(long, value_name = "XYZ.csv", conflicts_with = "joints")]
     targets: Option<PathBuf>,
-    /// Output: commanded joints (degrees) with status, residual and the desired values.
+    /// Output: commanded joints (degrees) with status, residual and the desired values. `-`:
+    /// standard output (written when complete; the summary then goes to standard error).
     #[arg(long, value_name = "COMMANDED.csv")]
     out: PathBuf,
     /// A solve has converged when the tool is this close to its target (mm).
     #[arg(long, default_value_t = 1e-6)]
     tolerance_mm: f64,
-    /// Most iterations (Jacobian evaluations) per solve.
+    /// Most iterations (Jacobian evaluations) per solve (1 to 100000).
     #[arg(long, default_value_t = 500)]
     max_iterations: usize,
     /// Fail (exit code 5, nothing written) if any row does not converge. Without it, such rows
@@ -59,10 +62,21 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 .replace("max_iterations", "--max-iterations"),
         )
     })?;
-    let input = a.joints.as_ref().or(a.targets.as_ref());
-    let mut inputs = vec![a.params.as_path()];
-    inputs.extend(input.map(|p| p.as_path()));
-    super::common::check_output("--out", &a.out, &inputs)?;
+    limits::count(
+        "--max-iterations",
+        a.max_iterations,
+        1,
+        limits::MAX_IK_ITERATIONS,
+        "per row; a solve converges in a handful",
+    )?;
+    let mut outputs = IoPlan::new()
+        .robot("--robot", &a.robot)
+        .input("--params", &a.params)
+        .recorded_in("--params", &a.params)
+        .input_opt("--joints", a.joints.as_deref())
+        .input_opt("--targets", a.targets.as_deref())
+        .output_or_stdout("--out", &a.out)
+        .check()?;
     let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
     if let Some(why) = res.partial_reason() {
         return Err(exit::input(format!(
@@ -89,7 +103,8 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 path.display()
             );
         }
-        let mut w = CommandedWriter::create(&a.out, dof, true, reader.extra_columns())?;
+        let mut w =
+            CommandedWriter::to_output(outputs.open(&a.out)?, dof, true, reader.extra_columns())?;
         let mut outside = Listing::default();
         while let Some(r) = reader.next_row().with_context(context)? {
             nominal.check_joints(&r.q, &format!("{}:{}", path.display(), r.line))?;
@@ -128,7 +143,8 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         let set =
             read_targets(path, dof).with_context(|| format!("--targets {}", path.display()))?;
         check_extra_columns(path, dof, &set.extra_columns)?;
-        let mut w = CommandedWriter::create(&a.out, dof, false, &set.extra_columns)?;
+        let mut w =
+            CommandedWriter::to_output(outputs.open(&a.out)?, dof, false, &set.extra_columns)?;
         for t in &set.rows {
             if let Some(s) = &t.seed {
                 cal.check_joints(s, &format!("{}:{}", path.display(), t.line))?;
@@ -165,7 +181,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
             eprintln!(
                 "warning: ... and {} more (see the status column of {})",
                 tally.failed.count - LISTED,
-                a.out.display()
+                super::io_plan::shown(&a.out)
             );
         }
     }
@@ -300,5 +316,5 @@ fn print_summary(a: &CompensateArgs, input: &std::path::Path, t: &Tally) {
     if let Some((ch, line, i)) = t.max_change {
         println!("  joint change   max {ch:.4} deg (line {line}, q{})", i + 1);
     }
-    println!("wrote {} ({} rows)", a.out.display(), t.rows);
+    println!("wrote {} ({} rows)", super::io_plan::shown(&a.out), t.rows);
 }

@@ -1,6 +1,7 @@
 //! `robocal demo`: the paper's whole experiment in simulation, with its tables beside the
 //! paper's, a report, and the files of every step.
 
+use super::io_plan::IoPlan;
 use super::paper_tables::{error_table, parameter_table, percent, Column};
 use anyhow::Context;
 use clap::Args;
@@ -26,6 +27,19 @@ pub struct DemoArgs {
     out: PathBuf,
 }
 
+/// Every file the demo writes into its directory.
+const OUTPUT_FILES: [&str; 9] = [
+    files::CELL,
+    files::VALIDATION,
+    files::CELL_TRUTH,
+    files::DESIRED,
+    files::RESULT,
+    files::COMMANDED,
+    files::VERIFY,
+    HTML_FILE,
+    HISTOGRAM_FILE,
+];
+
 /// A path as the user would type it in a POSIX shell (quoted when needed).
 fn sh(p: &Path) -> String {
     let s = p.display().to_string();
@@ -41,13 +55,9 @@ fn sh(p: &Path) -> String {
 
 pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     let dir = &a.out;
-    if dir.exists() && !dir.is_dir() {
-        return Err(robocal_core::Error::Io {
-            path: dir.clone(),
-            source: std::io::Error::other("exists and is not a directory"),
-        }
-        .into());
-    }
+    IoPlan::new()
+        .output_dir("--out", dir, &OUTPUT_FILES)
+        .check()?;
     let path = |name: &str| dir.join(name);
     let mut cfg = ExperimentConfig::paper(a.seed)?;
     // Record the files as `robocal calibrate` run by hand on them would.

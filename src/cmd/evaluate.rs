@@ -3,6 +3,7 @@
 //! desired positions (verification, section V.B, Table V).
 
 use super::common;
+use super::io_plan::{self, IoPlan};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use robocal_core::evaluation::{self, Against, Evaluator, PerPointWriter, Reference};
@@ -29,7 +30,8 @@ pub struct EvaluateArgs {
     /// else the models.
     #[arg(long, value_enum, default_value_t = AgainstArg::Auto)]
     against: AgainstArg,
-    /// Write per-point errors (dx, dy, dz, norm per series, mm, base frame) to this CSV.
+    /// Write per-point errors (dx, dy, dz, norm per series, mm, base frame) to this CSV. `-`:
+    /// standard output (written when complete; the table then goes to standard error).
     #[arg(long, value_name = "OUT.csv")]
     per_point: Option<PathBuf>,
     /// Print the statistics as JSON.
@@ -59,9 +61,22 @@ pub(super) fn calibrated_model(
 }
 
 pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
-    if let Some(p) = &a.per_point {
-        common::check_output("--per-point", p, &[&a.data, &a.params])?;
+    let stdout_data = a.per_point.as_deref() == Some(Path::new(io_plan::STDOUT));
+    if stdout_data && a.json {
+        return Err(crate::exit::usage(
+            "--per-point - and --json both want standard output: write the per-point errors to \
+             a file",
+        ));
     }
+    let mut plan = IoPlan::new();
+    plan.robot("--robot", &a.robot)
+        .input("--params", &a.params)
+        .recorded_in("--params", &a.params)
+        .input("--data", &a.data);
+    if let Some(p) = &a.per_point {
+        plan.output_or_stdout("--per-point", p);
+    }
+    let mut outputs = plan.check()?;
     let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
     common::warn_partial(&res, &a.params);
     let against = match a.against {
@@ -78,8 +93,8 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     let ev = Evaluator::new(&nominal, &cal, &frame, &header, against)?;
     let names = ev.series();
     let mut per_point = match &a.per_point {
-        Some(p) => Some(PerPointWriter::create(
-            p,
+        Some(p) => Some(PerPointWriter::to_output(
+            outputs.open(p)?,
             &header,
             [names[0].0, names[1].0],
         )?),
@@ -310,6 +325,6 @@ fn print_table(
         }
     }
     if let Some(p) = &a.per_point {
-        println!("wrote {} ({n} rows)", p.display());
+        println!("wrote {} ({n} rows)", io_plan::shown(p));
     }
 }

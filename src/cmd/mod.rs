@@ -6,6 +6,8 @@ mod compensate;
 mod demo;
 mod evaluate;
 mod fk;
+mod io_plan;
+mod limits;
 mod paper_tables;
 mod report;
 mod robot;

@@ -2,11 +2,12 @@
 //! measurement files when they are at hand.
 
 use super::evaluate::calibrated_model;
+use super::io_plan::IoPlan;
 use crate::exit;
 use anyhow::Context;
 use clap::Args;
 use robocal_core::io::{read_measurements, CalibrationResult, MeasurementSet, Positions};
-use robocal_report::{write_report, ReportData, RunData};
+use robocal_report::{write_report, ReportData, RunData, HISTOGRAM_FILE, HTML_FILE};
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
@@ -78,6 +79,17 @@ fn read(path: &Option<PathBuf>, dof: usize, flag: &str) -> anyhow::Result<Option
 }
 
 pub fn run(a: ReportArgs) -> anyhow::Result<()> {
+    let mut plan = IoPlan::new();
+    plan.input("RESULT", &a.result)
+        .recorded_in("RESULT", &a.result)
+        .input_opt("--data", a.data.as_deref())
+        .input_opt("--validate", a.validate.as_deref())
+        .input_opt("--verify", a.verify.as_deref())
+        .output_dir("--out", &a.out, &[HTML_FILE, HISTOGRAM_FILE]);
+    if let Some(r) = &a.robot {
+        plan.robot("--robot", r);
+    }
+    plan.check()?;
     let result = CalibrationResult::read(&a.result)?;
     let robot = match (&a.robot, recorded(&result, "robot_arg")) {
         (Some(r), _) => r.clone(),

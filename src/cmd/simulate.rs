@@ -1,6 +1,7 @@
 //! `robocal simulate`: measure a virtual robot with a virtual laser tracker.
 
-use super::common;
+use super::io_plan::IoPlan;
+use super::{common, limits};
 use crate::exit;
 use anyhow::Context;
 use clap::Args;
@@ -27,7 +28,8 @@ pub struct SimulateArgs {
     /// `random`: the nominal robot with seeded random geometric errors.
     #[arg(long)]
     truth: String,
-    /// Number of random calibration poses (set `calibration`).
+    /// Number of random calibration poses (set `calibration`); with --validation at most
+    /// 10000000 in all.
     #[arg(long, required_unless_present = "joints")]
     poses: Option<usize>,
     /// Measure the joint values of this CSV (q1..qn in degrees) instead of random poses, e.g.
@@ -218,6 +220,24 @@ fn config(
     })
 }
 
+/// The pose counts within [`limits::MAX_POSES`].
+fn check_counts(a: &SimulateArgs) -> anyhow::Result<()> {
+    let why = "about 5 GB of memory and a 1.4 GB file at the limit; draw larger sets in several \
+               runs with different seeds";
+    let poses = a.poses.unwrap_or(0);
+    limits::count("--poses", poses, 0, limits::MAX_POSES, why)?;
+    limits::count("--validation", a.validation, 0, limits::MAX_POSES, why)?;
+    if poses + a.validation > limits::MAX_POSES {
+        return Err(exit::usage(format!(
+            "--poses {poses} and --validation {}: {} poses in all, at most {} ({why})",
+            a.validation,
+            poses + a.validation,
+            limits::MAX_POSES
+        )));
+    }
+    Ok(())
+}
+
 /// `FILE.truth.json` beside `FILE.csv`.
 fn truth_path(out: &Path) -> PathBuf {
     out.with_extension("truth.json")
@@ -230,27 +250,32 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         ));
     }
     let truth_out = truth_path(&a.out);
-    let mut outputs = vec![a.out.clone(), truth_out.clone()];
-    outputs.extend(a.validation_out.iter().cloned());
-    for (i, p) in outputs.iter().enumerate() {
-        if outputs[..i].contains(p) {
-            return Err(exit::usage(format!(
-                "{} is given for two outputs",
-                p.display()
-            )));
-        }
-        if a.joints.as_deref() == Some(p.as_path()) && *p != a.out {
-            return Err(exit::usage(format!(
-                "{} is the --joints input",
-                p.display()
-            )));
-        }
+    check_counts(&a)?;
+    let mut plan = IoPlan::new();
+    plan.robot("--robot", &a.robot);
+    if a.truth != "random" {
+        plan.robot("--truth", &a.truth);
     }
-    common::check_output("--out", &a.out, &[])?;
-    common::check_output("--out (truth file)", &truth_out, &[])?;
+    plan.input_opt("--joints", a.joints.as_deref())
+        .output(
+            "--out",
+            &a.out,
+            "the truth file is written beside it (FILE.truth.json)",
+        )
+        .derived_output(
+            "--out",
+            &a.out,
+            &truth_out,
+            "the truth file written beside it",
+        );
     if let Some(v) = &a.validation_out {
-        common::check_output("--validation-out", v, &[])?;
+        plan.output(
+            "--validation-out",
+            v,
+            "the truth file records which file holds each set",
+        );
     }
+    plan.check()?;
     let nominal = common::robot(&a.robot)?;
     let (truth, truth_tracker) = truth_arg(&a, &nominal)?;
     let cfg = config(&a, &nominal, truth_tracker)?;

@@ -150,13 +150,24 @@ impl CommandedWriter<AtomicFile> {
         with_desired_joints: bool,
         extra_columns: &[String],
     ) -> Result<Self> {
-        Self::start(
+        Self::to_output(
             AtomicFile::create(path)?,
-            path,
             dof,
             with_desired_joints,
             extra_columns,
         )
+    }
+
+    /// As [`CommandedWriter::create`], into an output already open (a file or a stream such as
+    /// standard output, see [`AtomicFile::stream`]).
+    pub fn to_output(
+        out: AtomicFile,
+        dof: usize,
+        with_desired_joints: bool,
+        extra_columns: &[String],
+    ) -> Result<Self> {
+        let path = out.target().to_owned();
+        Self::start(out, &path, dof, with_desired_joints, extra_columns)
     }
 
     /// Completes the file: renames it into place.

@@ -121,6 +121,14 @@ impl PerPointWriter {
     /// Starts the file at `path` for the rows of the file `header` describes and the series
     /// named `names`. Fails if an extra column of the input has the name of an output column.
     pub fn create(path: &Path, header: &MeasurementSet, names: [&str; 2]) -> Result<Self> {
+        Self::to_output(AtomicFile::create(path)?, header, names)
+    }
+
+    /// As [`PerPointWriter::create`], into an output already open (a file or a stream such as
+    /// standard output, see [`AtomicFile::stream`]).
+    pub fn to_output(out: AtomicFile, header: &MeasurementSet, names: [&str; 2]) -> Result<Self> {
+        let path = out.target().to_owned();
+        let path = path.as_path();
         let mut head = vec!["line".to_owned()];
         head.extend((1..=header.dof).map(|i| format!("q{i}")));
         let own_start = head.len();
@@ -140,7 +148,7 @@ impl PerPointWriter {
         let own: Vec<String> = head.drain(own_start..).collect();
         head.extend(header.extra_columns.iter().cloned());
         head.extend(own);
-        let mut w = csv::Writer::from_writer(AtomicFile::create(path)?);
+        let mut w = csv::Writer::from_writer(out);
         w.write_record(&head).map_err(|e| csv_io(path, e))?;
         Ok(PerPointWriter {
             path: path.to_owned(),

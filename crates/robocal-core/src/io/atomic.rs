@@ -1,9 +1,18 @@
-//! Writing files so that a failed run never leaves a half-written file or destroys an earlier
-//! result: the content goes to a temporary file beside the target, which is renamed over it only
-//! once complete.
+//! Writing files so that a failed or interrupted run never leaves a half-written file, never
+//! destroys an earlier result and never replaces anything but a regular file: the content goes to
+//! a temporary file `.NAME.PID.tmp` beside the target, which is renamed over it only once
+//! complete. A symbolic link to a regular file is written through (see [`resolve_output`]).
+//!
+//! Temporary files are registered while open, so that a signal handler can remove them all
+//! ([`remove_temporaries`]); those a killed run left behind are removed at the next write of the
+//! same output.
 
 use crate::error::{Error, Result};
-use std::io::Write;
+pub use crate::io::target::resolve_output;
+pub use crate::io::temporaries::remove_temporaries;
+use crate::io::temporaries::{registry, remove_stale, temporary_name};
+use std::fs::File;
+use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
 
 fn io_err(path: &Path, e: std::io::Error) -> Error {
@@ -13,88 +22,209 @@ fn io_err(path: &Path, e: std::io::Error) -> Error {
     }
 }
 
+/// The error of a writer whose temporary file [`remove_temporaries`] removed.
+fn interrupted(path: &Path) -> Error {
+    io_err(
+        path,
+        std::io::Error::new(
+            std::io::ErrorKind::Interrupted,
+            "interrupted: the file being written was removed",
+        ),
+    )
+}
+
+/// Where the content of an [`AtomicFile`] goes on commit.
+enum Dest {
+    /// `tmp` is renamed over `path` (the target with its symbolic links resolved).
+    Rename { path: PathBuf, tmp: PathBuf },
+    /// The spool file is copied to `sink`. `tmp` is the spool's name while it still has one
+    /// (on Unix it is removed as soon as it is open).
+    Stream {
+        sink: Box<dyn Write + Send>,
+        tmp: Option<PathBuf>,
+    },
+}
+
 /// A file being written; becomes visible under its final name only on [`AtomicFile::commit`].
 /// Dropped without commit, the temporary file is removed.
 pub struct AtomicFile {
+    /// The name the caller gave (for messages).
     target: PathBuf,
-    tmp: PathBuf,
-    file: Option<std::io::BufWriter<std::fs::File>>,
+    dest: Dest,
+    file: Option<BufWriter<File>>,
 }
 
 impl AtomicFile {
     /// Starts writing `target`. Fails (naming the path) if its directory does not exist or is not
-    /// writable, or if `target` is a directory.
+    /// writable, if `target` is (or links to) a directory, device, FIFO or socket, or if the run
+    /// is being interrupted. Temporaries of `target` left by runs that no longer exist are
+    /// removed. An existing target's permissions are kept.
     pub fn create(target: &Path) -> Result<AtomicFile> {
-        if target.is_dir() {
-            return Err(io_err(
-                target,
-                std::io::Error::other("is a directory, expected a file path"),
-            ));
-        }
-        let dir = match target.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
-            _ => PathBuf::from("."),
-        };
-        if !dir.is_dir() {
-            return Err(io_err(
-                target,
-                std::io::Error::new(
-                    std::io::ErrorKind::NotFound,
-                    format!("directory {} does not exist", dir.display()),
-                ),
-            ));
-        }
-        let name = target
+        let path = resolve_output(target)?;
+        let name = path
             .file_name()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "out".into());
-        let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
-        let file = std::fs::File::create(&tmp).map_err(|e| io_err(target, e))?;
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
+            _ => PathBuf::from("."),
+        };
+        let tmp = dir.join(temporary_name(&name));
+        let file = {
+            // Created and registered under the lock: a signal handler removing the temporaries
+            // sees it, or this sees that the run is being interrupted.
+            let mut reg = registry();
+            if reg.closed() {
+                return Err(interrupted(target));
+            }
+            remove_stale(&reg, &dir, &name);
+            let file = File::options()
+                .write(true)
+                .create_new(true)
+                .open(&tmp)
+                .map_err(|e| io_err(target, e))?;
+            reg.add(tmp.clone());
+            file
+        };
+        if let Ok(m) = std::fs::metadata(&path) {
+            let _ = file.set_permissions(m.permissions());
+        }
         Ok(AtomicFile {
             target: target.to_owned(),
-            tmp,
-            file: Some(std::io::BufWriter::new(file)),
+            dest: Dest::Rename { path, tmp },
+            file: Some(BufWriter::new(file)),
         })
     }
 
-    /// The final path.
+    /// Starts writing to `sink` (e.g. standard output) under the name `label` (for messages):
+    /// the content is spooled to an anonymous temporary file and copied to `sink` only on
+    /// [`AtomicFile::commit`], so that a failed run writes nothing there either.
+    pub fn stream(label: &Path, sink: Box<dyn Write + Send>) -> Result<AtomicFile> {
+        static SPOOLS: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+        let k = SPOOLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let tmp =
+            std::env::temp_dir().join(format!(".robocal-spool.{}.{k}.tmp", std::process::id()));
+        let mut reg = registry();
+        if reg.closed() {
+            return Err(interrupted(label));
+        }
+        let file = File::options()
+            .read(true)
+            .write(true)
+            .create_new(true)
+            .open(&tmp)
+            .map_err(|e| io_err(&tmp, e))?;
+        // Unix keeps an open file's content after its name is removed: then nothing can be left
+        // behind, whatever ends the process.
+        let tmp = if std::fs::remove_file(&tmp).is_ok() {
+            None
+        } else {
+            reg.add(tmp.clone());
+            Some(tmp)
+        };
+        Ok(AtomicFile {
+            target: label.to_owned(),
+            dest: Dest::Stream { sink, tmp },
+            file: Some(BufWriter::new(file)),
+        })
+    }
+
+    /// The path (or label) given.
     pub fn target(&self) -> &Path {
         &self.target
     }
 
-    /// Flushes, syncs and renames the temporary file over the target. On failure the temporary
-    /// file is removed and the target is left as it was.
-    pub fn commit(mut self) -> Result<()> {
-        let Some(mut w) = self.file.take() else {
-            return Ok(());
-        };
-        let done = w
-            .flush()
-            .and_then(|()| w.into_inner().map_err(|e| e.into_error()))
-            .and_then(|f| f.sync_all())
-            .and_then(|()| std::fs::rename(&self.tmp, &self.target));
-        if let Err(e) = done {
-            let _ = std::fs::remove_file(&self.tmp);
-            return Err(io_err(&self.target, e));
-        }
-        Ok(())
+    /// Flushes, syncs and renames the temporary file over the target (or copies the spool to the
+    /// stream). On failure the temporary file is removed and the target is left as it was.
+    pub fn commit(self) -> Result<()> {
+        commit_all(vec![self])
     }
+
+    /// The writer, flushed and taken out (the temporary stays registered until renamed).
+    fn finish(&mut self) -> Result<File> {
+        let Some(w) = self.file.take() else {
+            return Err(io_err(
+                &self.target,
+                std::io::Error::other("already committed"),
+            ));
+        };
+        let file = w
+            .into_inner()
+            .map_err(|e| io_err(&self.target, e.into_error()))?;
+        if matches!(self.dest, Dest::Rename { .. }) {
+            file.sync_all().map_err(|e| io_err(&self.target, e))?;
+        }
+        Ok(file)
+    }
+
+    /// Removes the temporary file if it is still this writer's (not renamed, not removed by
+    /// [`remove_temporaries`]).
+    fn discard(&mut self) {
+        let tmp = match &self.dest {
+            Dest::Rename { tmp, .. } => Some(tmp),
+            Dest::Stream { tmp, .. } => tmp.as_ref(),
+        };
+        if let Some(tmp) = tmp {
+            let mut reg = registry();
+            if reg.forget(tmp) {
+                let _ = std::fs::remove_file(tmp);
+            }
+        }
+    }
+}
+
+/// Commits several files so that they are replaced together: all are completed and synced
+/// first, then renamed one after the other with no interruption between them (a signal handler
+/// calling [`remove_temporaries`] waits for the renames). Streams are copied last. On a failure
+/// before the renames nothing is replaced and every temporary file is removed.
+pub fn commit_all(mut files: Vec<AtomicFile>) -> Result<()> {
+    let mut spooled = Vec::new();
+    for f in &mut files {
+        spooled.push(f.finish()?);
+    }
+    {
+        let mut reg = registry();
+        for f in &files {
+            if let Dest::Rename { path, tmp } = &f.dest {
+                if reg.closed() || !reg.contains(tmp) {
+                    return Err(interrupted(&f.target));
+                }
+                std::fs::rename(tmp, path).map_err(|e| io_err(&f.target, e))?;
+                reg.forget(tmp);
+            }
+        }
+    }
+    for (f, mut spool) in files.iter_mut().zip(spooled) {
+        let target = f.target.clone();
+        if let Dest::Stream { sink, .. } = &mut f.dest {
+            spool
+                .rewind()
+                .and_then(|()| std::io::copy(&mut spool, sink))
+                .and_then(|_| sink.flush())
+                .map_err(|e| io_err(&target, e))?;
+        }
+    }
+    Ok(())
 }
 
 impl Write for AtomicFile {
     fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        self.file.as_mut().expect("not yet committed").write(buf)
+        match self.file.as_mut() {
+            Some(f) => f.write(buf),
+            None => Err(std::io::Error::other("already committed")),
+        }
     }
     fn flush(&mut self) -> std::io::Result<()> {
-        self.file.as_mut().expect("not yet committed").flush()
+        match self.file.as_mut() {
+            Some(f) => f.flush(),
+            None => Ok(()),
+        }
     }
 }
 
 impl Drop for AtomicFile {
     fn drop(&mut self) {
-        if self.file.take().is_some() {
-            let _ = std::fs::remove_file(&self.tmp);
-        }
+        self.discard();
     }
 }
 
@@ -106,7 +236,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Writes several files so that either all of them or none are replaced: each is written to a
-/// temporary file first; only when all are complete are they renamed.
+/// temporary file first; only when all are complete are they renamed ([`commit_all`]).
 pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
     let mut open = Vec::with_capacity(files.len());
     for (p, bytes) in files {
@@ -114,12 +244,8 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
         f.write_all(bytes).map_err(|e| io_err(p, e))?;
         open.push(f);
     }
-    for f in open {
-        f.commit()?;
-    }
-    Ok(())
+    commit_all(open)
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,5 +295,120 @@ mod tests {
             "temporary file left behind"
         );
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    fn scratch(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("robocal-atomic-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    fn names(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    #[test]
+    fn stale_temporaries_of_dead_runs_are_removed_at_the_next_write() {
+        let d = scratch("stale");
+        let stale = d.join(".r.json.999999999.tmp");
+        std::fs::write(&stale, "left by a killed run").unwrap();
+        // A live process's temporary (pid 1 always exists), another output's, a directory.
+        std::fs::write(d.join(".r.json.1.tmp"), "live").unwrap();
+        std::fs::write(d.join(".q.json.999999999.tmp"), "other output").unwrap();
+        std::fs::create_dir(d.join(".r.json.999999998.tmp")).unwrap();
+        write_atomic(&d.join("r.json"), b"new").unwrap();
+        assert_eq!(
+            names(&d),
+            [
+                ".q.json.999999999.tmp",
+                ".r.json.1.tmp",
+                ".r.json.999999998.tmp",
+                "r.json"
+            ]
+        );
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn a_link_to_a_regular_file_is_written_through_and_kept() {
+        let d = scratch("link");
+        std::fs::write(d.join("real.json"), "old").unwrap();
+        std::os::unix::fs::symlink("real.json", d.join("link.json")).unwrap();
+        write_atomic(&d.join("link.json"), b"new").unwrap();
+        assert!(std::fs::symlink_metadata(d.join("link.json"))
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read(d.join("real.json")).unwrap(), b"new");
+        assert_eq!(names(&d), ["link.json", "real.json"]);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn special_files_are_never_replaced() {
+        let d = scratch("special");
+        std::os::unix::fs::symlink("/dev/null", d.join("null.csv")).unwrap();
+        let e = write_atomic(&d.join("null.csv"), b"x")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("character device"), "{e}");
+        use std::os::unix::fs::FileTypeExt;
+        assert!(std::fs::metadata("/dev/null")
+            .unwrap()
+            .file_type()
+            .is_char_device());
+        assert_eq!(names(&d), ["null.csv"]);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[cfg(unix)]
+    #[test]
+    fn permissions_of_the_old_file_are_kept() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = scratch("mode");
+        let p = d.join("r.json");
+        std::fs::write(&p, "old").unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o640)).unwrap();
+        write_atomic(&p, b"new").unwrap();
+        let mode = std::fs::metadata(&p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640);
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_stream_gets_the_content_only_on_commit() {
+        #[derive(Clone, Default)]
+        struct Sink(std::sync::Arc<std::sync::Mutex<Vec<u8>>>);
+        impl Write for Sink {
+            fn write(&mut self, b: &[u8]) -> std::io::Result<usize> {
+                self.0.lock().unwrap().extend_from_slice(b);
+                Ok(b.len())
+            }
+            fn flush(&mut self) -> std::io::Result<()> {
+                Ok(())
+            }
+        }
+        let sink = Sink::default();
+        let mut f =
+            AtomicFile::stream(Path::new("standard output"), Box::new(sink.clone())).unwrap();
+        f.write_all(b"a,b\n1,2\n").unwrap();
+        assert!(sink.0.lock().unwrap().is_empty());
+        f.commit().unwrap();
+        assert_eq!(*sink.0.lock().unwrap(), b"a,b\n1,2\n");
+        let dropped = Sink::default();
+        {
+            let mut f = AtomicFile::stream(Path::new("standard output"), Box::new(dropped.clone()))
+                .unwrap();
+            f.write_all(b"half").unwrap();
+        }
+        assert!(dropped.0.lock().unwrap().is_empty());
     }
 }

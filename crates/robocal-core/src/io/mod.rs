@@ -5,8 +5,12 @@ pub(crate) mod columns;
 pub mod input;
 pub mod measurements;
 pub mod result;
+mod target;
+mod temporaries;
 
-pub use atomic::{write_all_atomic, write_atomic, AtomicFile};
+pub use atomic::{
+    commit_all, remove_temporaries, resolve_output, write_all_atomic, write_atomic, AtomicFile,
+};
 pub use measurements::{
     parse_measurements, read_measurements, write_measurements, Measurement, MeasurementReader,
     MeasurementSet, Positions,
