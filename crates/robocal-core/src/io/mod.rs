@@ -3,6 +3,7 @@
 pub mod atomic;
 pub(crate) mod columns;
 pub mod input;
+pub mod json_keys;
 pub mod measurements;
 pub mod result;
 
