@@ -199,11 +199,20 @@ mod tests {
         );
         let e = ANGLE.check(-1e300).unwrap_err();
         assert!(e.starts_with("-1e300 deg is out of range"), "{e}");
-        assert!(JOINT.check(1_000_080.0).unwrap_err().contains("1000080 deg"));
+        assert!(JOINT
+            .check(1_000_080.0)
+            .unwrap_err()
+            .contains("1000080 deg"));
         assert!(JOINT.check(99_999.5).is_ok());
         let e = ERROR.check(-0.5).unwrap_err();
-        assert!(e.contains("-0.5 mm") && e.contains("within 0..1e6 mm"), "{e}");
-        assert!(SIZE_MM.check(f64::NAN).unwrap_err().contains("not a finite"));
+        assert!(
+            e.contains("-0.5 mm") && e.contains("within 0..1e6 mm"),
+            "{e}"
+        );
+        assert!(SIZE_MM
+            .check(f64::NAN)
+            .unwrap_err()
+            .contains("not a finite"));
         assert!(COMPLIANCE.check(1e-7).is_ok() && COMPLIANCE.check(2.0).is_err());
         assert!(MASS.check(-1.0).is_err() && NOISE_PER_M.check(0.005).is_ok());
         assert_eq!(Range::for_unit(Unit::Mm), &LENGTH);

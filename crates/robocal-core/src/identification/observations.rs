@@ -7,9 +7,10 @@ use crate::model::Robot;
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
 
-/// Largest accepted measured coordinate (mm): 10 km, far beyond any tracker's range, but small
-/// enough that squares and sums of coordinates stay accurate.
-pub const MAX_COORDINATE_MM: f64 = 1e7;
+/// Largest accepted measured coordinate (mm): the bound of every length ([`crate::ranges::LENGTH`],
+/// 1 km), far beyond any tracker's range, but small enough that squares and sums of coordinates
+/// stay accurate.
+pub const MAX_COORDINATE_MM: f64 = crate::ranges::LENGTH.max;
 
 /// A set of measured tool points: joint values (model values, rad, stored flat) and the measured
 /// position of the tool in the tracker frame (mm), with the 1-based CSV line of each point.

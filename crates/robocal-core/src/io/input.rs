@@ -55,7 +55,8 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(
 ) -> Result<T> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let de = &mut serde_json::Deserializer::from_str(text);
-    let value: T = serde_path_to_error::deserialize(&mut *de).map_err(|e| json_error(e, path, what))?;
+    let value: T =
+        serde_path_to_error::deserialize(&mut *de).map_err(|e| json_error(e, path, what))?;
     de.end().map_err(|e| {
         let line = (e.line() > 0).then_some(e.line());
         Error::parse(

@@ -165,12 +165,18 @@ mod tests {
 
     #[test]
     fn finds_duplicates_at_any_depth_with_path_and_line() {
-        assert_eq!(find_duplicate_key("{\"a\": 1, \"b\": {\"a\": 2}}").unwrap(), None);
+        assert_eq!(
+            find_duplicate_key("{\"a\": 1, \"b\": {\"a\": 2}}").unwrap(),
+            None
+        );
         assert_eq!(find_duplicate_key("[1, {\"x\": [2]}, 3]").unwrap(), None);
-        let d = find_duplicate_key("{\n \"a\": 1,\n \"a\": 2\n}").unwrap().unwrap();
+        let d = find_duplicate_key("{\n \"a\": 1,\n \"a\": 2\n}")
+            .unwrap()
+            .unwrap();
         assert_eq!(d.path, "a");
         assert_eq!(d.line, 3);
-        let text = "{\"parameters\": {\n  \"a2\": {\"nominal\": 1},\n  \"d4\": {\"nominal\": 2},\n  \
+        let text =
+            "{\"parameters\": {\n  \"a2\": {\"nominal\": 1},\n  \"d4\": {\"nominal\": 2},\n  \
                     \"a2\": {\"nominal\": 3}\n}}";
         let d = find_duplicate_key(text).unwrap().unwrap();
         assert_eq!((d.path.as_str(), d.line), ("parameters.a2", 4));
@@ -178,7 +184,9 @@ mod tests {
         let d = find_duplicate_key(text).unwrap().unwrap();
         assert_eq!((d.path.as_str(), d.line), ("p[1].x", 2));
         // Keys equal after unescaping are the same key.
-        let d = find_duplicate_key("{\"ab\": 1, \"a\\u0062\": 2}").unwrap().unwrap();
+        let d = find_duplicate_key("{\"ab\": 1, \"a\\u0062\": 2}")
+            .unwrap()
+            .unwrap();
         assert_eq!(d.path, "ab");
         // Not JSON: serde_json's error.
         assert!(find_duplicate_key("{\"a\": }").is_err());
