@@ -2,7 +2,7 @@
 //! the CSV line it came from.
 
 use crate::error::{Error, Result};
-use crate::io::MeasurementSet;
+use crate::io::{MeasurementSet, SetLabel};
 use crate::model::Robot;
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
@@ -164,9 +164,10 @@ impl Observations {
     }
 }
 
-/// The points of a measurement file sorted by their role, from an optional `set` column:
-/// `plane` marks the paper's three points for the initial measurement frame, `validation` (or
-/// `val`) validation points; every other row is a calibration point.
+/// The points of a measurement file sorted by their role, from an optional `set` column
+/// ([`SetLabel`]): `plane` marks the paper's three points for the initial measurement frame,
+/// `validation` (or `val`) validation points, `calibration` (or an empty cell, or no `set`
+/// column) calibration points. Any other label is an error.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SplitData {
     /// Calibration points.
@@ -178,7 +179,7 @@ pub struct SplitData {
 }
 
 /// Sorts a measurement file's rows by their `set` column (see [`SplitData`]). Every row must have
-/// a measured position.
+/// a measured position, and every `set` label must be known ([`MeasurementSet::set_labels`]).
 pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
     let mk = || Observations::with_source(set.dof, &set.path);
     let mut out = SplitData {
@@ -186,11 +187,8 @@ pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
         validation: mk(),
         plane: mk(),
     };
-    let set_col = set
-        .extra_columns
-        .iter()
-        .position(|c| c.eq_ignore_ascii_case("set"));
-    for r in &set.rows {
+    let labels = set.set_labels()?;
+    for (r, label) in set.rows.iter().zip(labels) {
         let Some(p) = r.p else {
             return Err(Error::parse(
                 &set.path,
@@ -199,11 +197,10 @@ pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
                 "no measured position (x,y,z) in this row",
             ));
         };
-        let label = set_col.map(|k| r.extra[k].trim().to_ascii_lowercase());
-        let target = match label.as_deref() {
-            Some("plane") => &mut out.plane,
-            Some("validation" | "val") => &mut out.validation,
-            _ => &mut out.calibration,
+        let target = match label {
+            SetLabel::Plane => &mut out.plane,
+            SetLabel::Validation => &mut out.validation,
+            SetLabel::Calibration => &mut out.calibration,
         };
         target.push(&r.q, p, r.line)?;
     }

@@ -6,6 +6,7 @@ pub mod input;
 pub mod json_keys;
 pub mod measurements;
 pub mod result;
+pub mod set_label;
 
 pub use atomic::{write_all_atomic, write_atomic, AtomicFile};
 pub use measurements::{
@@ -13,3 +14,4 @@ pub use measurements::{
     MeasurementSet, Positions,
 };
 pub use result::CalibrationResult;
+pub use set_label::SetLabel;
