@@ -3,6 +3,7 @@
 pub mod atomic;
 pub(crate) mod columns;
 pub mod input;
+pub mod joint_limits;
 pub mod json_keys;
 pub mod measurements;
 pub mod result;
