@@ -12,6 +12,7 @@ use robocal_core::identification::{
     IdentifiabilityOptions, Objective, Observations, RobustLoss, SolverOptions,
     DEFAULT_RANK_TOLERANCE,
 };
+use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::{read_measurements, Positions};
 use robocal_core::{ErrorStats, Param, Robot};
 use serde_json::json;
@@ -24,12 +25,17 @@ pub struct CalibrateArgs {
     robot: String,
     /// Calibration measurements (CSV: q1..qn in degrees, x,y,z in mm in the tracker frame).
     /// Rows with `set` = `plane` give the initial frame; rows with `set` = `validation` are
-    /// validation points.
+    /// validation points; any other label than these, `calibration` or empty is an error.
     #[arg(long)]
     data: PathBuf,
-    /// Validation measurements (same format), evaluated with the fitted tracker frame.
+    /// Validation measurements (same format), evaluated with the fitted tracker frame. Must be
+    /// another file than --data.
     #[arg(long)]
     validate: Option<PathBuf>,
+    /// The robot's joint limits are only nominal: joint values outside them are a warning
+    /// listing the lines (recorded in the result's settings) instead of an error (exit code 3).
+    #[arg(long)]
+    nominal_limits: bool,
     /// What to minimize: the paper's total displacement error, squared errors, or a robust loss
     /// that down-weights outliers.
     #[arg(long, value_enum, default_value_t = ObjectiveArg::SumOfNorms)]
@@ -141,13 +147,48 @@ fn apply_beta(robot: &mut Robot, arg: &str) -> anyhow::Result<Vec<usize>> {
     }
 }
 
-/// Reads a measurement file and sorts its rows (see `split_measurements`).
-fn read(path: &Path, robot: &Robot) -> anyhow::Result<robocal_core::identification::SplitData> {
+/// Reads a measurement file and sorts its rows (see `split_measurements`). Rows outside the
+/// robot's joint limits are an error, or with --nominal-limits a warning, and are added to
+/// `outside`.
+fn read(
+    path: &Path,
+    robot: &Robot,
+    nominal_limits: bool,
+    outside: &mut Vec<OutsideLimits>,
+) -> anyhow::Result<robocal_core::identification::SplitData> {
     let set = read_measurements(path, robot.dof(), Positions::Required)?;
     for w in &set.warnings {
         eprintln!("warning: {w}");
     }
-    Ok(split_measurements(&set)?)
+    let split = split_measurements(&set)?;
+    let mut o = OutsideLimits::new(robot, path);
+    for r in &set.rows {
+        o.check(r.line, &r.q);
+    }
+    check_limits(o, nominal_limits, outside)?;
+    Ok(split)
+}
+
+/// Refuses rows outside the joint limits (exit code 3), or with `--nominal-limits` warns about
+/// them and keeps them in `outside` for the result.
+pub(super) fn check_limits(
+    o: OutsideLimits,
+    nominal_limits: bool,
+    outside: &mut Vec<OutsideLimits>,
+) -> anyhow::Result<()> {
+    if nominal_limits {
+        if let Some(w) = o.to_warning() {
+            eprintln!("warning: {w} (used anyway: --nominal-limits)");
+            outside.push(o);
+        }
+        return Ok(());
+    }
+    match o.to_error() {
+        None => Ok(()),
+        Some(e) => Err(exit::input(format!(
+            "{e}; if the robot's limits are only nominal, give --nominal-limits to use these rows"
+        ))),
+    }
 }
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
@@ -179,10 +220,22 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             "the result is a file that later commands read, and the tables go to standard output",
         )
         .check()?;
-    let data = read(&a.data, &robot)?;
+    if let Some(v) = &a.validate {
+        if super::io_plan::same_file(v, &a.data) {
+            return Err(exit::usage(format!(
+                "--validate {}: this is the --data file {} (the same file); validation points \
+                 must be points the calibration did not fit: give another file, or mark \
+                 validation rows of --data with set = validation",
+                v.display(),
+                a.data.display()
+            )));
+        }
+    }
+    let mut outside = Vec::new();
+    let data = read(&a.data, &robot, a.nominal_limits, &mut outside)?;
     let mut validation = data.validation.clone();
     if let Some(v) = &a.validate {
-        let vd = read(v, &robot)?;
+        let vd = read(v, &robot, a.nominal_limits, &mut outside)?;
         if !vd.plane.is_empty() {
             eprintln!(
                 "note: {}: {} plane point(s) ignored in the validation set",
@@ -277,6 +330,14 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     extra.insert("data".into(), json!(a.data.display().to_string()));
     if let Some(v) = &a.validate {
         extra.insert("validate".into(), json!(v.display().to_string()));
+    }
+    extra.insert("nominal_limits".into(), json!(a.nominal_limits));
+    if !outside.is_empty() {
+        let rows: Vec<_> = outside
+            .iter()
+            .map(|o| json!({"file": o.path().display().to_string(), "rows": o.count(), "lines": o.lines()}))
+            .collect();
+        extra.insert("rows_outside_limits".into(), json!(rows));
     }
     let mut res = cal.to_result(extra);
     if converged {

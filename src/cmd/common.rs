@@ -60,6 +60,12 @@ pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
                 i + 1
             )));
         }
+        if let Err(msg) = robocal_core::ranges::JOINT.check(v) {
+            return Err(crate::exit::usage(format!(
+                "--joints: value {}: {msg}",
+                i + 1
+            )));
+        }
         q.push(v.to_radians());
     }
     if q.len() != robot.dof() {

@@ -128,8 +128,9 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         }
         if outside.count > 0 {
             eprintln!(
-                "warning: {} desired pose(s) outside the joint limits; solved from the nearest \
-                 pose within them: {}",
+                "warning: {}: {} desired pose(s) outside the joint limits; solved from the \
+                 nearest pose within them: {}",
+                path.display(),
                 outside.count,
                 outside.text()
             );

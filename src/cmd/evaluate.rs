@@ -7,6 +7,7 @@ use super::io_plan::{self, IoPlan};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use robocal_core::evaluation::{self, Against, Evaluator, PerPointWriter, Reference};
+use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::{
     CalibrationResult, Measurement, MeasurementReader, MeasurementSet, Positions,
 };
@@ -37,6 +38,10 @@ pub struct EvaluateArgs {
     /// Print the statistics as JSON.
     #[arg(long)]
     json: bool,
+    /// The robot's joint limits are only nominal: joint values outside them are a warning
+    /// listing the lines instead of an error (exit code 3).
+    #[arg(long)]
+    nominal_limits: bool,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -102,7 +107,9 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     };
     let mut norms = [Vec::new(), Vec::new()];
     let mut not_converged = Statuses::new(&header);
+    let mut outside = OutsideLimits::new(&nominal, &a.data);
     while let Some(r) = reader.next_row().with_context(context)? {
+        outside.check(r.line, &r.q);
         let e = ev.errors(&r)?;
         norms[0].push(e[0].norm());
         norms[1].push(e[1].norm());
@@ -114,6 +121,9 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     for w in reader.finish().with_context(context)? {
         eprintln!("warning: {w}");
     }
+    let n_outside = outside.count();
+    // Refused before anything is written (the per-point writer is dropped).
+    super::calibrate::check_limits(outside, a.nominal_limits, &mut Vec::new())?;
     if let Some(w) = per_point {
         w.commit()?;
     }
@@ -142,6 +152,9 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             .into(),
         );
         o.insert("n".into(), n.into());
+        if a.nominal_limits {
+            o.insert("rows_outside_limits".into(), n_outside.into());
+        }
         for s in &series {
             o.insert(s.name.into(), serde_json::to_value(s.stats)?);
         }

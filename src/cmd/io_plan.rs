@@ -310,6 +310,12 @@ fn identity(p: &Path) -> Identity {
     }
 }
 
+/// Whether two paths name the same file (same device and inode, through any link), or the same
+/// place when they do not exist yet.
+pub fn same_file(a: &Path, b: &Path) -> bool {
+    identity(a) == identity(b)
+}
+
 /// How an output reaches an input it collides with, for the message.
 fn relation(out: &Path, input: &Path) -> &'static str {
     if std::fs::symlink_metadata(out).is_ok_and(|m| m.file_type().is_symlink()) {

@@ -56,7 +56,13 @@ pub fn result_for(nominal: &Robot, calibrated: &Robot, frame: &Frame) -> Calibra
             },
             validation: None,
         },
-        extra: Default::default(),
+        // Every result robocal writes has a status (readers refuse one without).
+        extra: [(
+            "status".to_owned(),
+            robocal_core::io::result::STATUS_CALIBRATED.into(),
+        )]
+        .into_iter()
+        .collect(),
     }
 }
 

@@ -175,24 +175,23 @@ impl DesiredSource {
         r: &Measurement,
         nominal: &Robot,
     ) -> Result<Vector3<f64>> {
-        let num = |k: usize| -> Result<f64> {
+        let num = |k: usize, range: &crate::ranges::Range| -> Result<f64> {
             let s = r.extra[k].trim();
+            let err = |msg: String| {
+                Error::parse(&data.path, Some(r.line), Some(&data.extra_columns[k]), msg)
+            };
             match s.parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(v),
-                _ => Err(Error::parse(
-                    &data.path,
-                    Some(r.line),
-                    Some(&data.extra_columns[k]),
-                    format!("`{s}` is not a finite number"),
-                )),
+                Ok(v) if v.is_finite() => range.check(v).map_err(err),
+                _ => Err(err(format!("`{s}` is not a finite number"))),
             }
         };
+        let pos = |k| num(k, &crate::ranges::LENGTH);
         match self {
-            DesiredSource::Position(c) => Ok(Vector3::new(num(c[0])?, num(c[1])?, num(c[2])?)),
+            DesiredSource::Position(c) => Ok(Vector3::new(pos(c[0])?, pos(c[1])?, pos(c[2])?)),
             DesiredSource::Joints(c) => {
                 let q = c
                     .iter()
-                    .map(|&k| num(k).map(f64::to_radians))
+                    .map(|&k| num(k, &crate::ranges::JOINT).map(f64::to_radians))
                     .collect::<Result<Vec<_>>>()?;
                 Ok(nominal.tool_position(&q))
             }

@@ -19,6 +19,7 @@ pub mod identification;
 pub mod io;
 pub mod kinematics;
 pub mod model;
+pub mod ranges;
 pub mod registration;
 pub mod simulation;
 pub mod stats;

@@ -5,8 +5,7 @@ use crate::build::{before_after_histogram, paper_tables};
 use crate::data::{HistogramSeries, Note, PointError, PointSet, ReachKind, ReportData};
 use robocal_core::evaluation::{evaluate, Against, Evaluation};
 use robocal_core::io::result::BeforeAfter;
-use robocal_core::io::{CalibrationResult, Measurement, MeasurementSet};
-use robocal_core::simulation::{SET_PLANE, SET_VALIDATION};
+use robocal_core::io::{CalibrationResult, MeasurementSet, SetLabel};
 use robocal_core::{ErrorStats, Result, Robot};
 use serde_json::Value;
 
@@ -44,22 +43,20 @@ struct Evaluated {
     stats: [ErrorStats; 2],
 }
 
-/// The rows of `set` whose `set` column is (or is not) one of `labels`.
-fn rows_where(set: &MeasurementSet, labels: &[&str], keep: bool) -> MeasurementSet {
-    let col = set
-        .extra_columns
-        .iter()
-        .position(|c| c.eq_ignore_ascii_case("set"));
-    let is = |r: &Measurement| {
-        col.is_some_and(|k| {
-            let v = r.extra[k].trim().to_ascii_lowercase();
-            labels.iter().any(|l| *l == v) || (labels.contains(&SET_VALIDATION) && v == "val")
-        })
-    };
-    MeasurementSet {
-        rows: set.rows.iter().filter(|r| is(r) == keep).cloned().collect(),
+/// The rows of `set` whose `set` label is (or is not) one of `labels`; an unknown label is an
+/// error naming the file and line.
+fn rows_where(set: &MeasurementSet, labels: &[SetLabel], keep: bool) -> Result<MeasurementSet> {
+    let of_row = set.set_labels()?;
+    Ok(MeasurementSet {
+        rows: set
+            .rows
+            .iter()
+            .zip(of_row)
+            .filter(|(_, l)| labels.contains(l) == keep)
+            .map(|(r, _)| r.clone())
+            .collect(),
         ..set.clone()
-    }
+    })
 }
 
 fn reach_of(v: nalgebra::Vector3<f64>) -> f64 {
@@ -133,13 +130,13 @@ impl ReportData {
         let mut validation_rows: Option<MeasurementSet> = None;
         match run.calibration {
             Some(set) => {
-                let cal = rows_where(set, &[SET_PLANE, SET_VALIDATION], false);
+                let cal = rows_where(set, &[SetLabel::Plane, SetLabel::Validation], false)?;
                 let e = evaluated(run, &cal, Against::Model)?;
                 sets.push(PointSet {
                     name: CALIBRATION.into(),
                     points: e.points,
                 });
-                let val = rows_where(set, &[SET_VALIDATION], true);
+                let val = rows_where(set, &[SetLabel::Validation], true)?;
                 if !val.rows.is_empty() {
                     validation_rows = Some(val);
                 }
@@ -156,7 +153,7 @@ impl ReportData {
 
         // Validation: the rows of the calibration file, then the validation file.
         if let Some(v) = run.validation {
-            let v = rows_where(v, &[SET_PLANE], false);
+            let v = rows_where(v, &[SetLabel::Plane], false)?;
             validation_rows = Some(match validation_rows {
                 Some(mut a) => {
                     a.rows.extend(v.rows);

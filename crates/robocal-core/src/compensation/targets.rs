@@ -4,6 +4,7 @@
 
 use crate::error::{Error, Result};
 use crate::io::columns::{csv_reader, next_record, ColumnLayout};
+use crate::ranges;
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
 
@@ -65,13 +66,16 @@ pub fn parse_targets<R: std::io::Read>(reader: R, path: &Path, dof: usize) -> Re
     let mut rows = Vec::new();
     let mut rec = csv::StringRecord::new();
     while let Some(line) = next_record(&mut rdr, &mut rec, path)? {
-        let num = |k: usize| layout.number(&rec, k, path, line);
-        let p = Vector3::new(num(x)?, num(y)?, num(z)?);
+        let num = |k: usize, range, what| layout.number_in(&rec, k, path, line, range, what);
+        let pos = |k| num(k, &ranges::LENGTH, "not a plausible target");
+        let p = Vector3::new(pos(x)?, pos(y)?, pos(z)?);
         let seed = if q_cols.len() == dof {
             Some(
                 q_cols
                     .iter()
-                    .map(|&c| num(c).map(f64::to_radians))
+                    .map(|&c| {
+                        num(c, &ranges::JOINT, "not a plausible joint value").map(f64::to_radians)
+                    })
                     .collect::<Result<Vec<f64>>>()?,
             )
         } else {
@@ -131,5 +135,17 @@ mod tests {
         assert!(e.contains("no data rows"), "{e}");
         let e = parse("x,y,z\n1,2\n").unwrap_err().to_string();
         assert!(e.contains("t.csv:2") && e.contains("2 fields"), "{e}");
+        let e = parse("x,y,z\n1,2,3\n-2e6,2,3\n").unwrap_err().to_string();
+        assert!(
+            e.contains("t.csv:3: field `x`: not a plausible target: -2000000 mm is out of range"),
+            "{e}"
+        );
+        let e = parse("x,y,z,q1,q2\n1,2,3,4,1e300\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("t.csv:2: field `q2`: not a plausible joint value: 1e300 deg"),
+            "{e}"
+        );
     }
 }

@@ -114,7 +114,7 @@ pub struct ExperimentConfig {
     /// Keys merged into the result's `settings` (the caller's file names, as `robocal
     /// calibrate` records them). By default the result records `robot_arg` = the nominal
     /// robot's name (a preset name in the paper's experiment; give the file for a robot file),
-    /// `data` = `cell.csv` and `validate` = `validation.csv`.
+    /// `data` = `cell.csv`, `validate` = `validation.csv` and `nominal_limits` = false.
     pub result_settings: serde_json::Map<String, serde_json::Value>,
 }
 
@@ -331,6 +331,8 @@ pub fn run_experiment(
     extra.insert("robot_arg".into(), nominal.name().into());
     extra.insert("data".into(), files::CELL.into());
     extra.insert("validate".into(), files::VALIDATION.into());
+    // Simulated poses are within the limits: the joint limits are enforced, as by default.
+    extra.insert("nominal_limits".into(), false.into());
     extra.extend(config.result_settings.clone());
     let mut result_json = serde_json::to_string_pretty(&calibration.to_result(extra))
         .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;

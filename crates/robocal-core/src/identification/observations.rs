@@ -2,14 +2,15 @@
 //! the CSV line it came from.
 
 use crate::error::{Error, Result};
-use crate::io::MeasurementSet;
+use crate::io::{MeasurementSet, SetLabel};
 use crate::model::Robot;
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
 
-/// Largest accepted measured coordinate (mm): 10 km, far beyond any tracker's range, but small
-/// enough that squares and sums of coordinates stay accurate.
-pub const MAX_COORDINATE_MM: f64 = 1e7;
+/// Largest accepted measured coordinate (mm): the bound of every length ([`crate::ranges::LENGTH`],
+/// 1 km), far beyond any tracker's range, but small enough that squares and sums of coordinates
+/// stay accurate.
+pub const MAX_COORDINATE_MM: f64 = crate::ranges::LENGTH.max;
 
 /// A set of measured tool points: joint values (model values, rad, stored flat) and the measured
 /// position of the tool in the tracker frame (mm), with the 1-based CSV line of each point.
@@ -163,9 +164,10 @@ impl Observations {
     }
 }
 
-/// The points of a measurement file sorted by their role, from an optional `set` column:
-/// `plane` marks the paper's three points for the initial measurement frame, `validation` (or
-/// `val`) validation points; every other row is a calibration point.
+/// The points of a measurement file sorted by their role, from an optional `set` column
+/// ([`SetLabel`]): `plane` marks the paper's three points for the initial measurement frame,
+/// `validation` (or `val`) validation points, `calibration` (or an empty cell, or no `set`
+/// column) calibration points. Any other label is an error.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SplitData {
     /// Calibration points.
@@ -177,7 +179,7 @@ pub struct SplitData {
 }
 
 /// Sorts a measurement file's rows by their `set` column (see [`SplitData`]). Every row must have
-/// a measured position.
+/// a measured position, and every `set` label must be known ([`MeasurementSet::set_labels`]).
 pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
     let mk = || Observations::with_source(set.dof, &set.path);
     let mut out = SplitData {
@@ -185,11 +187,8 @@ pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
         validation: mk(),
         plane: mk(),
     };
-    let set_col = set
-        .extra_columns
-        .iter()
-        .position(|c| c.eq_ignore_ascii_case("set"));
-    for r in &set.rows {
+    let labels = set.set_labels()?;
+    for (r, label) in set.rows.iter().zip(labels) {
         let Some(p) = r.p else {
             return Err(Error::parse(
                 &set.path,
@@ -198,11 +197,10 @@ pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
                 "no measured position (x,y,z) in this row",
             ));
         };
-        let label = set_col.map(|k| r.extra[k].trim().to_ascii_lowercase());
-        let target = match label.as_deref() {
-            Some("plane") => &mut out.plane,
-            Some("validation" | "val") => &mut out.validation,
-            _ => &mut out.calibration,
+        let target = match label {
+            SetLabel::Plane => &mut out.plane,
+            SetLabel::Validation => &mut out.validation,
+            SetLabel::Calibration => &mut out.calibration,
         };
         target.push(&r.q, p, r.line)?;
     }

@@ -123,6 +123,29 @@ impl ColumnLayout {
         Ok(v)
     }
 
+    /// [`ColumnLayout::number`] within `range` ([`crate::ranges`]); a value outside is an error
+    /// naming the file, line and column, its message starting with `what` (e.g. `not a plausible
+    /// tracker reading`).
+    pub fn number_in(
+        &self,
+        record: &csv::StringRecord,
+        k: usize,
+        path: &Path,
+        line: usize,
+        range: &crate::ranges::Range,
+        what: &str,
+    ) -> Result<f64> {
+        let v = self.number(record, k, path, line)?;
+        range.check(v).map_err(|msg| {
+            Error::parse(
+                path,
+                Some(line),
+                Some(&self.headers[k]),
+                format!("{what}: {msg}"),
+            )
+        })
+    }
+
     /// The values of the extra columns of `record`.
     pub fn extra_values(&self, record: &csv::StringRecord) -> Vec<String> {
         self.extra.iter().map(|&k| record[k].to_owned()).collect()

@@ -44,6 +44,10 @@ pub fn read_text(path: &Path) -> Result<String> {
 /// Deserializes JSON `text` read from `path`, naming on failure the line and the field (its path,
 /// e.g. `parameters.a2.calibrated`) of the first problem. `what` names the kind of file in the
 /// message (`not a robocal result: ...`).
+///
+/// Stricter than serde_json: the text must end after the value (no second document, no trailing
+/// garbage), and no object may have a key twice (serde_json would keep the last silently; see
+/// [`crate::io::json_keys`]).
 pub fn parse_json<T: serde::de::DeserializeOwned>(
     text: &str,
     path: &Path,
@@ -51,8 +55,39 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(
 ) -> Result<T> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let de = &mut serde_json::Deserializer::from_str(text);
-    let value: T = serde_path_to_error::deserialize(de).map_err(|e| json_error(e, path, what))?;
-    Ok(value)
+    let value: T =
+        serde_path_to_error::deserialize(&mut *de).map_err(|e| json_error(e, path, what))?;
+    de.end().map_err(|e| {
+        let line = (e.line() > 0).then_some(e.line());
+        Error::parse(
+            path,
+            line,
+            None,
+            format!(
+                "not a {what}: text after the end of the JSON document (two documents \
+                 concatenated, or characters after the last closing brace)"
+            ),
+        )
+    })?;
+    match crate::io::json_keys::find_duplicate_key(text) {
+        Ok(None) => Ok(value),
+        Ok(Some(d)) => Err(Error::parse(
+            path,
+            Some(d.line),
+            Some(&d.path),
+            format!(
+                "not a {what}: the key `{}` appears twice in one object (which one is meant?)",
+                d.path.rsplit('.').next().unwrap_or(&d.path)
+            ),
+        )),
+        // The typed pass read the same text: serde_json cannot fail here, but say so if it does.
+        Err(e) => Err(Error::parse(
+            path,
+            (e.line() > 0).then_some(e.line()),
+            None,
+            format!("not a {what}: {e}"),
+        )),
+    }
 }
 
 fn json_error(e: serde_path_to_error::Error<serde_json::Error>, path: &Path, what: &str) -> Error {
@@ -97,6 +132,20 @@ mod tests {
             "{e}"
         );
         assert_eq!(read_text(&p).unwrap(), "x\r\n");
+        let list = |t: &str| {
+            parse_json::<std::collections::BTreeMap<String, serde_json::Value>>(t, &p, "list")
+                .map_err(|e| e.to_string())
+        };
+        assert!(list("{\"a\": 1}\n\n").is_ok());
+        let e = list("{\"a\": 1}\n{\"a\": 1}\n").unwrap_err();
+        assert!(e.contains(":2: not a list: text after the end"), "{e}");
+        let e = list("{\"a\": 1} x").unwrap_err();
+        assert!(e.contains(":1: not a list: text after the end"), "{e}");
+        let e = list("{\"a\": {\"b\": 1,\n\"c\": 2,\n\"b\": 3}}").unwrap_err();
+        assert!(
+            e.contains(":3: field `a.b`: not a list: the key `b` appears twice"),
+            "{e}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

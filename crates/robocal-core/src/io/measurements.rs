@@ -3,10 +3,12 @@
 //!
 //! The same reader serves joint-only files (desired or commanded joints) with
 //! [`Positions::Forbidden`] or [`Positions::Optional`]. CRLF line endings and a UTF-8 byte-order
-//! mark are accepted. Every rejection names the file, the line and the column.
+//! mark are accepted. Every rejection names the file, the line and the column; joint values and
+//! positions must be within their plausible ranges ([`crate::ranges`]).
 
 use crate::error::{Error, Result};
 use crate::io::columns::{csv_reader, next_record, ColumnLayout};
+use crate::ranges;
 use nalgebra::Vector3;
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -207,15 +209,17 @@ impl<R: Read> MeasurementReader<R> {
         let Some(line) = next_record(&mut self.rdr, &mut self.record, &self.path)? else {
             return Ok(None);
         };
-        let num = |k: usize| self.layout.number(&self.record, k, &self.path, line);
+        let (layout, record, path) = (&self.layout, &self.record, &self.path);
+        let num = |k: usize, range, what| layout.number_in(record, k, path, line, range, what);
         let mut q = Vec::with_capacity(self.dof);
         for &c in &self.q_col {
-            let v = num(c)?;
+            let v = num(c, &ranges::JOINT, "not a plausible joint value")?;
             self.max_abs_deg = self.max_abs_deg.max(v.abs());
             q.push(v.to_radians());
         }
+        let pos = |k| num(k, &ranges::LENGTH, "not a plausible tracker reading");
         let p = match self.xyz_col {
-            Some([x, y, z]) => Some(Vector3::new(num(x)?, num(y)?, num(z)?)),
+            Some([x, y, z]) => Some(Vector3::new(pos(x)?, pos(y)?, pos(z)?)),
             None => None,
         };
         self.rows += 1;
@@ -361,6 +365,38 @@ mod tests {
         assert!(e.contains("empty file"), "{e}");
         let e = err("q1,q2,x,y,z\n1,2,3,4\n", Positions::Required);
         assert!(e.contains("m.csv:2") && e.contains("4 fields"), "{e}");
+    }
+
+    #[test]
+    fn absurd_magnitudes_name_line_and_column() {
+        let e = err(
+            "q1,q2,x,y,z\n1,2,3,4,5\n1,1000080,3,4,5\n",
+            Positions::Required,
+        );
+        assert!(
+            e.contains(
+                "m.csv:3: field `q2`: not a plausible joint value: 1000080 deg is out of range"
+            ),
+            "{e}"
+        );
+        let e = err("q1,q2,x,y,z\n1,2,3,4,1e30\n", Positions::Required);
+        assert!(
+            e.contains(
+                "m.csv:2: field `z`: not a plausible tracker reading: 1e30 mm is out of range"
+            ),
+            "{e}"
+        );
+        let e = err("q1,q2\n1,-2e5\n", Positions::Ignored);
+        assert!(
+            e.contains("m.csv:2: field `q2`: not a plausible joint value"),
+            "{e}"
+        );
+        // Multi-turn joints and a tracker 999 m away are fine.
+        parse(
+            "q1,q2,x,y,z\n36000,-99999,999000,0,-5\n",
+            Positions::Required,
+        )
+        .unwrap();
     }
 
     #[test]

@@ -3,8 +3,11 @@
 pub mod atomic;
 pub(crate) mod columns;
 pub mod input;
+pub mod joint_limits;
+pub mod json_keys;
 pub mod measurements;
 pub mod result;
+pub mod set_label;
 mod target;
 mod temporaries;
 
@@ -16,3 +19,4 @@ pub use measurements::{
     MeasurementSet, Positions,
 };
 pub use result::CalibrationResult;
+pub use set_label::SetLabel;

@@ -136,30 +136,34 @@ impl CalibrationResult {
         Self::parse(&text, path)
     }
 
-    /// Parses result JSON; `path` is used in messages.
+    /// Parses result JSON; `path` is used in messages. Beyond the JSON's shape it checks that
+    /// the `status` is one robocal writes ([`KNOWN_STATUSES`]) and that every number is within
+    /// its plausible range ([`crate::ranges`]): parameters, tracker frame and error statistics.
     pub fn parse(text: &str, path: &Path) -> Result<CalibrationResult> {
         let r: CalibrationResult = crate::io::input::parse_json(text, path, "robocal result")?;
-        for (name, p) in &r.parameters {
-            if !p.nominal.is_finite() || !p.calibrated.is_finite() {
-                return Err(Error::parse(
-                    path,
-                    None,
-                    Some(&format!("parameters.{name}")),
-                    "not a finite number",
-                ));
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        check_status(r.extra.get("status"), text, path)?;
+        check_parameters(&r.parameters, text, path)?;
+        check_frame(&r.tracker_frame, "tracker_frame", text, path)?;
+        let e = &r.errors;
+        let tables = [
+            ("calibration", Some(&e.calibration)),
+            ("validation", e.validation.as_ref()),
+        ];
+        for (set, t) in tables {
+            let Some(t) = t else { continue };
+            for (when, s) in [("before", &t.before), ("after", &t.after)] {
+                for (name, v) in [
+                    ("mean_mm", s.mean_mm),
+                    ("std_mm", s.std_mm),
+                    ("max_mm", s.max_mm),
+                    ("rms_mm", s.rms_mm),
+                    ("p95_mm", s.p95_mm),
+                ] {
+                    let field = format!("errors.{set}.{when}.{name}");
+                    check_value(text, path, &field, v, &crate::ranges::ERROR)?;
+                }
             }
-        }
-        let t = &r.tracker_frame;
-        if [t.x, t.y, t.z, t.a, t.b, t.c]
-            .iter()
-            .any(|v| !v.is_finite())
-        {
-            return Err(Error::parse(
-                path,
-                None,
-                Some("tracker_frame"),
-                "not a finite number",
-            ));
         }
         Ok(r)
     }
@@ -283,5 +287,208 @@ impl CalibrationResult {
                 )
             })
             .collect()
+    }
+}
+
+/// Checks `v` against `range`; the error names the file, the field and its line in `text`.
+pub(crate) fn check_value(
+    text: &str,
+    path: &Path,
+    field: &str,
+    v: f64,
+    range: &crate::ranges::Range,
+) -> Result<()> {
+    range.check(v).map(|_| ()).map_err(|msg| {
+        let line = crate::io::json_keys::line_of_key(text, field);
+        Error::parse(path, line, Some(field), msg)
+    })
+}
+
+/// Checks the values of a `parameters` object (result or truth file) against the range of their
+/// unit: nominal and calibrated values, and standard deviations.
+pub(crate) fn check_parameters(
+    params: &IndexMap<String, ParamEntry>,
+    text: &str,
+    path: &Path,
+) -> Result<()> {
+    use crate::ranges::Range;
+    for (name, p) in params {
+        let range = Range::for_unit(p.unit);
+        let field = |k: &str| format!("parameters.{name}.{k}");
+        check_value(text, path, &field("nominal"), p.nominal, range)?;
+        check_value(text, path, &field("calibrated"), p.calibrated, range)?;
+        if let Some(sd) = p.std {
+            check_value(text, path, &field("std"), sd, Range::size_for_unit(p.unit))?;
+        }
+    }
+    Ok(())
+}
+
+/// Checks a frame vector (`field` names it, e.g. `tracker_frame`): x, y, z as lengths, A, B, C
+/// as angles.
+pub(crate) fn check_frame(f: &FrameVec, field: &str, text: &str, path: &Path) -> Result<()> {
+    use crate::ranges::{ANGLE, LENGTH};
+    for (k, v, range) in [
+        ("x", f.x, &LENGTH),
+        ("y", f.y, &LENGTH),
+        ("z", f.z, &LENGTH),
+        ("a", f.a, &ANGLE),
+        ("b", f.b, &ANGLE),
+        ("c", f.c, &ANGLE),
+    ] {
+        check_value(text, path, &format!("{field}.{k}"), v, range)?;
+    }
+    Ok(())
+}
+
+/// Checks a result's `status`: present, and one robocal writes.
+fn check_status(status: Option<&serde_json::Value>, text: &str, path: &Path) -> Result<()> {
+    let known = KNOWN_STATUSES.join(", ");
+    let msg = match status {
+        Some(serde_json::Value::String(s)) if KNOWN_STATUSES.contains(&s.as_str()) => return Ok(()),
+        None => {
+            return Err(Error::parse(
+                path,
+                None,
+                Some("status"),
+                format!(
+                    "missing: every result robocal writes says whether it is a calibration \
+                     (one of {known}); without it the file cannot be trusted as one"
+                ),
+            ))
+        }
+        Some(serde_json::Value::String(s)) => {
+            format!("`{s}` is not a status robocal writes ({known})")
+        }
+        Some(other) => format!("{other} is not a status robocal writes ({known})"),
+    };
+    let line = crate::io::json_keys::line_of_key(text, "status");
+    Err(Error::parse(path, line, Some("status"), msg))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::{json, Value};
+
+    fn good() -> Value {
+        let nom = crate::model::presets::preset("kuka-kr480-r3330").unwrap();
+        let s = ErrorStats::from_norms(&[1.0, 2.0]);
+        let mut extra = serde_json::Map::new();
+        extra.insert("status".into(), json!(STATUS_CALIBRATED));
+        let r = CalibrationResult {
+            robot: RobotInfo {
+                name: nom.name().into(),
+                dof: 6,
+                convention: "mdh".into(),
+            },
+            parameters: CalibrationResult::parameter_entries(&nom, &nom),
+            tracker_frame: FrameVec::from_frame(&Frame::identity()),
+            errors: ErrorTables {
+                calibration: BeforeAfter {
+                    before: s,
+                    after: s,
+                },
+                validation: Some(BeforeAfter {
+                    before: s,
+                    after: s,
+                }),
+            },
+            extra,
+        };
+        serde_json::to_value(&r).unwrap()
+    }
+
+    fn parse(v: &Value) -> std::result::Result<CalibrationResult, String> {
+        let text = serde_json::to_string_pretty(v).unwrap();
+        CalibrationResult::parse(&text, Path::new("r.json")).map_err(|e| e.to_string())
+    }
+
+    fn line_of(v: &Value, needle: &str) -> usize {
+        let text = serde_json::to_string_pretty(v).unwrap();
+        1 + text.lines().position(|l| l.contains(needle)).unwrap()
+    }
+
+    #[test]
+    fn status_must_be_one_robocal_writes() {
+        let mut v = good();
+        for s in KNOWN_STATUSES {
+            v["status"] = json!(s);
+            parse(&v).unwrap();
+        }
+        v["status"] = json!("bogus");
+        let l = line_of(&v, "\"status\"");
+        let e = parse(&v).unwrap_err();
+        assert!(
+            e.contains(&format!(
+                "r.json:{l}: field `status`: `bogus` is not a status"
+            )) && e.contains("calibrated, partial, implausible"),
+            "{e}"
+        );
+        v["status"] = json!(1);
+        assert!(parse(&v).unwrap_err().contains("1 is not a status"));
+        v.as_object_mut().unwrap().remove("status");
+        let e = parse(&v).unwrap_err();
+        assert!(e.contains("r.json: field `status`: missing"), "{e}");
+    }
+
+    #[test]
+    fn absurd_magnitudes_are_range_errors_naming_the_field() {
+        let cases: [(&[&str], Value, &str, &str); 6] = [
+            (
+                &["parameters", "a2", "calibrated"],
+                json!(1e300),
+                "parameters.a2.calibrated",
+                "1e300 mm is out of range",
+            ),
+            (
+                &["parameters", "alpha2", "nominal"],
+                json!(-1e5),
+                "parameters.alpha2.nominal",
+                "-1e5 deg is out of range",
+            ),
+            (
+                &["parameters", "d4", "std"],
+                json!(-0.1),
+                "parameters.d4.std",
+                "-0.1 mm is out of range",
+            ),
+            (
+                &["tracker_frame", "x"],
+                json!(1e308),
+                "tracker_frame.x",
+                "1e308 mm is out of range",
+            ),
+            (
+                &["tracker_frame", "c"],
+                json!(4000.0),
+                "tracker_frame.c",
+                "4000 deg is out of range",
+            ),
+            (
+                &["errors", "validation", "after", "rms_mm"],
+                json!(2e6),
+                "errors.validation.after.rms_mm",
+                "2000000 mm is out of range",
+            ),
+        ];
+        for (at, x, field, want) in cases {
+            let mut v = good();
+            let mut t = &mut v;
+            for k in &at[..at.len() - 1] {
+                t = &mut t[*k];
+            }
+            t[at[at.len() - 1]] = x;
+            let e = parse(&v).unwrap_err();
+            assert!(
+                e.contains(&format!("field `{field}`: {want}")),
+                "{field}: {e}"
+            );
+            assert!(e.starts_with("r.json:"), "{e}");
+        }
+        let mut v = good();
+        v["tracker_frame"]["x"] = json!(999_999.0);
+        v["parameters"]["a2"]["calibrated"] = json!(-999_999.0);
+        parse(&v).unwrap();
     }
 }

@@ -17,6 +17,7 @@
 
 use super::{presets, Convention, JointLimit, Link, Robot};
 use crate::error::{Error, Result};
+use crate::ranges;
 use serde::Deserialize;
 use std::path::Path;
 use toml::Spanned;
@@ -99,14 +100,14 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
         field: Some(field),
         message: msg,
     };
-    let finite = |v: &Spanned<f64>, field: String| -> Result<f64> {
-        let x = *v.get_ref();
-        if x.is_finite() {
-            Ok(x)
-        } else {
-            Err(err(v.span(), field, format!("{x} is not a finite number")))
-        }
+    // Every number must be finite and within the plausible range of its kind (crate::ranges).
+    let value = |v: &Spanned<f64>, field: String, range: &ranges::Range| -> Result<f64> {
+        range
+            .check(*v.get_ref())
+            .map_err(|msg| err(v.span(), field, msg))
     };
+    let length = |v: &Spanned<f64>, field: String| value(v, field, &ranges::LENGTH);
+    let angle = |v: &Spanned<f64>, field: String| value(v, field, &ranges::ANGLE);
     let convention = match file.convention.get_ref().as_str() {
         "mdh" => Convention::Mdh,
         "dh" => Convention::Dh,
@@ -152,7 +153,12 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
         }
         let mut out = [0.0; 6];
         for (k, x) in v.get_ref().iter().enumerate() {
-            out[k] = finite(x, format!("{name}[{k}]"))?;
+            let range = if k < 3 {
+                &ranges::LENGTH
+            } else {
+                &ranges::ANGLE
+            };
+            out[k] = value(x, format!("{name}[{k}]"), range)?;
         }
         Ok(crate::frame::vec_deg_to_rad(&out))
     };
@@ -164,20 +170,20 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
     for (i, j) in file.joints.iter().enumerate() {
         let f = |name: &str| format!("joints[{}].{name}", i + 1);
         let phi = match &j.phi {
-            Some(v) => finite(v, f("phi"))?,
+            Some(v) => angle(v, f("phi"))?,
             None => 0.0,
         };
         let beta = match &j.beta {
             Some(v) => {
                 betas.push(i);
-                finite(v, f("beta"))?
+                angle(v, f("beta"))?
             }
             None => 0.0,
         };
         links.push(Link {
-            alpha: finite(&j.alpha, f("alpha"))?.to_radians(),
-            d: finite(&j.d, f("d"))?,
-            a: finite(&j.a, f("a"))?,
+            alpha: angle(&j.alpha, f("alpha"))?.to_radians(),
+            d: length(&j.d, f("d"))?,
+            a: length(&j.a, f("a"))?,
             phi: phi.to_radians(),
             beta: beta.to_radians(),
         });
@@ -194,8 +200,8 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
                         ),
                     ));
                 }
-                let min = finite(&l.get_ref()[0], f("limits"))?;
-                let max = finite(&l.get_ref()[1], f("limits"))?;
+                let min = value(&l.get_ref()[0], f("limits"), &ranges::JOINT)?;
+                let max = value(&l.get_ref()[1], f("limits"), &ranges::JOINT)?;
                 if min > max {
                     return Err(err(
                         l.span(),
@@ -289,6 +295,41 @@ beta = 0
             &GOOD.replace("a = 300", "a = nan"),
             &[":12", "joints[2].a", "not a finite"],
         );
+    }
+
+    #[test]
+    fn absurd_magnitudes() {
+        expect_err(
+            &GOOD.replace("a = 300", "a = 1e300"),
+            &[
+                ":12",
+                "field `joints[2].a`",
+                "1e300 mm is out of range",
+                "±1e6 mm",
+            ],
+        );
+        expect_err(
+            &GOOD.replace("alpha = 90", "alpha = 1e5"),
+            &[":6", "field `joints[1].alpha`", "1e5 deg is out of range"],
+        );
+        expect_err(
+            &GOOD.replace("[-90, 90]", "[-90, 2e5]"),
+            &[
+                ":13",
+                "field `joints[2].limits`",
+                "a joint value must be within ±1e5 deg",
+            ],
+        );
+        expect_err(
+            &GOOD.replace("[0, 0, 10, 0, 0, 0]", "[0, 0, 10, 0, -1e9, 0]"),
+            &[":4", "field `tool[4]`", "-1e9 deg is out of range"],
+        );
+        expect_err(
+            &format!("base = [2e6, 0, 0, 0, 0, 0]\n{GOOD}"),
+            &[":1", "field `base[0]`", "2000000 mm is out of range"],
+        );
+        // Multi-turn axes are fine.
+        parse(&GOOD.replace("[-90, 90]", "[-3600, 3600]")).unwrap();
     }
 
     #[test]

@@ -8,7 +8,7 @@ use super::plane::{plane_poses, quantize_joints};
 use super::poses::{random_poses, PoseSampler};
 use super::tracker::Tracker;
 use super::truth::{check_truth_matches, TruthSpec};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::model::Robot;
 use nalgebra::Vector3;
 use rand::SeedableRng;
@@ -248,6 +248,20 @@ impl VirtualCell {
         };
         for o in &outliers {
             points[o.index] += Vector3::from(o.displacement_mm);
+        }
+        // A reading no measurement file may hold (crate::ranges::LENGTH) is never produced.
+        for (i, p) in points.iter().enumerate() {
+            for (k, v) in p.iter().enumerate() {
+                crate::ranges::LENGTH.check(*v).map_err(|msg| {
+                    Error::invalid(
+                        format!("reading {} ({})", i + 1, ["x", "y", "z"][k]),
+                        format!(
+                            "{msg}: the tracker frame, the noise or the robot put the simulated \
+                             reading beyond what a measurement file may hold"
+                        ),
+                    )
+                })?;
+            }
         }
         Ok(Readings {
             points,

@@ -6,6 +6,7 @@ use super::poses::PoseSampler;
 use crate::error::{Error, Result};
 use crate::io::result::FrameVec;
 use crate::model::Robot;
+use crate::ranges;
 use serde::{Deserialize, Serialize};
 
 /// The default pose of the tracker in the robot's base frame (mm, deg): 3.8 m away horizontally
@@ -90,40 +91,42 @@ impl Default for SimulationConfig {
     }
 }
 
-fn nonneg(name: &str, v: f64) -> Result<()> {
-    if !v.is_finite() || v < 0.0 {
-        return Err(Error::invalid(
-            name,
-            format!("{v} must be a finite number >= 0"),
-        ));
-    }
-    Ok(())
+/// Checks a setting against its plausible range ([`crate::ranges`]); `name` names it.
+pub(crate) fn in_range(name: &str, v: f64, range: &ranges::Range) -> Result<()> {
+    range
+        .check(v)
+        .map(|_| ())
+        .map_err(|msg| Error::invalid(name, msg))
 }
 
 impl SimulationConfig {
-    /// Checks every setting against the nominal robot. Errors name the command-line option.
-    /// The number of poses is checked by [`super::simulate`], which needs it (measuring given
-    /// joints does not).
+    /// Checks every setting against the nominal robot: finite, and within its plausible range
+    /// ([`crate::ranges`]: lengths within ±1 km, noise and sizes not negative). Errors name the
+    /// command-line option. The number of poses is checked by [`super::simulate`], which needs
+    /// it (measuring given joints does not).
     pub fn validate(&self, nominal: &Robot) -> Result<()> {
-        nonneg("--noise-mm", self.noise_mm)?;
-        nonneg("--noise-per-m", self.noise_per_m)?;
+        in_range("--noise-mm", self.noise_mm, &ranges::SIZE_MM)?;
+        in_range("--noise-per-m", self.noise_per_m, &ranges::NOISE_PER_M)?;
         let t = &self.tracker_frame;
-        if [t.x, t.y, t.z, t.a, t.b, t.c]
-            .iter()
-            .any(|v| !v.is_finite())
-        {
-            return Err(Error::invalid("--tracker", "not a finite frame vector"));
+        let (l, a) = (&ranges::LENGTH, &ranges::ANGLE);
+        for (k, v, range) in [
+            ("x", t.x, l),
+            ("y", t.y, l),
+            ("z", t.z, l),
+            ("A", t.a, a),
+            ("B", t.b, a),
+            ("C", t.c, a),
+        ] {
+            range
+                .check(v)
+                .map_err(|msg| Error::invalid("--tracker", format!("{k}: {msg}")))?;
         }
-        if !self.floor_z_mm.is_finite() {
-            return Err(Error::invalid("--floor-mm", "not a finite number"));
-        }
+        in_range("--floor-mm", self.floor_z_mm, &ranges::LENGTH)?;
         if let Some(r) = self.footprint_radius_mm {
-            nonneg("--footprint-mm", r)?;
+            in_range("--footprint-mm", r, &ranges::SIZE_MM)?;
         }
         if let Some(z) = self.plane_z_mm {
-            if !z.is_finite() {
-                return Err(Error::invalid("--plane-z-mm", "not a finite number"));
-            }
+            in_range("--plane-z-mm", z, &ranges::LENGTH)?;
         }
         if let Some(g) = &self.gravity {
             g.validate(nominal.dof())?;

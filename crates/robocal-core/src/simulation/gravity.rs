@@ -59,9 +59,17 @@ impl GravityModel {
     /// Checks the model against a robot with `dof` joints: one compliance and one mass per joint,
     /// all finite and non-negative, and some mass to deflect.
     pub fn validate(&self, dof: usize) -> Result<()> {
-        for (name, v) in [
-            ("--compliance", &self.compliance_rad_per_nm),
-            ("--link-masses-kg", &self.link_masses_kg),
+        for (name, v, range) in [
+            (
+                "--compliance",
+                &self.compliance_rad_per_nm,
+                &crate::ranges::COMPLIANCE,
+            ),
+            (
+                "--link-masses-kg",
+                &self.link_masses_kg,
+                &crate::ranges::MASS,
+            ),
         ] {
             if v.len() != dof {
                 return Err(Error::invalid(
@@ -79,6 +87,11 @@ impl GravityModel {
                     format!("value {} ({x}) must be a finite number >= 0", i + 1),
                 ));
             }
+            for (i, x) in v.iter().enumerate() {
+                range
+                    .check(*x)
+                    .map_err(|msg| Error::invalid(name, format!("value {}: {msg}", i + 1)))?;
+            }
         }
         if !self.payload_kg.is_finite() || self.payload_kg < 0.0 {
             return Err(Error::invalid(
@@ -86,6 +99,7 @@ impl GravityModel {
                 format!("{} must be a finite number >= 0", self.payload_kg),
             ));
         }
+        super::config::in_range("--payload-kg", self.payload_kg, &crate::ranges::MASS)?;
         if self.gravity_m_s2.iter().any(|g| !g.is_finite()) {
             return Err(Error::invalid("gravity", "not a finite vector"));
         }

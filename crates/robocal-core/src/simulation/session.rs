@@ -9,17 +9,18 @@ use super::truth_file::{OutlierRecord, SetInfo, TruthFile};
 use crate::error::{Error, Result};
 use crate::io::measurements::{Measurement, MeasurementSet};
 use crate::io::result::RobotInfo;
+use crate::io::SetLabel;
 use crate::model::Robot;
 use crate::stats::ErrorStats;
 use indexmap::IndexMap;
 use std::path::{Path, PathBuf};
 
 /// The `set` of the three plane points.
-pub const SET_PLANE: &str = "plane";
+pub const SET_PLANE: &str = SetLabel::Plane.as_str();
 /// The `set` of the calibration points.
-pub const SET_CALIBRATION: &str = "calibration";
+pub const SET_CALIBRATION: &str = SetLabel::Calibration.as_str();
 /// The `set` of the validation points.
-pub const SET_VALIDATION: &str = "validation";
+pub const SET_VALIDATION: &str = SetLabel::Validation.as_str();
 
 /// Poses drawn per progress step.
 const CHUNK: usize = 1000;

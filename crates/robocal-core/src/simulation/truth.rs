@@ -39,9 +39,17 @@ impl Default for GeometricErrors {
 impl GeometricErrors {
     /// Rejects negative or non-finite sigmas.
     pub fn validate(&self) -> Result<()> {
-        for (name, v) in [
-            ("--length-error-mm", self.length_sigma_mm),
-            ("--angle-error-deg", self.angle_sigma_deg),
+        for (name, v, range) in [
+            (
+                "--length-error-mm",
+                self.length_sigma_mm,
+                &crate::ranges::SIZE_MM,
+            ),
+            (
+                "--angle-error-deg",
+                self.angle_sigma_deg,
+                &crate::ranges::SIZE_DEG,
+            ),
         ] {
             if !v.is_finite() || v < 0.0 {
                 return Err(Error::invalid(
@@ -49,6 +57,7 @@ impl GeometricErrors {
                     format!("{v} is not a valid standard deviation (must be >= 0)"),
                 ));
             }
+            super::config::in_range(name, v, range)?;
         }
         Ok(())
     }

@@ -96,9 +96,15 @@ impl TruthFile {
         Self::parse(&text, path)
     }
 
-    /// Parses truth-file JSON; `path` is used in messages (file, line and field).
+    /// Parses truth-file JSON; `path` is used in messages (file, line and field). The true
+    /// parameters and the tracker frame must be within their plausible ranges
+    /// ([`crate::ranges`]).
     pub fn parse(text: &str, path: &Path) -> Result<TruthFile> {
-        crate::io::input::parse_json(text, path, "robocal truth file")
+        let tf: TruthFile = crate::io::input::parse_json(text, path, "robocal truth file")?;
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        crate::io::result::check_parameters(&tf.parameters, text, path)?;
+        crate::io::result::check_frame(&tf.tracker_frame, "tracker_frame", text, path)?;
+        Ok(tf)
     }
 
     /// The true robot: `nominal` with every parameter set to its true value. Fails, naming the
