@@ -23,6 +23,8 @@ pub mod solver;
 pub mod system;
 
 #[cfg(test)]
+mod conditioning_tests;
+#[cfg(test)]
 mod tests;
 
 pub use covariance::{Correlation, Covariance};
