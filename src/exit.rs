@@ -14,7 +14,6 @@ pub const IO: i32 = 4;
 pub const NUMERICAL: i32 = 5;
 /// A fit that converged but cannot be right (the plausibility gate: units, handedness, wrong
 /// robot, parameter moves beyond calibration): nothing written unless explicitly accepted.
-#[allow(dead_code)]
 pub const IMPLAUSIBLE: i32 = 6;
 /// Interrupted by SIGINT/SIGTERM (128 + signal number for SIGINT, as shells report it).
 #[cfg_attr(not(unix), allow(dead_code))]
@@ -66,6 +65,15 @@ pub fn numerical(message: impl Into<String>) -> anyhow::Error {
     .into()
 }
 
+/// An implausible fit (exit code 6).
+pub fn implausible(message: impl Into<String>) -> anyhow::Error {
+    CliError {
+        code: IMPLAUSIBLE,
+        message: message.into(),
+    }
+    .into()
+}
+
 /// The message of an error and its causes, outermost first, joined by `: `. A cause whose text
 /// the message already ends with is left out (an I/O error is part of its wrapper's text:
 /// `FILE: No such file or directory`, not `FILE: No such file...: No such file...`).
@@ -100,6 +108,7 @@ pub fn code_for(e: &anyhow::Error) -> i32 {
                 | E::JointCount { .. } => INPUT,
                 E::UnknownPreset { .. } => USAGE,
                 E::Numerical(_) => NUMERICAL,
+                E::Implausible(_) => IMPLAUSIBLE,
             };
         }
         if cause.downcast_ref::<std::io::Error>().is_some() {

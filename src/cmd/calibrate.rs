@@ -8,9 +8,9 @@ use crate::tables::{layout, num};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use robocal_core::identification::{
-    calibrate, split_measurements, Calibration, CalibrationData, CalibrationSettings,
+    calibrate, split_measurements, Calibration, CalibrationData, CalibrationSettings, CheckKind,
     IdentifiabilityOptions, Objective, Observations, RobustLoss, SolverOptions,
-    DEFAULT_RANK_TOLERANCE,
+    DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
 };
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::{read_measurements, Positions};
@@ -61,9 +61,11 @@ pub struct CalibrateArgs {
     /// stays rigid).
     #[arg(long)]
     affine: bool,
-    /// Relative rank threshold of the identifiability analysis.
-    #[arg(long, default_value_t = DEFAULT_RANK_TOLERANCE, value_name = "TOL")]
-    rank_tol: f64,
+    /// Relative rank threshold of the identifiability analysis [default: 1e-6]; at least 1e-10.
+    /// Given explicitly, an ill-conditioned identification (condition number above 1e7) is
+    /// written with its standard deviations marked unavailable instead of failing (exit 5).
+    #[arg(long, value_name = "TOL")]
+    rank_tol: Option<f64>,
     /// Iteration limit of the solver (1 to 1000000). If the solver stops there without converging, the command
     /// fails (exit code 5) and writes nothing, unless --keep-partial is given.
     #[arg(long, default_value_t = 1000)]
@@ -72,6 +74,12 @@ pub struct CalibrateArgs {
     /// (the exit code stays 5; `compensate` refuses such a file, other commands warn).
     #[arg(long)]
     keep_partial: bool,
+    /// Write a converged fit that fails the plausibility gate (units, handedness, nominal error,
+    /// parameter moves) anyway, marked `"status": "implausible"` (exit code 0, with a warning).
+    /// Without it such a fit exits with code 6 and writes nothing; `compensate` refuses the file
+    /// unless given --accept-implausible too.
+    #[arg(long)]
+    accept_implausible: bool,
     /// Where to write the result JSON.
     #[arg(long)]
     out: PathBuf,
@@ -210,6 +218,23 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     }
     let fix = param_list(&robot, &a.fix, "--fix")?;
     let free = param_list(&robot, &a.free, "--free")?;
+    if fix.len() == robot.param_count() {
+        return Err(exit::usage(format!(
+            "--fix names every parameter of robot `{}` ({}): nothing is left to identify",
+            robot.name(),
+            robot.param_count()
+        )));
+    }
+    let rank_tolerance = a.rank_tol.unwrap_or(DEFAULT_RANK_TOLERANCE);
+    if !(MIN_RANK_TOLERANCE..1.0).contains(&rank_tolerance) {
+        return Err(exit::usage(format!(
+            "--rank-tol {rank_tolerance:?}: not in [{MIN_RANK_TOLERANCE:e}, 1); it is the \
+             smallest independence (sine of the angle between a parameter's effect and the \
+             others') accepted, and below {MIN_RANK_TOLERANCE:e} double precision cannot tell a \
+             parameter from an exact duplicate (whose independence computes as 1e-17 to 1e-14 \
+             from rounding)"
+        )));
+    }
     IoPlan::new()
         .robot("--robot", &a.robot)
         .input("--data", &a.data)
@@ -258,9 +283,10 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         robust_scale_mm: a.robust_scale,
         affine_registration: a.affine,
         identifiability: IdentifiabilityOptions {
-            rank_tolerance: a.rank_tol,
+            rank_tolerance,
             fix,
             free,
+            allow_ill_conditioned: a.rank_tol.is_some(),
         },
         solver: SolverOptions {
             max_iterations: a.max_iterations,
@@ -314,15 +340,22 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         },
     );
     bar.finish_and_clear();
-    let cal = result.with_context(|| format!("calibrating from {}", a.data.display()))?;
+    let cal = result
+        .map_err(|e| match e {
+            robocal_core::Error::Numerical(m) if m.contains("rank tolerance") => {
+                robocal_core::Error::Numerical(m.replace("rank tolerance", "rank tolerance (--rank-tol)"))
+            }
+            e => e,
+        })
+        .with_context(|| format!("calibrating from {}", a.data.display()))?;
     let converged = cal.solver().termination.converged();
-    print_report(&cal, converged);
-    if cal.registration.stats.mean_mm > 50.0 {
+    let implausible = cal.plausibility.implausible();
+    print_report(&cal, converged, implausible);
+    print_plausibility(&cal);
+    if let Some(why) = &cal.covariance.unavailable {
         eprintln!(
-            "warning: the nominal model misses the measured points by {:.1} mm on average \
-             after the frame fit: check that positions are in mm, joint values in degrees and \
-             that --robot matches the data",
-            cal.registration.stats.mean_mm
+            "warning: standard deviations unavailable (written as null): {why} (--rank-tol \
+             {rank_tolerance:e} given explicitly)"
         );
     }
     let mut extra = serde_json::Map::new();
@@ -340,10 +373,43 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         extra.insert("rows_outside_limits".into(), json!(rows));
     }
     let mut res = cal.to_result(extra);
-    if converged {
+    let failed_gate = if implausible {
+        format!(
+            "\nThe fit also FAILED the plausibility gate:\n{}",
+            common::indent(&cal.plausibility.summary())
+        )
+    } else {
+        String::new()
+    };
+    if converged && !implausible {
         res.write(&a.out)?;
         println!("result written to {}", a.out.display());
         return Ok(());
+    }
+    if converged {
+        // Converged but implausible: not a calibration. Fail; keep it only if asked, marked.
+        let summary = common::indent(&cal.plausibility.summary());
+        if a.accept_implausible {
+            res.write(&a.out)?;
+            println!(
+                "result written to {} marked \"status\": \"implausible\"",
+                a.out.display()
+            );
+            eprintln!(
+                "WARNING: IMPLAUSIBLE FIT WRITTEN (--accept-implausible): the fit failed the \
+                 plausibility gate and is NOT a calibration:\n{summary}\n{} is marked \
+                 \"status\": \"implausible\"; compensate refuses it unless given \
+                 --accept-implausible too",
+                a.out.display()
+            );
+            return Ok(());
+        }
+        return Err(exit::implausible(format!(
+            "implausible fit: the solver converged, but the result cannot be a calibration; \
+             nothing written to {}. Failed checks:\n{summary}\n(fix the data or the robot; \
+             --accept-implausible writes it anyway, marked \"status\": \"implausible\")",
+            a.out.display()
+        )));
     }
     // Not converged: not a calibration. Fail; keep the partial result only if asked, marked.
     let why = format!(
@@ -360,16 +426,44 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         res.write(&a.out)?;
         Err(exit::numerical(format!(
             "{why}: the parameters above are a partial result, not a calibration; written to {} \
-             marked \"status\": \"partial\" (--keep-partial)",
+             marked \"status\": \"partial\" (--keep-partial){failed_gate}",
             a.out.display()
         )))
     } else {
         Err(exit::numerical(format!(
             "{why}: the parameters above are a partial result, not a calibration; nothing \
              written to {} (raise --max-iterations, or use --keep-partial to \
-             write the partial result, marked as such)",
+             write the partial result, marked as such){failed_gate}",
             a.out.display()
         )))
+    }
+}
+
+/// Prints the plausibility gate's outcome: one line when it passed, every failed check with its
+/// likely cause otherwise.
+fn print_plausibility(c: &Calibration) {
+    let p = &c.plausibility;
+    println!();
+    if p.passed() {
+        println!(
+            "plausibility: all {} checks passed (units, handedness, nominal error, parameter \
+             moves, convergence)",
+            p.checks.len()
+        );
+        return;
+    }
+    println!(
+        "plausibility: {} of {} checks FAILED",
+        p.failures().count(),
+        p.checks.len()
+    );
+    if !c.solver().termination.converged() {
+        if let Some(f) = p.failures().find(|f| f.kind == CheckKind::Convergence) {
+            println!("  convergence: {}", f.detail);
+        }
+    }
+    if p.implausible() {
+        println!("{}", common::indent(&p.summary()));
     }
 }
 
@@ -410,11 +504,13 @@ fn stats_table(title: &str, cols: &[(&str, ErrorStats)]) -> String {
     s
 }
 
-fn print_report(c: &Calibration, converged: bool) {
-    let partial = if converged {
-        ""
-    } else {
+fn print_report(c: &Calibration, converged: bool, implausible: bool) {
+    let partial = if !converged {
         " -- PARTIAL: the solver did not converge; not a calibration"
+    } else if implausible {
+        " -- IMPLAUSIBLE: failed the plausibility gate; not a calibration"
+    } else {
+        ""
     };
     let reg = &c.registration;
     let tf = robocal_core::io::result::FrameVec::from_frame(&reg.frame);
@@ -474,7 +570,7 @@ fn print_report(c: &Calibration, converged: bool) {
         println!("  {:<8} fixed: {}", f.param.name(), f.describe());
     }
     println!();
-    let fixed = |p: Param| c.covariance.std_of(p).is_none();
+    let fixed = |p: Param| !c.covariance.identifies(p);
     println!(
         "Table III. Calibrated parameters of the robot (* fixed at its nominal value){partial}"
     );
@@ -489,11 +585,12 @@ fn print_report(c: &Calibration, converged: bool) {
             }
         })
     );
-    println!("Standard deviations (same layout; - fixed)");
+    println!("Standard deviations (same layout; - fixed, n/a unavailable)");
     print!(
         "{}",
         layout(&c.calibrated, &|p| match c.covariance.std_of(p) {
             Some(sd) => format!("{:.4} ", p.unit().from_internal(sd)),
+            None if c.covariance.identifies(p) => "n/a ".to_string(),
             None => "- ".to_string(),
         })
     );

@@ -79,13 +79,30 @@ pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
     Ok(q)
 }
 
-/// Warns (stderr) when a result file is a partial result (`calibrate --keep-partial` after the
-/// solver did not converge), which is not a calibration.
-pub fn warn_partial(res: &CalibrationResult, path: &Path) {
-    if let Some(why) = res.partial_reason() {
-        eprintln!(
+/// Warns (stderr) when a result file is not a calibration: a partial result (`calibrate
+/// --keep-partial` after the solver did not converge) or an implausible one (`calibrate
+/// --accept-implausible` after the fit failed the plausibility gate).
+pub fn warn_not_calibrated(res: &CalibrationResult, path: &Path) {
+    use robocal_core::io::result::NotCalibrated;
+    match res.not_calibrated() {
+        Some(NotCalibrated::Partial(why)) => eprintln!(
             "warning: {} is a PARTIAL result, not a calibration ({why})",
             path.display()
-        );
+        ),
+        Some(NotCalibrated::Implausible(why)) => eprintln!(
+            "warning: {} is an IMPLAUSIBLE result, not a calibration: it failed the \
+             plausibility gate and was kept with --accept-implausible:\n{}",
+            path.display(),
+            indent(&why)
+        ),
+        None => {}
     }
+}
+
+/// Indents every line of `text` by four spaces.
+pub fn indent(text: &str) -> String {
+    text.lines()
+        .map(|l| format!("    {l}"))
+        .collect::<Vec<_>>()
+        .join("\n")
 }

@@ -44,6 +44,10 @@ pub struct CompensateArgs {
     /// are written with their status and the closest joints found, and listed as warnings.
     #[arg(long)]
     strict: bool,
+    /// Use a result that failed the plausibility gate (`"status": "implausible"`, written by
+    /// `calibrate --accept-implausible`). Without it such a result is refused (exit code 6).
+    #[arg(long)]
+    accept_implausible: bool,
 }
 
 /// Rows listed one by one in warnings before the rest are summarized.
@@ -84,6 +88,23 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
              it: re-run calibrate with a higher --max-iterations",
             a.params.display()
         )));
+    }
+    if let Some(why) = res.implausible_reason() {
+        if !a.accept_implausible {
+            return Err(exit::implausible(format!(
+                "--params {}: an IMPLAUSIBLE result, not a calibration: it failed the \
+                 plausibility gate:\n{}\ncompensation refuses it (fix the data or the robot \
+                 and calibrate again, or give --accept-implausible to use it anyway)",
+                a.params.display(),
+                super::common::indent(&why)
+            )));
+        }
+        eprintln!(
+            "WARNING: --accept-implausible: compensating with {}, a result that FAILED the \
+             plausibility gate; the commanded joints may be far from right:\n{}",
+            a.params.display(),
+            super::common::indent(&why)
+        );
     }
     let dof = nominal.dof();
     let comp = Compensator::new(&nominal, &cal, solver)?;

@@ -83,7 +83,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     }
     let mut outputs = plan.check()?;
     let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
-    common::warn_partial(&res, &a.params);
+    common::warn_not_calibrated(&res, &a.params);
     let against = match a.against {
         AgainstArg::Auto => Against::Auto,
         AgainstArg::Model => Against::Model,

@@ -23,7 +23,7 @@ pub struct FkArgs {
 pub fn run(a: FkArgs) -> anyhow::Result<()> {
     let m = common::model(&a.robot, a.params.as_deref())?;
     if let (Some((_, res)), Some(p)) = (&m.calibrated, &a.params) {
-        common::warn_partial(res, p);
+        common::warn_not_calibrated(res, p);
     }
     let r = m.active();
     let q = common::joints_arg(&a.joints, r)?;

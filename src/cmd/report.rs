@@ -108,6 +108,7 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
             format!("--robot {robot}")
         }
     })?;
+    super::common::warn_not_calibrated(&result, &a.result);
     let dof = nominal.dof();
     let data_path = file_arg(&a.data, &result, "data", "--data");
     let val_path = file_arg(&a.validate, &result, "validate", "--validate");

@@ -32,12 +32,16 @@ pub fn run(c: RobotCmd) -> anyhow::Result<()> {
         RobotCmd::Show(a) => {
             let m = common::model(&a.robot, a.params.as_deref())?;
             if let (Some((_, res)), Some(p)) = (&m.calibrated, &a.params) {
-                common::warn_partial(res, p);
+                common::warn_not_calibrated(res, p);
             }
             let r = m.active();
             let label = match &m.calibrated {
                 Some((_, res)) if res.partial_reason().is_some() => {
                     "PARTIAL parameters (the solver did not converge; not a calibration)"
+                }
+                Some((_, res)) if res.implausible_reason().is_some() => {
+                    "IMPLAUSIBLE parameters (the fit failed the plausibility gate; not a \
+                     calibration)"
                 }
                 Some(_) => "calibrated parameters",
                 None => "parameters",

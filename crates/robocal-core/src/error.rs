@@ -63,6 +63,10 @@ pub enum Error {
     /// A numerical procedure failed.
     #[error("{0}")]
     Numerical(String),
+    /// A fit converged but failed the plausibility gate
+    /// ([`crate::identification::plausibility`]): it cannot be a calibration.
+    #[error("{0}")]
+    Implausible(String),
 }
 
 fn fmt_parse(

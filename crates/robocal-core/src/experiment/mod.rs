@@ -327,6 +327,12 @@ pub fn run_experiment(
         &config.calibration,
         &mut |_, i, n| progress(Phase::Calibration, i, n),
     )?;
+    if calibration.plausibility.implausible() {
+        return Err(Error::Implausible(format!(
+            "the simulated calibration failed the plausibility gate:\n{}",
+            calibration.plausibility.summary()
+        )));
+    }
     let mut extra = serde_json::Map::new();
     extra.insert("robot_arg".into(), nominal.name().into());
     extra.insert("data".into(), files::CELL.into());

@@ -23,6 +23,11 @@ pub struct Covariance {
     /// Estimated per-axis standard deviation of the measurement errors, `sqrt(B/S)` with the
     /// degrees-of-freedom correction (mm): for least squares the residual RMS per axis.
     pub sigma_mm: f64,
+    /// Why the standard deviations are unavailable, when they are: an ill-conditioned problem
+    /// (see [`crate::identification::MAX_CONDITION_NUMBER`]) or a Hessian that is not positive
+    /// definite. Then [`Covariance::std_of`] gives `None` for every parameter rather than a
+    /// number without meaning.
+    pub unavailable: Option<String>,
 }
 
 /// A pair of parameters and the correlation of their estimates.
@@ -53,39 +58,75 @@ impl Covariance {
                 params: params.to_vec(),
                 matrix: nan(),
                 sigma_mm: f64::NAN,
+                unavailable: Some("no second-order pass at the solution".into()),
             };
         };
-        let matrix = match h.clone().cholesky() {
+        let (matrix, mut unavailable) = match h.clone().cholesky() {
             Some(ch) => {
                 let hinv_s = ch.solve(s);
                 let mut c = ch.solve(&hinv_s.transpose()) * psi_var;
                 // Symmetrize rounding.
                 c = (&c + c.transpose()) * 0.5;
-                c
+                (c, None)
             }
-            None => nan(),
+            None => (
+                nan(),
+                Some(
+                    "the objective's Hessian is not positive definite at the solution".to_string(),
+                ),
+            ),
         };
+        if unavailable.is_none() {
+            if let Some(j) = (0..k).find(|&j| !(matrix[(j, j)] >= 0.0 && matrix[(j, j)].is_finite()))
+            {
+                unavailable = Some(format!(
+                    "the computed variance of {} is {:e}: rounding dominates the covariance",
+                    params[j].name(),
+                    matrix[(j, j)]
+                ));
+            }
+        }
         // For least squares psi = r, so psi_var is the residual variance per axis.
         Covariance {
             params: params.to_vec(),
             matrix,
             sigma_mm: psi_var.sqrt(),
+            unavailable,
         }
     }
 
-    /// Standard deviation of each parameter (internal units).
-    pub fn std(&self) -> Vec<f64> {
-        (0..self.params.len())
-            .map(|j| self.matrix[(j, j)].max(0.0).sqrt())
-            .collect()
+    /// Marks every standard deviation unavailable, with the reason.
+    pub fn mark_unavailable(&mut self, reason: impl Into<String>) {
+        self.unavailable = Some(reason.into());
     }
 
-    /// The standard deviation of one parameter, if identified.
+    /// Whether `p` is one of the identified parameters.
+    pub fn identifies(&self, p: Param) -> bool {
+        self.params.contains(&p)
+    }
+
+    /// Standard deviation of each parameter (internal units); NaN for every parameter when they
+    /// are unavailable (see [`Covariance::unavailable`]).
+    pub fn std(&self) -> Vec<f64> {
+        (0..self.params.len()).map(|j| self.std_at(j)).collect()
+    }
+
+    fn std_at(&self, j: usize) -> f64 {
+        if self.unavailable.is_some() {
+            f64::NAN
+        } else {
+            self.matrix[(j, j)].sqrt()
+        }
+    }
+
+    /// The standard deviation of one parameter, if it is identified and the standard deviations
+    /// are available.
     pub fn std_of(&self, p: Param) -> Option<f64> {
         self.params
             .iter()
             .position(|q| *q == p)
-            .map(|j| self.matrix[(j, j)].max(0.0).sqrt())
+            .map(|j| self.std_at(j))
+            .filter(|v| v.is_finite())
     }
 
     /// The `count` most correlated pairs, strongest first.

@@ -8,6 +8,8 @@
 //! - [`solver`]: Levenberg–Marquardt with reweighting and a termination report;
 //! - [`covariance`]: standard deviations and correlations of the estimates;
 //! - [`pipeline`]: registration + all of the above ([`calibrate`]);
+//! - [`plausibility`]: the gate run after every fit (units, handedness, nominal error, parameter
+//!   moves, convergence) and the likely cause of a failure;
 //! - [`report`]: the result JSON.
 
 pub mod covariance;
@@ -15,21 +17,26 @@ pub mod identifiability;
 pub mod objective;
 pub mod observations;
 pub mod pipeline;
+pub mod plausibility;
 pub mod report;
 pub mod solver;
 pub mod system;
 
+#[cfg(test)]
+mod conditioning_tests;
 #[cfg(test)]
 mod tests;
 
 pub use covariance::{Correlation, Covariance};
 pub use identifiability::{
     analyze, FixReason, FixedParam, Identifiability, IdentifiabilityOptions, DEFAULT_RANK_TOLERANCE,
+    MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
 };
 pub use objective::{Loss, Objective, RobustLoss};
 pub use observations::{split_measurements, Observations, SplitData};
 pub use pipeline::{
     calibrate, Calibration, CalibrationData, CalibrationSettings, DownWeighted, SetErrors, Stage,
 };
+pub use plausibility::{Check, CheckKind, Plausibility};
 pub use solver::{solve, SolverOptions, SolverReport, Termination};
 pub use system::Problem;

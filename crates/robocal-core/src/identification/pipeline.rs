@@ -11,10 +11,13 @@
 
 use crate::error::{Error, Result};
 use crate::identification::covariance::Covariance;
-use crate::identification::identifiability::{analyze, Identifiability, IdentifiabilityOptions};
+use crate::identification::identifiability::{
+    analyze, Identifiability, IdentifiabilityOptions, MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
+};
 use crate::identification::objective::{
     Loss, Objective, RobustLoss, CHI3_MEDIAN, ROBUST_SCALE_SIGMAS, SUM_OF_NORMS_SMOOTHING_MM,
 };
+use crate::identification::plausibility::{self, Plausibility};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
 use crate::identification::Observations;
@@ -139,6 +142,9 @@ pub struct Calibration {
     /// Points whose error exceeds the robust scale (Cauchy weight below 1/2, Huber weight below
     /// 1), largest error first.
     pub downweighted: Vec<DownWeighted>,
+    /// The plausibility gate's outcome (see [`plausibility`]): a converged fit that fails it is
+    /// not a calibration.
+    pub plausibility: Plausibility,
     /// The settings used.
     pub settings: CalibrationSettings,
 }
@@ -184,12 +190,14 @@ pub fn calibrate(
             format!("`{}` is given both to --fix and to --free", p.name()),
         ));
     }
-    if !(idopts.rank_tolerance > 0.0 && idopts.rank_tolerance < 1.0) {
+    if !(idopts.rank_tolerance >= MIN_RANK_TOLERANCE && idopts.rank_tolerance < 1.0) {
         return Err(Error::invalid(
-            "--rank-tol",
+            "rank tolerance",
             format!(
-                "{} is not in (0, 1): it is the smallest independence (sine of the angle \
-                 between a parameter's effect and the others') accepted",
+                "{:e} is not in [{MIN_RANK_TOLERANCE:e}, 1): it is the smallest independence \
+                 (sine of the angle between a parameter's effect and the others') accepted, and \
+                 below {MIN_RANK_TOLERANCE:e} double precision cannot tell a parameter from an \
+                 exact duplicate (whose independence computes as 1e-17 to 1e-14 from rounding)",
                 idopts.rank_tolerance
             ),
         ));
@@ -217,11 +225,29 @@ pub fn calibrate(
     progress("identifiability", 0, 1);
     let ident = analyze(nominal, cal, idopts)?;
     let k = ident.identified.len();
-    if k == 0 {
-        return Err(Error::invalid(
-            "--fix",
-            "every parameter is fixed; nothing to identify",
-        ));
+    let ill_conditioned = ident.ill_conditioned().then(|| {
+        let (p, ind) = ident
+            .least_independent()
+            .expect("analyze identifies at least one parameter");
+        format!(
+            "the identified parameters are too nearly dependent for double precision: the \
+             condition number of their scaled Jacobian is {:.3e}, above {MAX_CONDITION_NUMBER:e}, \
+             where the normal equations (condition {:.1e}) leave the estimates' uncertainty \
+             without reliable digits; the least independent is {} ({ind:.1e}, rank tolerance \
+             {:e})",
+            ident.condition_number,
+            ident.condition_number * ident.condition_number,
+            p.name(),
+            ident.rank_tolerance
+        )
+    });
+    if let Some(why) = &ill_conditioned {
+        if !ident.condition_number.is_finite() || !idopts.allow_ill_conditioned {
+            return Err(Error::Numerical(format!(
+                "{why}. Raise the rank tolerance above {:.1e} to fix it",
+                ident.least_independent().map_or(0.0, |(_, i)| i)
+            )));
+        }
     }
     if cal.len() < k {
         return Err(Error::Numerical(format!(
@@ -297,7 +323,10 @@ pub fn calibrate(
 
     progress("uncertainty", 0, 1);
     let acc = problem.accumulate(&robot, &final_loss, Level::Full);
-    let covariance = Covariance::from_accumulated(&ident.identified, &acc, cal.len());
+    let mut covariance = Covariance::from_accumulated(&ident.identified, &acc, cal.len());
+    if let Some(why) = ill_conditioned {
+        covariance.mark_unavailable(why);
+    }
 
     let calibration = SetErrors::new(cal, &registration, nominal, &robot);
     let validation = data
@@ -318,6 +347,17 @@ pub fn calibrate(
         }
         downweighted.sort_by(|a, b| b.error_mm.total_cmp(&a.error_mm));
     }
+    progress("plausibility", 0, 1);
+    let plausibility = plausibility::assess(&plausibility::Fit {
+        nominal,
+        calibrated: &robot,
+        identified: &ident.identified,
+        calibration: cal,
+        registration: &registration,
+        validation_before: validation.as_ref().map(|v| v.before.as_slice()),
+        solver: &stages.last().expect("at least one stage").report,
+        max_iterations: settings.solver.max_iterations,
+    });
     Ok(Calibration {
         nominal: nominal.clone(),
         calibrated: robot,
@@ -329,6 +369,7 @@ pub fn calibrate(
         validation,
         robust_scale_mm: robust_scale,
         downweighted,
+        plausibility,
         settings: settings.clone(),
     })
 }

@@ -3,7 +3,8 @@
 //! Contract keys: `parameters` (with `std` for identified and `reason` for fixed parameters),
 //! `tracker_frame` (the registration frame F; the calibrated base frame B is among the
 //! parameters) and `errors`. Further keys: `settings`, `registration`, `identifiability`,
-//! `solver`, `uncertainty`, `downweighted_points` and `points` (per-point errors).
+//! `solver`, `uncertainty`, `downweighted_points`, `points` (per-point errors), `plausibility`
+//! (the gate's checks) and `status` (with `partial_reason` or `implausible_reason`).
 
 use crate::identification::identifiability::FixReason;
 use crate::identification::objective::Loss;
@@ -49,9 +50,12 @@ impl Calibration {
                 .calibrated
                 .param_by_name(name)
                 .expect("names come from the robot");
-            if let Some(sd) = self.covariance.std_of(p) {
+            if self.covariance.identifies(p) {
                 e.fixed = false;
-                e.std = Some(p.unit().from_internal(sd));
+                e.std = self.covariance.std_of(p).map(|sd| p.unit().from_internal(sd));
+                if let Some(why) = &self.covariance.unavailable {
+                    e.reason = Some(format!("identified; standard deviation unavailable: {why}"));
+                }
             } else {
                 e.fixed = true;
                 e.reason = Some(
@@ -200,7 +204,14 @@ impl Calibration {
             .params
             .iter()
             .zip(self.covariance.std())
-            .map(|(p, sd)| (p.name(), json!(p.unit().from_internal(sd))))
+            .map(|(p, sd)| {
+                let v = if sd.is_finite() {
+                    json!(p.unit().from_internal(sd))
+                } else {
+                    Value::Null
+                };
+                (p.name(), v)
+            })
             .collect();
         let mut extra = Map::new();
         extra.insert("settings".into(), settings);
@@ -210,6 +221,8 @@ impl Calibration {
             json!({
                 "rank_tolerance": id.rank_tolerance,
                 "condition_number": id.condition_number,
+                "condition_limit": crate::identification::MAX_CONDITION_NUMBER,
+                "ill_conditioned": id.ill_conditioned(),
                 "n_identified": id.identified.len(),
                 "n_fixed": id.fixed.len(),
                 "identified": identified,
@@ -227,14 +240,15 @@ impl Calibration {
                 "stages": stages,
             }),
         );
-        extra.insert(
-            "uncertainty".into(),
-            json!({
-                "sigma_mm": self.covariance.sigma_mm,
-                "std": stds,
-                "most_correlated": correlations,
-            }),
-        );
+        let mut uncertainty = json!({
+            "sigma_mm": self.covariance.sigma_mm,
+            "std": stds,
+            "most_correlated": correlations,
+        });
+        if let Some(why) = &self.covariance.unavailable {
+            uncertainty["std_unavailable"] = json!(why);
+        }
+        extra.insert("uncertainty".into(), uncertainty);
         extra.insert(
             "downweighted_points".into(),
             Value::Array(
@@ -249,17 +263,25 @@ impl Calibration {
             points["validation"] = points_json(v);
         }
         extra.insert("points".into(), points);
-        // A result is a calibration only when the solver converged; otherwise it is marked
-        // partial so that no reader takes it for one.
+        // A result is a calibration only when the solver converged and the fit passed the
+        // plausibility gate; otherwise it is marked partial or implausible so that no reader
+        // takes it for one.
         let termination = &self.solver().termination;
-        if termination.converged() {
-            extra.insert("status".into(), json!(crate::io::result::STATUS_CALIBRATED));
-        } else {
+        extra.insert("plausibility".into(), self.plausibility.to_json());
+        if !termination.converged() {
             extra.insert("status".into(), json!(crate::io::result::STATUS_PARTIAL));
             extra.insert(
                 "partial_reason".into(),
                 json!(format!("the solver {}", termination.describe())),
             );
+        } else if self.plausibility.implausible() {
+            extra.insert("status".into(), json!(crate::io::result::STATUS_IMPLAUSIBLE));
+            extra.insert(
+                "implausible_reason".into(),
+                json!(self.plausibility.summary()),
+            );
+        } else {
+            extra.insert("status".into(), json!(crate::io::result::STATUS_CALIBRATED));
         }
         CalibrationResult {
             robot: RobotInfo {

@@ -24,6 +24,32 @@ pub const STATUS_IMPLAUSIBLE: &str = "implausible";
 /// Every `status` robocal writes; a reader refuses any other.
 pub const KNOWN_STATUSES: [&str; 3] = [STATUS_CALIBRATED, STATUS_PARTIAL, STATUS_IMPLAUSIBLE];
 
+/// Why a result file is not a calibration (see [`CalibrationResult::not_calibrated`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum NotCalibrated {
+    /// The solver did not converge (`status` partial); the reason.
+    Partial(String),
+    /// The fit failed the plausibility gate (`status` implausible); the failed checks.
+    Implausible(String),
+}
+
+impl NotCalibrated {
+    /// `PARTIAL` or `IMPLAUSIBLE`, for warnings and labels.
+    pub fn label(&self) -> &'static str {
+        match self {
+            NotCalibrated::Partial(_) => "PARTIAL",
+            NotCalibrated::Implausible(_) => "IMPLAUSIBLE",
+        }
+    }
+
+    /// The reason.
+    pub fn reason(&self) -> &str {
+        match self {
+            NotCalibrated::Partial(r) | NotCalibrated::Implausible(r) => r,
+        }
+    }
+}
+
 /// Which robot a result belongs to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RobotInfo {
@@ -202,6 +228,34 @@ impl CalibrationResult {
             (None, Some(false), None) => "the solver did not converge".to_owned(),
             _ => format!("marked \"status\": \"{STATUS_PARTIAL}\""),
         })
+    }
+
+    /// Why this result failed the plausibility gate, if it did: its `status` is
+    /// [`STATUS_IMPLAUSIBLE`] (`calibrate` wrote it on explicit request); `implausible_reason`
+    /// lists the failed checks.
+    pub fn implausible_reason(&self) -> Option<String> {
+        let status = self.extra.get("status").and_then(|s| s.as_str());
+        if status != Some(STATUS_IMPLAUSIBLE) {
+            return None;
+        }
+        Some(
+            self.extra
+                .get("implausible_reason")
+                .and_then(|r| r.as_str())
+                .map_or_else(
+                    || "it failed the plausibility gate".to_owned(),
+                    |r| r.to_owned(),
+                ),
+        )
+    }
+
+    /// Why this result is not a calibration to use, if it is not: partial
+    /// ([`CalibrationResult::partial_reason`]) before implausible
+    /// ([`CalibrationResult::implausible_reason`]).
+    pub fn not_calibrated(&self) -> Option<NotCalibrated> {
+        self.partial_reason()
+            .map(NotCalibrated::Partial)
+            .or_else(|| self.implausible_reason().map(NotCalibrated::Implausible))
     }
 
     /// The tracker frame as a rigid transform.

@@ -1,0 +1,589 @@
+//! The plausibility gate: checks run after every fit that tell a calibration from a fit that
+//! cannot be right.
+//!
+//! A flexible model fits almost anything: positions in metres, a mirrored tracker frame or the
+//! wrong robot all end in a small Table IV, with parameters moved by metres or 180 degrees. The
+//! gate measures what no calibration of a real robot produces:
+//!
+//! - **convergence**: the solver's termination;
+//! - **units**: a uniform scale fits the measured points to the nominal model clearly better
+//!   than scale 1 (positions in metres: about 1000; inches: 25.4);
+//! - **handedness**: a reflection fits them better than a rotation (a left-handed tracker frame);
+//! - **nominal error**: Table II (the nominal model after the frame fit) larger than any plausible
+//!   geometric error of the robot, relative to its reach (also on the validation points);
+//! - **parameter moves**: a length or an angle moved further than calibration corrects.
+//!
+//! The limits are the constants below, each with the margins measured on good and bad data. A
+//! failed check carries the likely cause, found by undoing the usual mistakes one at a time
+//! ([`diagnosis`]).
+
+pub mod diagnosis;
+pub mod similarity;
+
+#[cfg(test)]
+mod tests;
+
+use crate::identification::solver::SolverReport;
+use crate::identification::Observations;
+use crate::model::{Param, Robot, Unit};
+use crate::registration::Registration;
+use crate::stats::ErrorStats;
+use diagnosis::{explain, sig, unit_of_scale, Explanation};
+use serde_json::{json, Value};
+use similarity::{fit_similarity, Handedness};
+
+// Margins below were measured with the release build (see README "The plausibility gate"): good
+// data are the demo (KR 480, seeds 1-30), the real UR5 and WAM sets (grid and random), and
+// simulated random robots (KR 480, UR5, WAM; default and 4x larger errors, with noise); bad data
+// are those sets with positions in metres, centimetres and inches, one axis mirrored, joints in
+// radians, a missing J2/J3 coupling, reversed joint signs, and the KR 480 model on UR5 data.
+
+/// Units check: the best uniform scale must lie within this factor of 1 ...
+///
+/// Good data: at most 1.0011 (WAM grid); bad: 10 (centimetres) and beyond.
+pub const SCALE_LIMIT: f64 = 1.05;
+/// ... unless the scaled fit is not at least this many times better than the rigid one (a poorly
+/// spread pose set leaves the scale loosely determined, without any gain from it).
+pub const SCALE_GAIN: f64 = 2.0;
+
+/// Handedness check: the RMS of the best reflection over that of the best rotation (both with a
+/// free scale) must be at least this. Good data: 14 or more; mirrored data: 0.01 or less. Points
+/// on a plane fit both equally (ratio 1) and pass.
+pub const HANDEDNESS_LIMIT: f64 = 0.5;
+
+/// Nominal-error check: the RMS of Table II must stay below this fraction of the robot's reach
+/// ([`reach_mm`]). 2% of the reach is the tool displacement of a 1.15 degree rotation at full
+/// reach — every joint's zero off by about half a degree at once, where mastering errors are
+/// hundredths of a degree and link errors millimetres. Good data: at most 0.57% (WAM grid, a
+/// cable-driven arm sagging under gravity); bad data: 13% and more.
+pub const NOMINAL_ERROR_LIMIT: f64 = 0.05;
+
+/// Parameter moves: no identified length (link, base or tool) may move by more than this fraction
+/// of the reach. The registration absorbs the rigid motion between the tracker and the base, so
+/// the base moves only by the residual corrections (and what it absorbs of d1, a1, alpha1,
+/// phi1), the same size as the links'; the tool moves by the uncertainty of its nominal value,
+/// a few millimetres. Good data: at most 1.1% (WAM tool_z, 11 mm); bad data: 9% and more.
+pub const LENGTH_MOVE_LIMIT: f64 = 0.05;
+
+/// Parameter moves: no identified angle may move by more than this (degrees). Good data: at most
+/// 3.2 degrees (WAM alpha6, where a 44 mm tool is a short lever); bad data: 80 degrees and more
+/// where the lengths alone do not already fail.
+pub const ANGLE_MOVE_LIMIT_DEG: f64 = 10.0;
+
+/// What a check measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CheckKind {
+    /// The solver converged.
+    Convergence,
+    /// The best uniform scale (units).
+    Units,
+    /// Reflection against rotation.
+    Handedness,
+    /// Table II on the calibration points, relative to the reach.
+    NominalError,
+    /// Table II on the validation points, relative to the reach.
+    ValidationNominalError,
+    /// The largest move of an identified length.
+    LengthMoves,
+    /// The largest move of an identified angle.
+    AngleMoves,
+}
+
+impl CheckKind {
+    /// The check's name in the result JSON and messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            CheckKind::Convergence => "convergence",
+            CheckKind::Units => "units",
+            CheckKind::Handedness => "handedness",
+            CheckKind::NominalError => "nominal_error",
+            CheckKind::ValidationNominalError => "validation_nominal_error",
+            CheckKind::LengthMoves => "length_moves",
+            CheckKind::AngleMoves => "angle_moves",
+        }
+    }
+}
+
+/// One check's outcome.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Check {
+    /// What it measures.
+    pub kind: CheckKind,
+    /// The measured value.
+    pub measured: f64,
+    /// Its limit.
+    pub limit: f64,
+    /// Unit of both (`"mm"`, `"deg"`, `"factor"`, `"ratio"`, `"iterations"`).
+    pub unit: &'static str,
+    /// Whether the fit passed.
+    pub passed: bool,
+    /// What was measured, as a sentence with the numbers and the limit.
+    pub detail: String,
+    /// For a failure: the likely cause.
+    pub cause: Option<String>,
+}
+
+/// The outcome of the gate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plausibility {
+    /// The robot's reach (mm), the scale of the length limits ([`reach_mm`]).
+    pub reach_mm: f64,
+    /// Every check, in a fixed order.
+    pub checks: Vec<Check>,
+    /// For a failure: the corrections of the data that make the nominal model fit, best first
+    /// (empty when none does).
+    pub explanations: Vec<Explanation>,
+}
+
+/// What the gate looks at.
+#[derive(Debug, Clone, Copy)]
+pub struct Fit<'a> {
+    /// The nominal model.
+    pub nominal: &'a Robot,
+    /// The calibrated model.
+    pub calibrated: &'a Robot,
+    /// The identified parameters.
+    pub identified: &'a [Param],
+    /// The calibration points.
+    pub calibration: &'a Observations,
+    /// The fitted measurement frame and Table II.
+    pub registration: &'a Registration,
+    /// Table II error norms of the validation points, if any (mm).
+    pub validation_before: Option<&'a [f64]>,
+    /// The last solver run.
+    pub solver: &'a SolverReport,
+    /// The solver's iteration limit.
+    pub max_iterations: usize,
+}
+
+/// The robot's reach: the chain's total length `sum(|a_i| + |d_i|)` plus the nominal tool's
+/// offset (mm), an upper bound of the distance of the tool from the first axis (at least 1 mm).
+pub fn reach_mm(robot: &Robot) -> f64 {
+    let links: f64 = robot.links().iter().map(|l| l.a.abs() + l.d.abs()).sum();
+    let t = robot.tool0();
+    let tool = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+    (links + tool).max(1.0)
+}
+
+/// Whether every joint value is within ±2π "degrees" while the limits span far more: values in
+/// radians read as degrees.
+pub fn joints_look_like_radians(robot: &Robot, obs: &Observations) -> bool {
+    let span = robot
+        .limits()
+        .iter()
+        .map(|l| l.max - l.min)
+        .fold(0.0, f64::max);
+    let two_pi_deg = std::f64::consts::TAU.to_radians();
+    !obs.is_empty()
+        && span > 4.0 * two_pi_deg
+        && (0..obs.len()).all(|i| obs.q(i).iter().all(|v| v.abs() <= two_pi_deg))
+}
+
+fn check(
+    kind: CheckKind,
+    measured: f64,
+    limit: f64,
+    unit: &'static str,
+    passed: bool,
+    detail: String,
+) -> Check {
+    Check {
+        kind,
+        measured,
+        limit,
+        unit,
+        passed,
+        detail,
+        cause: None,
+    }
+}
+
+/// The largest move among the identified parameters of one unit: (parameter, |move|) in display
+/// units, angles wrapped to ±180 degrees.
+fn largest_move(fit: &Fit, unit: Unit) -> Option<(Param, f64)> {
+    fit.identified
+        .iter()
+        .filter(|p| p.unit() == unit)
+        .map(|&p| {
+            let nominal = if fit.nominal.has_param(p) {
+                fit.nominal.get(p)
+            } else {
+                0.0
+            };
+            let mut d = fit.calibrated.get(p) - nominal;
+            if unit == Unit::Deg {
+                d = (d + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                    - std::f64::consts::PI;
+            }
+            (p, unit.from_internal(d.abs()))
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// Runs every check on a fit and, if one fails, looks for the likely cause.
+pub fn assess(fit: &Fit) -> Plausibility {
+    let reach = reach_mm(fit.nominal);
+    let mut checks = Vec::new();
+
+    let converged = fit.solver.termination.converged();
+    checks.push(check(
+        CheckKind::Convergence,
+        fit.solver.iterations as f64,
+        fit.max_iterations as f64,
+        "iterations",
+        converged,
+        format!(
+            "the solver {} after {} iteration(s) (limit {})",
+            fit.solver.termination.describe(),
+            fit.solver.iterations,
+            fit.max_iterations
+        ),
+    ));
+
+    let measured = fit.calibration.measured();
+    let model = fit.calibration.model_positions(fit.nominal);
+    let rigid = fit_similarity(measured, &model, Handedness::Rotation, false);
+    let scaled = fit_similarity(measured, &model, Handedness::Rotation, true);
+    let mirrored = fit_similarity(measured, &model, Handedness::Reflection, true);
+    let baseline_rms = rigid.map_or(f64::NAN, |f| f.rms);
+    match (rigid, scaled) {
+        (Some(r), Some(s)) => {
+            let factor = s.scale.max(1.0 / s.scale);
+            let gain = r.rms / s.rms;
+            let passed = !(factor > SCALE_LIMIT && gain >= SCALE_GAIN);
+            let unit = unit_of_scale(s.scale)
+                .filter(|(_, f)| *f != 1.0)
+                .map_or(String::new(), |(u, _)| format!(", the scale of {u}"));
+            checks.push(check(
+                CheckKind::Units,
+                factor,
+                SCALE_LIMIT,
+                "factor",
+                passed,
+                format!(
+                    "the measured points fit the nominal model best at scale {}{unit} \
+                     ({:.3} mm RMS, against {:.3} mm at scale 1); limit: within a factor {} of \
+                     1 unless the scale improves the fit less than {}-fold",
+                    sig(s.scale),
+                    s.rms,
+                    r.rms,
+                    SCALE_LIMIT,
+                    SCALE_GAIN
+                ),
+            ));
+        }
+        _ => checks.push(check(
+            CheckKind::Units,
+            f64::NAN,
+            SCALE_LIMIT,
+            "factor",
+            true,
+            "not measurable: the measured points coincide".into(),
+        )),
+    }
+    match (scaled, mirrored) {
+        (Some(s), Some(m)) => {
+            let ratio = if s.rms > 0.0 {
+                m.rms / s.rms
+            } else {
+                f64::INFINITY
+            };
+            checks.push(check(
+                CheckKind::Handedness,
+                ratio,
+                HANDEDNESS_LIMIT,
+                "ratio",
+                ratio >= HANDEDNESS_LIMIT,
+                format!(
+                    "the best reflection fits the measured points to {:.3} mm RMS, the best \
+                     rotation to {:.3} mm (ratio {}); limit: a reflection must not fit better \
+                     than {} times the rotation's RMS",
+                    m.rms,
+                    s.rms,
+                    sig(ratio),
+                    HANDEDNESS_LIMIT
+                ),
+            ));
+        }
+        _ => checks.push(check(
+            CheckKind::Handedness,
+            f64::NAN,
+            HANDEDNESS_LIMIT,
+            "ratio",
+            true,
+            "not measurable: the measured points coincide".into(),
+        )),
+    }
+
+    let limit_mm = NOMINAL_ERROR_LIMIT * reach;
+    let table2 = |rms: f64, what: &str| {
+        format!(
+            "the nominal model misses the {what} points by {rms:.3} mm RMS after the frame fit \
+             (Table II), {:.2}% of the robot's reach of {reach:.0} mm; limit: {}% ({limit_mm:.1} \
+             mm)",
+            100.0 * rms / reach,
+            100.0 * NOMINAL_ERROR_LIMIT
+        )
+    };
+    let rms2 = fit.registration.stats.rms_mm;
+    checks.push(check(
+        CheckKind::NominalError,
+        rms2,
+        limit_mm,
+        "mm",
+        rms2 <= limit_mm,
+        table2(rms2, "calibration"),
+    ));
+    if let Some(v) = fit.validation_before.filter(|v| !v.is_empty()) {
+        let rms = ErrorStats::from_norms(v).rms_mm;
+        checks.push(check(
+            CheckKind::ValidationNominalError,
+            rms,
+            limit_mm,
+            "mm",
+            rms <= limit_mm,
+            table2(rms, "validation"),
+        ));
+    }
+
+    let length_limit = LENGTH_MOVE_LIMIT * reach;
+    let (lp, lv) = largest_move(fit, Unit::Mm).map_or((None, 0.0), |(p, v)| (Some(p), v));
+    checks.push(check(
+        CheckKind::LengthMoves,
+        lv,
+        length_limit,
+        "mm",
+        lv <= length_limit,
+        match lp {
+            Some(p) => format!(
+                "the largest move of an identified length is {} by {lv:.3} mm, {:.2}% of the \
+                 reach; limit: {}% ({length_limit:.1} mm)",
+                p.name(),
+                100.0 * lv / reach,
+                100.0 * LENGTH_MOVE_LIMIT
+            ),
+            None => "no length identified".into(),
+        },
+    ));
+    let (ap, av) = largest_move(fit, Unit::Deg).map_or((None, 0.0), |(p, v)| (Some(p), v));
+    checks.push(check(
+        CheckKind::AngleMoves,
+        av,
+        ANGLE_MOVE_LIMIT_DEG,
+        "deg",
+        av <= ANGLE_MOVE_LIMIT_DEG,
+        match ap {
+            Some(p) => format!(
+                "the largest move of an identified angle is {} by {av:.4} deg; limit: \
+                 {ANGLE_MOVE_LIMIT_DEG} deg",
+                p.name()
+            ),
+            None => "no angle identified".into(),
+        },
+    ));
+
+    let data_suspect = checks
+        .iter()
+        .any(|c| !c.passed && c.kind != CheckKind::Convergence);
+    let explanations = if data_suspect && baseline_rms.is_finite() {
+        explain(fit.nominal, fit.calibration, baseline_rms, limit_mm)
+    } else {
+        Vec::new()
+    };
+    let radians = joints_look_like_radians(fit.nominal, fit.calibration);
+    let scale = scaled.map_or(f64::NAN, |s| s.scale);
+    let causes = Causes {
+        explanations: &explanations,
+        radians,
+        scale,
+        failed: checks
+            .iter()
+            .filter(|c| !c.passed)
+            .map(|c| c.kind)
+            .collect(),
+        max_iterations: fit.max_iterations,
+    };
+    for c in checks.iter_mut().filter(|c| !c.passed) {
+        c.cause = Some(causes.of(c.kind));
+    }
+    Plausibility {
+        reach_mm: reach,
+        checks,
+        explanations,
+    }
+}
+
+/// What the likely cause of a failure is made from.
+struct Causes<'a> {
+    explanations: &'a [Explanation],
+    radians: bool,
+    scale: f64,
+    failed: Vec<CheckKind>,
+    max_iterations: usize,
+}
+
+impl Causes<'_> {
+    /// The likely cause of a failed check: the corrections that explain the data if there are
+    /// any; else, when the nominal model does not fit the points, a robot description that does
+    /// not match them; else what the check alone suggests.
+    fn of(&self, kind: CheckKind) -> String {
+        let failed = |k: CheckKind| self.failed.contains(&k);
+        let radians_hint = if self.radians {
+            "; the joint values all lie within ±2π while the joint limits span far more: they \
+             look like radians"
+        } else {
+            ""
+        };
+        if kind == CheckKind::Convergence {
+            return format!(
+                "the solver stopped at its iteration limit ({}) before converging",
+                self.max_iterations
+            );
+        }
+        let data_wide =
+            kind != CheckKind::ValidationNominalError || failed(CheckKind::NominalError);
+        if data_wide && !self.explanations.is_empty() {
+            let all: Vec<String> = self
+                .explanations
+                .iter()
+                .take(3)
+                .map(|e| e.describe())
+                .collect();
+            return all.join("; or ");
+        }
+        if data_wide && failed(CheckKind::NominalError) {
+            let mut extra = String::new();
+            if failed(CheckKind::Units) {
+                extra.push_str(&format!(
+                    "; the points are {} times the model's size, which is no length unit",
+                    sig(self.scale)
+                ));
+            }
+            if failed(CheckKind::Handedness) {
+                extra.push_str("; they are closer to the model's mirror image than to the model");
+            }
+            return format!(
+                "the robot description does not match the data: a different robot, or joint \
+                 values that are not the model's (zero offsets, signs, couplings); no change of \
+                 unit, handedness, joint unit, joint sign or J2/J3-style coupling makes the \
+                 nominal model fit{extra}{radians_hint}"
+            );
+        }
+        match kind {
+            CheckKind::Units => format!(
+                "the data are {} times the size of the nominal model, which is no length unit: a \
+                 different robot{radians_hint}",
+                sig(self.scale)
+            ),
+            CheckKind::Handedness => format!(
+                "the measured points are closer to a mirror image of the model than to the \
+                 model: a mirrored (left-handed) tracker frame or a reversed joint sign, together \
+                 with a further mismatch; or a different robot{radians_hint}"
+            ),
+            CheckKind::ValidationNominalError => format!(
+                "the validation points do not match the calibration points: measured in another \
+                 unit, frame or set-up, or of another robot{radians_hint}"
+            ),
+            _ => format!(
+                "a calibration corrects errors of millimetres and tenths of a degree: a \
+                 parameter the poses hardly determine, a wrong nominal value (the tool, a link), \
+                 or data of a different robot{radians_hint}"
+            ),
+        }
+    }
+}
+
+impl Plausibility {
+    /// Whether every check passed.
+    pub fn passed(&self) -> bool {
+        self.checks.iter().all(|c| c.passed)
+    }
+
+    /// The failed checks.
+    pub fn failures(&self) -> impl Iterator<Item = &Check> {
+        self.checks.iter().filter(|c| !c.passed)
+    }
+
+    /// Whether a check other than convergence failed: the fit cannot be right (a fit that did not
+    /// converge is partial; see `Termination`).
+    pub fn implausible(&self) -> bool {
+        self.failures().any(|c| c.kind != CheckKind::Convergence)
+    }
+
+    /// The failed checks other than convergence, one line each with its measurement and limit,
+    /// then the likely cause (one line when the checks share it, else one per check).
+    pub fn summary(&self) -> String {
+        let failed: Vec<&Check> = self
+            .failures()
+            .filter(|c| c.kind != CheckKind::Convergence)
+            .collect();
+        let mut lines: Vec<String> = failed
+            .iter()
+            .map(|c| format!("{}: {}", c.kind.name(), c.detail))
+            .collect();
+        let mut causes: Vec<&str> = Vec::new();
+        for c in &failed {
+            if let Some(cause) = c.cause.as_deref() {
+                if !causes.contains(&cause) {
+                    causes.push(cause);
+                }
+            }
+        }
+        if causes.len() == 1 {
+            lines.push(format!("likely cause: {}", causes[0]));
+        } else {
+            for c in &failed {
+                if let Some(cause) = &c.cause {
+                    lines.push(format!("likely cause ({}): {cause}", c.kind.name()));
+                }
+            }
+        }
+        lines.join("\n")
+    }
+
+    /// The `plausibility` object of the result JSON.
+    pub fn to_json(&self) -> Value {
+        let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
+        let checks: Vec<Value> = self
+            .checks
+            .iter()
+            .map(|c| {
+                let mut o = json!({
+                    "name": c.kind.name(),
+                    "measured": num(c.measured),
+                    "limit": c.limit,
+                    "unit": c.unit,
+                    "passed": c.passed,
+                    "detail": c.detail,
+                });
+                if let Some(cause) = &c.cause {
+                    o["cause"] = json!(cause);
+                }
+                o
+            })
+            .collect();
+        let mut o = json!({
+            "passed": self.passed(),
+            "reach_mm": self.reach_mm,
+            "checks": checks,
+        });
+        if !self.explanations.is_empty() {
+            o["likely_causes"] = Value::Array(
+                self.explanations
+                    .iter()
+                    .map(|e| {
+                        json!({
+                            "cause": e.describe(),
+                            "fit_rms_mm": e.rms_mm,
+                            "scale": e.scale,
+                            "mirrored": e.mirrored,
+                            "unit": e.unit.map(|(u, _)| u),
+                            "joints": e.joints.map(|j| j.describe()),
+                        })
+                    })
+                    .collect(),
+            );
+        }
+        o
+    }
+}
