@@ -158,6 +158,9 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         limits::MAX_CALIBRATION_ITERATIONS,
         "a solver that has not converged by then will not",
     )?;
+    if let Some(s) = a.robust_scale {
+        limits::magnitude("--robust-scale", s, limits::MAX_LENGTH_MM, "mm")?;
+    }
     let mut robot = common::robot(&a.robot)?;
     let betas = apply_beta(&mut robot, &a.beta)?;
     if betas.is_empty() && a.beta.trim() == "parallel" {
