@@ -58,8 +58,9 @@ pub struct CalibrateArgs {
     /// Relative rank threshold of the identifiability analysis.
     #[arg(long, default_value_t = DEFAULT_RANK_TOLERANCE, value_name = "TOL")]
     rank_tol: f64,
-    /// Iteration limit of the solver (1 to 1000000). If the solver stops there without converging, the command
-    /// fails (exit code 5) and writes nothing, unless --keep-partial is given.
+    /// Iteration limit of the solver (1 to 1000000). If the solver stops there without
+    /// converging, the command fails (exit code 5) and writes nothing, unless --keep-partial is
+    /// given.
     #[arg(long, default_value_t = 1000)]
     max_iterations: usize,
     /// When the solver does not converge, still write the result, marked `"status": "partial"`

@@ -1,7 +1,9 @@
-//! Limits of the count and size arguments. A count is a `usize` to clap, so `--poses 18446744073709551615`
-//! parses; unchecked it would overflow a capacity computation (a panic) or ask for an allocation
-//! the machine cannot give (an abort). These limits keep every run within a machine of 2 cores
-//! and 24 GiB, the size robocal is built and tested on, with a clear usage error beyond them.
+//! Limits of the count and size arguments. A count is a `usize` to clap, so
+//! `--poses 18446744073709551615` parses; unchecked it would overflow a capacity computation (a
+//! panic) or ask for an allocation the machine cannot give (an abort). These limits keep every run
+//! within a machine of 2 cores and 24 GiB, the size robocal is built and tested on, with a clear
+//! usage error beyond them. Lengths and masses far beyond any robot cell are refused too: they
+//! would give readings of `inf`.
 
 use crate::exit;
 
