@@ -593,7 +593,7 @@ fn dash_is_standard_output_where_it_makes_sense() {
 }
 
 #[test]
-fn absurd_counts_are_usage_errors_not_panics() {
+fn absurd_counts_and_sizes_are_usage_errors_not_panics() {
     let dir = inputs();
     let d = dir.path();
     let sim = [
@@ -664,6 +664,55 @@ fn absurd_counts_are_usage_errors_not_panics() {
         ],
         2,
         &["--max-iterations 18446744073709551615: at most 100000"],
+    );
+    // Lengths, masses and compliances far beyond any cell: readings of `inf` otherwise.
+    for (extra, want) in [
+        (
+            vec!["--tracker", "1e300,0,0,0,0,0"],
+            "--tracker (x) 1e300: at most 1000000 mm",
+        ),
+        (
+            vec!["--noise-mm", "1e300"],
+            "--noise-mm 1e300: at most 1000000 mm",
+        ),
+        (
+            vec!["--compliance", "1e-7", "--payload-kg", "1e300"],
+            "--payload-kg 1e300: at most 1000000 kg",
+        ),
+        (
+            vec!["--compliance", "1e300", "--payload-kg", "1"],
+            "--compliance (joint 1) 1e300: at most 1 rad/(N m)",
+        ),
+        (
+            vec!["--outlier-fraction", "0.5", "--outlier-max-mm", "1e300"],
+            "--outlier-max-mm 1e300: at most 1000000 mm",
+        ),
+    ] {
+        let mut a = sim.to_vec();
+        a.extend(["--poses", "5"]);
+        a.extend(extra);
+        refused(d, &a, 2, &[want]);
+    }
+    let mut a = cal.to_vec();
+    a.extend(["--objective", "robust", "--robust-scale", "1e300"]);
+    refused(d, &a, 2, &["--robust-scale 1e300: at most 1000000 mm"]);
+    refused(
+        d,
+        &[
+            "compensate",
+            "--robot",
+            KUKA,
+            "--params",
+            "{d}/res.json",
+            "--joints",
+            "{d}/j.csv",
+            "--out",
+            "{d}/c.csv",
+            "--tolerance-mm",
+            "1e300",
+        ],
+        2,
+        &["--tolerance-mm 1e300: at most 1000000 mm"],
     );
     // Beyond usize: clap's own usage error.
     let mut a = sim.to_vec();

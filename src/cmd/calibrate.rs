@@ -66,8 +66,9 @@ pub struct CalibrateArgs {
     /// written with its standard deviations marked unavailable instead of failing (exit 5).
     #[arg(long, value_name = "TOL")]
     rank_tol: Option<f64>,
-    /// Iteration limit of the solver (1 to 1000000). If the solver stops there without converging, the command
-    /// fails (exit code 5) and writes nothing, unless --keep-partial is given.
+    /// Iteration limit of the solver (1 to 1000000). If the solver stops there without
+    /// converging, the command fails (exit code 5) and writes nothing, unless --keep-partial is
+    /// given.
     #[arg(long, default_value_t = 1000)]
     max_iterations: usize,
     /// When the solver does not converge, still write the result, marked `"status": "partial"`
@@ -207,6 +208,9 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         limits::MAX_CALIBRATION_ITERATIONS,
         "a solver that has not converged by then will not",
     )?;
+    if let Some(s) = a.robust_scale {
+        limits::magnitude("--robust-scale", s, limits::MAX_LENGTH_MM, "mm")?;
+    }
     let mut robot = common::robot(&a.robot)?;
     let betas = apply_beta(&mut robot, &a.beta)?;
     if betas.is_empty() && a.beta.trim() == "parallel" {

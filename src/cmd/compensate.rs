@@ -73,6 +73,12 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         limits::MAX_IK_ITERATIONS,
         "per row; a solve converges in a handful",
     )?;
+    limits::magnitude(
+        "--tolerance-mm",
+        a.tolerance_mm,
+        limits::MAX_LENGTH_MM,
+        "mm",
+    )?;
     let mut outputs = IoPlan::new()
         .robot("--robot", &a.robot)
         .input("--params", &a.params)

@@ -1,7 +1,9 @@
-//! Limits of the count arguments. A count is a `usize` to clap, so `--poses 18446744073709551615`
-//! parses; unchecked it would overflow a capacity computation (a panic) or ask for an allocation
-//! the machine cannot give (an abort). These limits keep every run within a machine of 2 cores
-//! and 24 GiB, the size robocal is built and tested on, with a clear usage error beyond them.
+//! Limits of the count and size arguments. A count is a `usize` to clap, so
+//! `--poses 18446744073709551615` parses; unchecked it would overflow a capacity computation (a
+//! panic) or ask for an allocation the machine cannot give (an abort). These limits keep every run
+//! within a machine of 2 cores and 24 GiB, the size robocal is built and tested on, with a clear
+//! usage error beyond them. Lengths and masses far beyond any robot cell are refused too: they
+//! would give readings of `inf`.
 
 use crate::exit;
 
@@ -19,6 +21,38 @@ pub const MAX_CALIBRATION_ITERATIONS: usize = 1_000_000;
 /// Most iterations of one inverse-kinematics solve in `compensate` (default 500; a solve
 /// converges in a handful). The limit applies per row, and a file may have millions of rows.
 pub const MAX_IK_ITERATIONS: usize = 100_000;
+
+/// Largest length argument of a simulation (mm): 1 km. A laser tracker reaches about 80 m and
+/// the largest robots a few metres; beyond this a value is a typing mistake, and far beyond it
+/// (1e300) the readings overflow to `inf`.
+pub const MAX_LENGTH_MM: f64 = 1e6;
+
+/// Largest standard deviation of random angle errors (deg): a full turn.
+pub const MAX_ANGLE_DEG: f64 = 360.0;
+
+/// Largest mass (kg): 1000 t, far above the heaviest industrial robot and payload (a few t).
+pub const MAX_MASS_KG: f64 = 1e6;
+
+/// Largest joint compliance (rad per N·m); real joints have about 1e-7, and 1 already turns a
+/// joint by radians under a 1 N·m torque.
+pub const MAX_COMPLIANCE: f64 = 1.0;
+
+/// Checks that a finite `value` of `flag` is at most `max` in magnitude (`unit` for the
+/// message). Non-finite and negative values are left to the checks of the setting itself.
+pub fn magnitude(flag: &str, value: f64, max: f64, unit: &str) -> anyhow::Result<()> {
+    if value.is_finite() && value.abs() > max {
+        // 1e300 in full would be 301 digits.
+        let shown = if value.abs() >= 1e15 {
+            format!("{value:e}")
+        } else {
+            format!("{value}")
+        };
+        return Err(exit::usage(format!(
+            "{flag} {shown}: at most {max} {unit} in magnitude"
+        )));
+    }
+    Ok(())
+}
 
 /// Checks that `value` of `flag` is within `min..=max` (`what` says what the limit protects, for
 /// the message).
@@ -52,5 +86,12 @@ mod tests {
         );
         let e = count("--max-iterations", 0, 1, 10, "time").unwrap_err();
         assert!(e.to_string().contains("at least 1"));
+        let e = magnitude("--noise-mm", 1e300, MAX_LENGTH_MM, "mm").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "--noise-mm 1e300: at most 1000000 mm in magnitude"
+        );
+        assert!(magnitude("--noise-mm", -1e6, MAX_LENGTH_MM, "mm").is_ok());
+        assert!(magnitude("--noise-mm", f64::INFINITY, MAX_LENGTH_MM, "mm").is_ok());
     }
 }
