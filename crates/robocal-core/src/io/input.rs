@@ -54,6 +54,20 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(
     what: &str,
 ) -> Result<T> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // Duplicates first, so that a repeated key reads the same whether serde's derived structs
+    // would catch it (`duplicate field`) or a map would keep the last silently. Text that is not
+    // one JSON document is left to the typed pass, whose errors name the field.
+    if let Ok(Some(d)) = crate::io::json_keys::find_duplicate_key(text) {
+        return Err(Error::parse(
+            path,
+            Some(d.line),
+            Some(&d.path),
+            format!(
+                "not a {what}: the key `{}` appears twice in one object (which one is meant?)",
+                d.path.rsplit('.').next().unwrap_or(&d.path)
+            ),
+        ));
+    }
     let de = &mut serde_json::Deserializer::from_str(text);
     let value: T =
         serde_path_to_error::deserialize(&mut *de).map_err(|e| json_error(e, path, what))?;
@@ -69,25 +83,7 @@ pub fn parse_json<T: serde::de::DeserializeOwned>(
             ),
         )
     })?;
-    match crate::io::json_keys::find_duplicate_key(text) {
-        Ok(None) => Ok(value),
-        Ok(Some(d)) => Err(Error::parse(
-            path,
-            Some(d.line),
-            Some(&d.path),
-            format!(
-                "not a {what}: the key `{}` appears twice in one object (which one is meant?)",
-                d.path.rsplit('.').next().unwrap_or(&d.path)
-            ),
-        )),
-        // The typed pass read the same text: serde_json cannot fail here, but say so if it does.
-        Err(e) => Err(Error::parse(
-            path,
-            (e.line() > 0).then_some(e.line()),
-            None,
-            format!("not a {what}: {e}"),
-        )),
-    }
+    Ok(value)
 }
 
 fn json_error(e: serde_path_to_error::Error<serde_json::Error>, path: &Path, what: &str) -> Error {
