@@ -59,8 +59,21 @@ fn fixture() -> &'static Fixture {
         let cell = dir.path().join("cell.csv");
         let validation = dir.path().join("validation.csv");
         let o = robocal(&[
-            "simulate", "--robot", KUKA, "--truth", "random", "--poses", "75", "--validation",
-            "30", "--seed", "3", "--out", s(&cell), "--validation-out", s(&validation),
+            "simulate",
+            "--robot",
+            KUKA,
+            "--truth",
+            "random",
+            "--poses",
+            "75",
+            "--validation",
+            "30",
+            "--seed",
+            "3",
+            "--out",
+            s(&cell),
+            "--validation-out",
+            s(&validation),
         ]);
         assert!(o.status.success(), "{}", stderr(&o));
         let ur5 = dir.path().join("ur5.csv");
@@ -90,12 +103,7 @@ fn fixture() -> &'static Fixture {
 }
 
 /// A copy of a measurement CSV with every row's joints (degrees) and position changed.
-fn transformed(
-    src: &Path,
-    dst: &Path,
-    q_of: &dyn Fn(&mut [f64]),
-    m_of: &dyn Fn(&mut [f64; 3]),
-) {
+fn transformed(src: &Path, dst: &Path, q_of: &dyn Fn(&mut [f64]), m_of: &dyn Fn(&mut [f64; 3])) {
     let text = std::fs::read_to_string(src).unwrap();
     let mut lines = text.lines();
     let header: Vec<&str> = lines.next().unwrap().split(',').collect();
@@ -131,12 +139,29 @@ fn expect_implausible(robot: &str, data: &Path, check: &str, cause: &str) {
     let out = dir.join("result.json");
     std::fs::write(&out, "earlier result").unwrap();
     let before = std::fs::read(data).unwrap();
-    let o = robocal(&["calibrate", "--robot", robot, "--data", s(data), "--out", s(&out)]);
+    let o = robocal(&[
+        "calibrate",
+        "--robot",
+        robot,
+        "--data",
+        s(data),
+        "--out",
+        s(&out),
+    ]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(6), "{}: {err}", data.display());
-    assert!(err.contains("implausible fit") && err.contains("nothing written"), "{err}");
-    assert!(err.contains(&format!("{check}:")), "{check} not named: {err}");
-    assert!(err.contains("likely cause") && err.contains(cause), "cause `{cause}`: {err}");
+    assert!(
+        err.contains("implausible fit") && err.contains("nothing written"),
+        "{err}"
+    );
+    assert!(
+        err.contains(&format!("{check}:")),
+        "{check} not named: {err}"
+    );
+    assert!(
+        err.contains("likely cause") && err.contains(cause),
+        "cause `{cause}`: {err}"
+    );
     assert!(err.contains("--accept-implausible"), "{err}");
     assert!(stdout(&o).contains("IMPLAUSIBLE"), "{}", stdout(&o));
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "earlier result");
@@ -156,9 +181,27 @@ type MFn = fn(&mut [f64; 3]);
 fn units_mirror_radians_and_coupling_exit_6_with_the_cause() {
     let f = fixture();
     let cases: [(&str, QFn, MFn, &str, &str); 5] = [
-        ("metres", same_q, |m| m.iter_mut().for_each(|v| *v /= 1000.0), "units", "metres"),
-        ("inches", same_q, |m| m.iter_mut().for_each(|v| *v /= 25.4), "units", "inches"),
-        ("mirrored", same_q, |m| m[1] = -m[1], "handedness", "mirrored"),
+        (
+            "metres",
+            same_q,
+            |m| m.iter_mut().for_each(|v| *v /= 1000.0),
+            "units",
+            "metres",
+        ),
+        (
+            "inches",
+            same_q,
+            |m| m.iter_mut().for_each(|v| *v /= 25.4),
+            "units",
+            "inches",
+        ),
+        (
+            "mirrored",
+            same_q,
+            |m| m[1] = -m[1],
+            "handedness",
+            "mirrored",
+        ),
         (
             "radians",
             |q| q.iter_mut().for_each(|v| *v = v.to_radians()),
@@ -189,7 +232,12 @@ fn the_kuka_model_on_ur5_data_is_the_wrong_robot() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("ur5.csv");
     std::fs::copy(&f.ur5, &data).unwrap();
-    expect_implausible(KUKA, &data, "nominal_error", "robot description does not match");
+    expect_implausible(
+        KUKA,
+        &data,
+        "nominal_error",
+        "robot description does not match",
+    );
 }
 
 /// The real data sets of ../shared/data (see its README); `None` (and a printed reason) when the
@@ -213,7 +261,12 @@ fn the_kuka_model_on_real_ur5_data_exits_6() {
     let dir = tempfile::tempdir().unwrap();
     let data = dir.path().join("grid.csv");
     std::fs::copy(d.join("jacobi_ur5_grid.csv"), &data).unwrap();
-    expect_implausible(KUKA, &data, "nominal_error", "robot description does not match");
+    expect_implausible(
+        KUKA,
+        &data,
+        "nominal_error",
+        "robot description does not match",
+    );
 }
 
 #[test]
@@ -249,7 +302,10 @@ fn real_ur5_and_wam_pass_the_gate() {
             .find(|c| c["name"] == "nominal_error")
             .unwrap()
             .clone();
-        let (m, l) = (nominal["measured"].as_f64().unwrap(), nominal["limit"].as_f64().unwrap());
+        let (m, l) = (
+            nominal["measured"].as_f64().unwrap(),
+            nominal["limit"].as_f64().unwrap(),
+        );
         assert!(m < 0.25 * l, "{robot}: {nominal}");
     }
 }
@@ -260,8 +316,15 @@ fn good_data_pass_and_the_result_records_every_check() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r.json");
     let o = robocal(&[
-        "calibrate", "--robot", KUKA, "--data", s(&f.cell), "--validate", s(&f.validation),
-        "--out", s(&out),
+        "calibrate",
+        "--robot",
+        KUKA,
+        "--data",
+        s(&f.cell),
+        "--validate",
+        s(&f.validation),
+        "--out",
+        s(&out),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(
@@ -320,7 +383,10 @@ fn accept_implausible_writes_a_marked_result_that_compensate_refuses() {
     ]);
     let err = stderr(&o);
     assert!(o.status.success(), "{err}");
-    assert!(err.contains("WARNING: IMPLAUSIBLE FIT WRITTEN") && err.contains("metres"), "{err}");
+    assert!(
+        err.contains("WARNING: IMPLAUSIBLE FIT WRITTEN") && err.contains("metres"),
+        "{err}"
+    );
     let j = read_json(&out);
     assert_eq!(j["status"], "implausible");
     assert!(j["implausible_reason"].as_str().unwrap().contains("units:"));
@@ -347,14 +413,20 @@ fn accept_implausible_writes_a_marked_result_that_compensate_refuses() {
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(6), "{err}");
     assert!(
-        err.contains("IMPLAUSIBLE") && err.contains("units:") && err.contains("--accept-implausible"),
+        err.contains("IMPLAUSIBLE")
+            && err.contains("units:")
+            && err.contains("--accept-implausible"),
         "{err}"
     );
     assert!(!commanded.exists());
     // ... unless accepted there too.
     let o = comp(&["--accept-implausible"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stderr(&o).contains("FAILED the plausibility gate"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("FAILED the plausibility gate"),
+        "{}",
+        stderr(&o)
+    );
     assert!(commanded.exists());
 
     // evaluate, fk, robot show and report use it with a warning.
@@ -367,14 +439,30 @@ fn accept_implausible_writes_a_marked_result_that_compensate_refuses() {
         );
     };
     warned(&robocal(&[
-        "evaluate", "--robot", KUKA, "--params", s(&out), "--data", s(&data),
+        "evaluate",
+        "--robot",
+        KUKA,
+        "--params",
+        s(&out),
+        "--data",
+        s(&data),
     ]));
     warned(&robocal(&[
-        "fk", "--robot", KUKA, "--params", s(&out), "--joints", "0,-90,90,0,0,0",
+        "fk",
+        "--robot",
+        KUKA,
+        "--params",
+        s(&out),
+        "--joints",
+        "0,-90,90,0,0,0",
     ]));
     let o = robocal(&["robot", "show", KUKA, "--params", s(&out)]);
     warned(&o);
-    assert!(stdout(&o).contains("IMPLAUSIBLE parameters"), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains("IMPLAUSIBLE parameters"),
+        "{}",
+        stdout(&o)
+    );
     warned(&robocal(&[
         "report",
         s(&out),
@@ -389,7 +477,11 @@ fn all_params(but_tool_orientation: bool) -> String {
         .flat_map(|p| (1..=6).map(move |i| format!("{p}{i}")))
         .collect();
     v.extend("xyzabc".chars().map(|c| format!("base_{c}")));
-    let tool = if but_tool_orientation { "xyz" } else { "xyzabc" };
+    let tool = if but_tool_orientation {
+        "xyz"
+    } else {
+        "xyzabc"
+    };
     v.extend(tool.chars().map(|c| format!("tool_{c}")));
     v.join(",")
 }
@@ -400,14 +492,26 @@ fn nothing_to_identify_and_tolerances_beyond_double_precision_are_clear_errors()
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("r.json");
     let run = |extra: &[&str]| {
-        let mut args = vec!["calibrate", "--robot", KUKA, "--data", s(&f.cell), "--out", s(&out)];
+        let mut args = vec![
+            "calibrate",
+            "--robot",
+            KUKA,
+            "--data",
+            s(&f.cell),
+            "--out",
+            s(&out),
+        ];
         args.extend_from_slice(extra);
         robocal(&args)
     };
     let all = all_params(false);
     let o = run(&["--fix", &all]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
-    assert!(stderr(&o).contains("--fix names every parameter"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--fix names every parameter"),
+        "{}",
+        stderr(&o)
+    );
     let effective = all_params(true);
     let o = run(&["--fix", &effective]);
     assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
@@ -435,14 +539,31 @@ fn an_ill_conditioned_fit_writes_null_standard_deviations_with_the_reason() {
     // identified beside d2 with a condition number beyond double precision.
     let dir = tempfile::tempdir().unwrap();
     let text = std::fs::read_to_string(root().join("examples/kr480-r3330.toml")).unwrap();
-    let tilted = text.replacen("alpha = 0\nd = 0\na = 1300", "alpha = 0.01\nd = 0\na = 1300", 1);
+    let tilted = text.replacen(
+        "alpha = 0\nd = 0\na = 1300",
+        "alpha = 0.01\nd = 0\na = 1300",
+        1,
+    );
     assert_ne!(tilted, text);
     let robot = dir.path().join("tilted.toml");
     std::fs::write(&robot, tilted).unwrap();
     let data = dir.path().join("exact.csv");
     let o = robocal(&[
-        "simulate", "--robot", s(&robot), "--truth", s(&robot), "--poses", "75", "--seed", "5",
-        "--noise-mm", "0", "--noise-per-m", "0", "--out", s(&data),
+        "simulate",
+        "--robot",
+        s(&robot),
+        "--truth",
+        s(&robot),
+        "--poses",
+        "75",
+        "--seed",
+        "5",
+        "--noise-mm",
+        "0",
+        "--noise-per-m",
+        "0",
+        "--out",
+        s(&data),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let out = dir.path().join("r.json");
@@ -478,10 +599,19 @@ fn an_ill_conditioned_fit_writes_null_standard_deviations_with_the_reason() {
     let u = &j["uncertainty"];
     let stds = u["std"].as_object().unwrap();
     assert!(!stds.is_empty() && stds.values().all(Value::is_null), "{u}");
-    assert!(u["std_unavailable"].as_str().unwrap().contains("condition number"));
+    assert!(u["std_unavailable"]
+        .as_str()
+        .unwrap()
+        .contains("condition number"));
     // At the default tolerance d3 is fixed and every standard deviation is a number.
     let o = robocal(&[
-        "calibrate", "--robot", s(&robot), "--data", s(&data), "--out", s(&out),
+        "calibrate",
+        "--robot",
+        s(&robot),
+        "--data",
+        s(&data),
+        "--out",
+        s(&out),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let j = read_json(&out);

@@ -347,7 +347,9 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let cal = result
         .map_err(|e| match e {
             robocal_core::Error::Numerical(m) if m.contains("rank tolerance") => {
-                robocal_core::Error::Numerical(m.replace("rank tolerance", "rank tolerance (--rank-tol)"))
+                robocal_core::Error::Numerical(
+                    m.replace("rank tolerance", "rank tolerance (--rank-tol)"),
+                )
             }
             e => e,
         })

@@ -35,7 +35,11 @@ fn exact(robot: &Robot, n: usize, seed: u64) -> Observations {
     obs
 }
 
-fn run(robot: &Robot, obs: &Observations, id: IdentifiabilityOptions) -> crate::Result<Calibration> {
+fn run(
+    robot: &Robot,
+    obs: &Observations,
+    id: IdentifiabilityOptions,
+) -> crate::Result<Calibration> {
     calibrate(
         robot,
         CalibrationData {
@@ -66,7 +70,10 @@ fn nothing_left_to_identify_is_an_error_not_a_panic() {
     )
     .unwrap_err();
     assert!(matches!(e, Error::Numerical(_)), "{e:?}");
-    assert!(e.to_string().contains("every parameter is held fixed"), "{e}");
+    assert!(
+        e.to_string().contains("every parameter is held fixed"),
+        "{e}"
+    );
     // Everything but the tool orientation, which has no effect on a point.
     let effective: Vec<Param> = all
         .iter()
@@ -176,10 +183,17 @@ fn an_ill_conditioned_identification_fails_unless_the_tolerance_was_chosen() {
     let r = c.to_result(Default::default());
     let d3 = &r.parameters["d3"];
     assert!(!d3.fixed && d3.std.is_none());
-    assert!(d3.reason.as_deref().unwrap().contains("standard deviation unavailable"));
+    assert!(d3
+        .reason
+        .as_deref()
+        .unwrap()
+        .contains("standard deviation unavailable"));
     let u = &r.extra["uncertainty"];
     assert!(u["std"].as_object().unwrap().values().all(|v| v.is_null()));
-    assert!(u["std_unavailable"].as_str().unwrap().contains("condition number"));
+    assert!(u["std_unavailable"]
+        .as_str()
+        .unwrap()
+        .contains("condition number"));
     let j = &r.extra["identifiability"];
     assert!(j["condition_number"].as_f64().unwrap() > MAX_CONDITION_NUMBER);
     assert_eq!(j["ill_conditioned"], true);

@@ -77,7 +77,8 @@ impl Covariance {
             ),
         };
         if unavailable.is_none() {
-            if let Some(j) = (0..k).find(|&j| !(matrix[(j, j)] >= 0.0 && matrix[(j, j)].is_finite()))
+            if let Some(j) =
+                (0..k).find(|&j| !(matrix[(j, j)] >= 0.0 && matrix[(j, j)].is_finite()))
             {
                 unavailable = Some(format!(
                     "the computed variance of {} is {:e}: rounding dominates the covariance",

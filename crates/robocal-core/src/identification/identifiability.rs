@@ -164,7 +164,7 @@ impl Identifiability {
     /// Whether the identified parameters are too nearly dependent for double precision (see
     /// [`MAX_CONDITION_NUMBER`]); also when the condition number is not finite.
     pub fn ill_conditioned(&self) -> bool {
-        !(self.condition_number <= MAX_CONDITION_NUMBER)
+        self.condition_number.is_nan() || self.condition_number > MAX_CONDITION_NUMBER
     }
 }
 

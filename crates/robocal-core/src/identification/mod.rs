@@ -29,8 +29,8 @@ mod tests;
 
 pub use covariance::{Correlation, Covariance};
 pub use identifiability::{
-    analyze, FixReason, FixedParam, Identifiability, IdentifiabilityOptions, DEFAULT_RANK_TOLERANCE,
-    MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
+    analyze, FixReason, FixedParam, Identifiability, IdentifiabilityOptions,
+    DEFAULT_RANK_TOLERANCE, MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
 };
 pub use objective::{Loss, Objective, RobustLoss};
 pub use observations::{split_measurements, Observations, SplitData};

@@ -243,8 +243,14 @@ pub fn calibrate(
     });
     if let Some(why) = &ill_conditioned {
         if !ident.condition_number.is_finite() || !idopts.allow_ill_conditioned {
+            let hint = if plausibility::joints_look_like_radians(nominal, cal) {
+                " (but first check the joint values: they all lie within ±2π while the joint \
+                 limits span far more, as if they were radians)"
+            } else {
+                ""
+            };
             return Err(Error::Numerical(format!(
-                "{why}. Raise the rank tolerance above {:.1e} to fix it",
+                "{why}. Raise the rank tolerance above {:.1e} to fix it{hint}",
                 ident.least_independent().map_or(0.0, |(_, i)| i)
             )));
         }

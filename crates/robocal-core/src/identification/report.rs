@@ -52,7 +52,10 @@ impl Calibration {
                 .expect("names come from the robot");
             if self.covariance.identifies(p) {
                 e.fixed = false;
-                e.std = self.covariance.std_of(p).map(|sd| p.unit().from_internal(sd));
+                e.std = self
+                    .covariance
+                    .std_of(p)
+                    .map(|sd| p.unit().from_internal(sd));
                 if let Some(why) = &self.covariance.unavailable {
                     e.reason = Some(format!("identified; standard deviation unavailable: {why}"));
                 }
@@ -275,7 +278,10 @@ impl Calibration {
                 json!(format!("the solver {}", termination.describe())),
             );
         } else if self.plausibility.implausible() {
-            extra.insert("status".into(), json!(crate::io::result::STATUS_IMPLAUSIBLE));
+            extra.insert(
+                "status".into(),
+                json!(crate::io::result::STATUS_IMPLAUSIBLE),
+            );
             extra.insert(
                 "implausible_reason".into(),
                 json!(self.plausibility.summary()),

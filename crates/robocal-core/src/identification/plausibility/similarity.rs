@@ -89,7 +89,11 @@ mod tests {
         (0..20)
             .map(|i| {
                 let t = i as f64;
-                Vector3::new(100.0 * t.sin(), 80.0 * (1.3 * t).cos(), 10.0 * t - 50.0 * t.cos())
+                Vector3::new(
+                    100.0 * t.sin(),
+                    80.0 * (1.3 * t).cos(),
+                    10.0 * t - 50.0 * t.cos(),
+                )
             })
             .collect()
     }
@@ -111,7 +115,10 @@ mod tests {
         let mirrored: Vec<Vector3<f64>> = p.iter().map(|x| Vector3::new(-x.x, x.y, x.z)).collect();
         let refl = fit_similarity(&mirrored, &p, Handedness::Reflection, true).unwrap();
         let rot = fit_similarity(&mirrored, &p, Handedness::Rotation, true).unwrap();
-        assert!(refl.rms < 1e-9 && (refl.scale - 1.0).abs() < 1e-12, "{refl:?}");
+        assert!(
+            refl.rms < 1e-9 && (refl.scale - 1.0).abs() < 1e-12,
+            "{refl:?}"
+        );
         assert!(rot.rms > 10.0, "{rot:?}");
         // Degenerate input.
         assert!(fit_similarity(&p[..2], &p[..2], Handedness::Rotation, true).is_none());

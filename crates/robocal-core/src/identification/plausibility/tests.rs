@@ -71,7 +71,11 @@ fn measure(nominal: &Robot, truth: &Robot, n: usize, seed: u64) -> Cell {
 
 impl Cell {
     /// The observations, with `q` and `m` changed by the mistakes to test.
-    fn obs(&self, q_of: impl Fn(&[f64]) -> Vec<f64>, m_of: impl Fn(Vector3<f64>) -> Vector3<f64>) -> Observations {
+    fn obs(
+        &self,
+        q_of: impl Fn(&[f64]) -> Vec<f64>,
+        m_of: impl Fn(Vector3<f64>) -> Vector3<f64>,
+    ) -> Observations {
         let mut o = Observations::new(self.qs[0].len());
         for (i, (q, m)) in self.qs.iter().zip(&self.ms).enumerate() {
             o.push(&q_of(q), m_of(*m), i + 2).unwrap();
@@ -120,7 +124,11 @@ fn fails(c: &Calibration, kind: CheckKind, cause: &str) {
     let k = check_of(c, kind);
     assert!(!k.passed, "{} passed: {}", kind.name(), k.detail);
     let why = k.cause.as_deref().unwrap_or_default();
-    assert!(why.contains(cause), "{}: cause `{why}` lacks `{cause}`", kind.name());
+    assert!(
+        why.contains(cause),
+        "{}: cause `{why}` lacks `{cause}`",
+        kind.name()
+    );
     assert!(c.plausibility.implausible());
 }
 
@@ -156,8 +164,16 @@ fn good_data_pass_every_check() {
 #[test]
 fn reach_is_the_chains_length() {
     // KR 480: 1045 + 500 + 1300 + 55 + 1525 + 290 + |T0| (254 mm).
-    assert!((reach_mm(&kuka()) - 4968.0).abs() < 1.0, "{}", reach_mm(&kuka()));
-    assert!((reach_mm(&ur5()) - 1223.5).abs() < 0.1, "{}", reach_mm(&ur5()));
+    assert!(
+        (reach_mm(&kuka()) - 4968.0).abs() < 1.0,
+        "{}",
+        reach_mm(&kuka())
+    );
+    assert!(
+        (reach_mm(&ur5()) - 1223.5).abs() < 0.1,
+        "{}",
+        reach_mm(&ur5())
+    );
 }
 
 #[test]
@@ -168,7 +184,11 @@ fn units_check_names_metres_and_inches() {
         fails(&c, CheckKind::Units, unit);
         let k = check_of(&c, CheckKind::Units);
         assert!((k.measured / factor - 1.0).abs() < 0.01, "{}", k.detail);
-        assert!(k.detail.contains(&format!("the scale of {unit}")), "{}", k.detail);
+        assert!(
+            k.detail.contains(&format!("the scale of {unit}")),
+            "{}",
+            k.detail
+        );
         // The other checks that fail share the cause.
         fails(&c, CheckKind::NominalError, unit);
         let e = &c.plausibility.explanations[0];
@@ -204,7 +224,11 @@ fn nominal_error_check_catches_a_wrong_robot() {
     let u = ur5();
     let cell = measure(&u, &truth_of(&u, 3), 75, 4);
     let c = fit(&kuka(), &cell.good(), None);
-    fails(&c, CheckKind::NominalError, "robot description does not match");
+    fails(
+        &c,
+        CheckKind::NominalError,
+        "robot description does not match",
+    );
     assert!(c.plausibility.explanations.is_empty());
     let k = check_of(&c, CheckKind::NominalError);
     assert!(k.measured > 0.1 * reach_mm(&kuka()), "{}", k.detail);
@@ -225,7 +249,11 @@ fn missing_coupling_radians_and_signs_are_named() {
         |m| m,
     );
     let c = fit(&kuka(), &coupled, None);
-    fails(&c, CheckKind::NominalError, "joint 3 is given without its coupling to joint 2");
+    fails(
+        &c,
+        CheckKind::NominalError,
+        "joint 3 is given without its coupling to joint 2",
+    );
     let radians = cell.obs(|q| q.iter().map(|v| v.to_radians()).collect(), |m| m);
     let c = fit(&kuka(), &radians, None);
     fails(&c, CheckKind::NominalError, "radians");
@@ -238,7 +266,11 @@ fn missing_coupling_radians_and_signs_are_named() {
         |m| m,
     );
     let c = fit(&kuka(), &sign2, None);
-    fails(&c, CheckKind::NominalError, "the sign of joint 2 is reversed");
+    fails(
+        &c,
+        CheckKind::NominalError,
+        "the sign of joint 2 is reversed",
+    );
 }
 
 #[test]
@@ -250,7 +282,11 @@ fn validation_points_in_another_unit_fail_their_own_check() {
         &cell.good(),
         Some(&val.obs(|q| q.to_vec(), |m| m / 1000.0)),
     );
-    fails(&c, CheckKind::ValidationNominalError, "validation points do not match");
+    fails(
+        &c,
+        CheckKind::ValidationNominalError,
+        "validation points do not match",
+    );
     assert!(check_of(&c, CheckKind::NominalError).passed);
     assert!(check_of(&c, CheckKind::Units).passed);
 }
@@ -277,18 +313,32 @@ fn parameter_move_checks_catch_lengths_and_angles_beyond_calibration() {
     let mut moved = c.calibrated.clone();
     moved.set(Param::A(2), moved.get(Param::A(2)) + 300.0);
     let p = assess_with(&moved);
-    let k = p.checks.iter().find(|k| k.kind == CheckKind::LengthMoves).unwrap();
+    let k = p
+        .checks
+        .iter()
+        .find(|k| k.kind == CheckKind::LengthMoves)
+        .unwrap();
     assert!(!k.passed && k.detail.contains("a3"), "{}", k.detail);
     assert!(k.cause.as_deref().unwrap().contains("hardly determine"));
     let mut turned = c.calibrated.clone();
-    turned.set(Param::Phi(1), turned.get(Param::Phi(1)) + 20f64.to_radians());
+    turned.set(
+        Param::Phi(1),
+        turned.get(Param::Phi(1)) + 20f64.to_radians(),
+    );
     let p = assess_with(&turned);
-    let k = p.checks.iter().find(|k| k.kind == CheckKind::AngleMoves).unwrap();
+    let k = p
+        .checks
+        .iter()
+        .find(|k| k.kind == CheckKind::AngleMoves)
+        .unwrap();
     assert!(!k.passed && k.detail.contains("phi2"), "{}", k.detail);
     assert!((k.measured - 20.0).abs() < 0.5, "{}", k.measured);
     // A full turn is no move.
     let mut wrapped = c.calibrated.clone();
-    wrapped.set(Param::Phi(1), wrapped.get(Param::Phi(1)) + std::f64::consts::TAU);
+    wrapped.set(
+        Param::Phi(1),
+        wrapped.get(Param::Phi(1)) + std::f64::consts::TAU,
+    );
     assert!(assess_with(&wrapped).passed());
 }
 
@@ -358,7 +408,11 @@ fn the_gate_passes_the_demo_for_seeds_1_to_30() {
         assert!(p.passed(), "seed {seed}: {}", p.summary());
         // With a wide margin: Table II under a tenth of its limit, the scale within 0.1%.
         let nominal = check_of(&e.calibration, CheckKind::NominalError);
-        assert!(nominal.measured < 0.1 * nominal.limit, "seed {seed}: {}", nominal.detail);
+        assert!(
+            nominal.measured < 0.1 * nominal.limit,
+            "seed {seed}: {}",
+            nominal.detail
+        );
         assert!(check_of(&e.calibration, CheckKind::Units).measured < 1.001);
         assert_eq!(e.result.extra["status"], "calibrated");
     }
