@@ -2,8 +2,8 @@
 //! `--poses 18446744073709551615` parses; unchecked it would overflow a capacity computation (a
 //! panic) or ask for an allocation the machine cannot give (an abort). These limits keep every run
 //! within a machine of 2 cores and 24 GiB, the size robocal is built and tested on, with a clear
-//! usage error beyond them. Lengths and masses far beyond any robot cell are refused too: they
-//! would give readings of `inf`.
+//! usage error beyond them. Lengths of the CLI's own settings are held to the library's plausible
+//! length (`robocal_core::ranges::LENGTH`); the library checks the settings it is given itself.
 
 use crate::exit;
 
@@ -22,20 +22,8 @@ pub const MAX_CALIBRATION_ITERATIONS: usize = 1_000_000;
 /// converges in a handful). The limit applies per row, and a file may have millions of rows.
 pub const MAX_IK_ITERATIONS: usize = 100_000;
 
-/// Largest length argument of a simulation (mm): 1 km. A laser tracker reaches about 80 m and
-/// the largest robots a few metres; beyond this a value is a typing mistake, and far beyond it
-/// (1e300) the readings overflow to `inf`.
-pub const MAX_LENGTH_MM: f64 = 1e6;
-
-/// Largest standard deviation of random angle errors (deg): a full turn.
-pub const MAX_ANGLE_DEG: f64 = 360.0;
-
-/// Largest mass (kg): 1000 t, far above the heaviest industrial robot and payload (a few t).
-pub const MAX_MASS_KG: f64 = 1e6;
-
-/// Largest joint compliance (rad per N·m); real joints have about 1e-7, and 1 already turns a
-/// joint by radians under a 1 N·m torque.
-pub const MAX_COMPLIANCE: f64 = 1.0;
+/// Largest length of a CLI setting (mm): the library's plausible length, 1 km.
+pub const MAX_LENGTH_MM: f64 = robocal_core::ranges::LENGTH.max;
 
 /// Checks that a finite `value` of `flag` is at most `max` in magnitude (`unit` for the
 /// message). Non-finite and negative values are left to the checks of the setting itself.

@@ -238,60 +238,6 @@ fn check_counts(a: &SimulateArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The lengths, masses and compliances of the arguments within [`limits`]: absurd values are
-/// usage errors instead of readings of `inf`.
-fn check_magnitudes(a: &SimulateArgs, cfg: &SimulationConfig) -> anyhow::Result<()> {
-    use limits::{magnitude, MAX_LENGTH_MM as MM};
-    let lengths = [
-        ("--noise-mm", Some(cfg.noise_mm)),
-        ("--noise-per-m", Some(cfg.noise_per_m)),
-        ("--length-error-mm", a.length_error_mm),
-        ("--floor-mm", Some(cfg.floor_z_mm)),
-        ("--footprint-mm", cfg.footprint_radius_mm),
-        ("--plane-z-mm", cfg.plane_z_mm),
-        ("--outlier-min-mm", cfg.outliers.as_ref().map(|o| o.min_mm)),
-        ("--outlier-max-mm", cfg.outliers.as_ref().map(|o| o.max_mm)),
-    ];
-    for (flag, v) in lengths {
-        if let Some(v) = v {
-            magnitude(flag, v, MM, "mm")?;
-        }
-    }
-    if a.tracker.is_some() {
-        let t = &cfg.tracker_frame;
-        for (axis, v) in [("x", t.x), ("y", t.y), ("z", t.z)] {
-            magnitude(&format!("--tracker ({axis})"), v, MM, "mm")?;
-        }
-    }
-    if let Some(v) = a.angle_error_deg {
-        magnitude("--angle-error-deg", v, limits::MAX_ANGLE_DEG, "deg")?;
-    }
-    if let Some(g) = &cfg.gravity {
-        for (j, (c, m)) in g
-            .compliance_rad_per_nm
-            .iter()
-            .zip(&g.link_masses_kg)
-            .enumerate()
-        {
-            let j = j + 1;
-            magnitude(
-                &format!("--compliance (joint {j})"),
-                *c,
-                limits::MAX_COMPLIANCE,
-                "rad/(N m)",
-            )?;
-            magnitude(
-                &format!("--link-masses-kg (joint {j})"),
-                *m,
-                limits::MAX_MASS_KG,
-                "kg",
-            )?;
-        }
-        magnitude("--payload-kg", g.payload_kg, limits::MAX_MASS_KG, "kg")?;
-    }
-    Ok(())
-}
-
 /// `FILE.truth.json` beside `FILE.csv`.
 fn truth_path(out: &Path) -> PathBuf {
     out.with_extension("truth.json")
@@ -333,7 +279,6 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     let nominal = common::robot(&a.robot)?;
     let (truth, truth_tracker) = truth_arg(&a, &nominal)?;
     let cfg = config(&a, &nominal, truth_tracker)?;
-    check_magnitudes(&a, &cfg)?;
     cfg.validate(&nominal)?;
 
     let joints = match &a.joints {
