@@ -142,7 +142,7 @@ fn apply_beta(robot: &mut Robot, arg: &str) -> anyhow::Result<Vec<usize>> {
 
 /// Reads a measurement file and sorts its rows (see `split_measurements`).
 fn read(path: &Path, robot: &Robot) -> anyhow::Result<robocal_core::identification::SplitData> {
-    let set = read_measurements(path, robot.dof(), Positions::Required)?;
+    let set = read_measurements(path, robot.joint_space(), Positions::Required)?;
     for w in &set.warnings {
         eprintln!("warning: {w}");
     }

@@ -43,7 +43,8 @@ pub fn model(robot_arg: &str, params: Option<&Path>) -> anyhow::Result<Model> {
     })
 }
 
-/// Parses `--joints q1,...,qn` (degrees) into radians, checking count and finiteness.
+/// Parses `--joints q1,...,qn` (model joint values: degrees, or mm for a prismatic joint) into
+/// internal units (radians or mm), checking count and finiteness.
 pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
     let mut q = Vec::new();
     for (i, part) in s.split(',').enumerate() {
@@ -60,7 +61,7 @@ pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
                 i + 1
             )));
         }
-        q.push(v.to_radians());
+        q.push(v);
     }
     if q.len() != robot.dof() {
         return Err(crate::exit::usage(format!(
@@ -70,7 +71,7 @@ pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
             q.len()
         )));
     }
-    Ok(q)
+    Ok(robot.joints_from_display(&q))
 }
 
 /// Checks an output path before any work: its directory must exist, it must not be a directory,

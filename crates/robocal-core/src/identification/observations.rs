@@ -179,7 +179,7 @@ pub struct SplitData {
 /// Sorts a measurement file's rows by their `set` column (see [`SplitData`]). Every row must have
 /// a measured position.
 pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
-    let mk = || Observations::with_source(set.dof, &set.path);
+    let mk = || Observations::with_source(set.dof(), &set.path);
     let mut out = SplitData {
         calibration: mk(),
         validation: mk(),

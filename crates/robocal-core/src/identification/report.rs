@@ -262,11 +262,7 @@ impl Calibration {
             );
         }
         CalibrationResult {
-            robot: RobotInfo {
-                name: self.nominal.name().to_owned(),
-                dof: self.nominal.dof(),
-                convention: self.nominal.convention().as_str().to_owned(),
-            },
+            robot: RobotInfo::of(&self.nominal),
             parameters,
             tracker_frame: FrameVec::from_frame(&self.registration.frame),
             errors,

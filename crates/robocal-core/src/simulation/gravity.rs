@@ -15,11 +15,17 @@
 //!   robot really stands at `q + dq` while the controller reports `q`.
 //! - First order: the torques are evaluated at the commanded `q` (the change of torque caused by
 //!   `dq` is of second order for realistic stiffnesses).
+//! - A prismatic joint (e.g. a linear track) has no torque-driven rotation. Its generalized force
+//!   is the weight's component along its axis, `f_j = u_j . sum_{k >= j} m_k g` (N; equal to
+//!   `-dV/dq_j` with `q_j` in metres), which [`GravityModel::torques`] reports in its place; the
+//!   joint is taken as rigid along its axis (its position-controlled drive holds the carriage, and
+//!   a horizontal track carries no axial weight at all), so it does not deflect and its
+//!   compliance entry is not used. The masses beyond it still load the revolute joints.
 //!
 //! Link elasticity, gear backlash and the robot's own counterbalance are not modelled.
 
 use crate::error::{Error, Result};
-use crate::model::Robot;
+use crate::model::{JointType, Robot};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -119,7 +125,8 @@ impl GravityModel {
         out
     }
 
-    /// The gravity torque about each joint axis (N·m) at joint values `q` (rad).
+    /// The gravity torque about each joint axis (N·m) at joint values `q` (rad, or mm for a
+    /// prismatic joint); for a prismatic joint, the axial force (N) instead.
     pub fn torques(&self, robot: &Robot, q: &[f64]) -> Vec<f64> {
         let axes = robot.joint_axes(q);
         let masses = self.masses_on(&axes, robot.tool_position(q));
@@ -127,26 +134,35 @@ impl GravityModel {
         // Mass k (k < n) belongs to link k and hangs beyond joints 0..=k; the payload (k = n)
         // beyond all joints.
         axes.iter()
+            .zip(robot.joint_types())
             .enumerate()
-            .map(|(j, (u, o))| {
+            .map(|(j, ((u, o), t))| {
                 masses[j..]
                     .iter()
-                    .map(|(m, r)| u.dot(&((r - o) * 1e-3).cross(&(g * *m))))
+                    .map(|(m, r)| match t {
+                        JointType::Revolute => u.dot(&((r - o) * 1e-3).cross(&(g * *m))),
+                        JointType::Prismatic => u.dot(&(g * *m)),
+                    })
                     .sum()
             })
             .collect()
     }
 
-    /// The joint deflections `dq_j = c_j tau_j` (rad) at joint values `q` (rad).
+    /// The joint deflections `dq_j = c_j tau_j` (rad) at joint values `q` (rad or mm); zero for
+    /// a prismatic joint (rigid along its axis, see the module documentation).
     pub fn deflection(&self, robot: &Robot, q: &[f64]) -> Vec<f64> {
         self.torques(robot, q)
             .iter()
             .zip(&self.compliance_rad_per_nm)
-            .map(|(t, c)| t * c)
+            .zip(robot.joint_types())
+            .map(|((t, c), jt)| match jt {
+                JointType::Revolute => t * c,
+                JointType::Prismatic => 0.0,
+            })
             .collect()
     }
 
-    /// Where the robot really stands when commanded to `q`: `q + dq` (rad).
+    /// Where the robot really stands when commanded to `q`: `q + dq` (rad or mm).
     pub fn deflected(&self, robot: &Robot, q: &[f64]) -> Vec<f64> {
         self.deflection(robot, q)
             .iter()
