@@ -415,7 +415,10 @@ fn compensation_converges_on_the_tracked_robot() {
          track, {max_angle:.4} rad of arm"
     );
     assert!(converged >= 1990, "{converged} converged");
-    assert!(max_track > 0.0 && max_track < 20.0, "track moved {max_track} mm");
+    assert!(
+        max_track > 0.0 && max_track < 20.0,
+        "track moved {max_track} mm"
+    );
     assert!(max_angle < 0.6, "arm moved {max_angle} rad");
 }
 

@@ -399,4 +399,70 @@ mod tests {
         assert!((t.rows[0].q[0] - s.rows[0].q[0]).abs() < 1e-12);
         assert_eq!(t.rows[0].p, s.rows[0].p);
     }
+
+    fn tracked() -> JointSpace {
+        use crate::model::{Controller, JointType};
+        let c = Controller::new(vec![1.0, -1.0], vec![100.0, 0.0], vec![]).unwrap();
+        JointSpace::new(vec![JointType::Prismatic, JointType::Revolute], Some(c)).unwrap()
+    }
+
+    fn parse_with(s: &str, j: &JointSpace) -> Result<MeasurementSet> {
+        parse_measurements(s.as_bytes(), Path::new("m.csv"), j, Positions::Optional)
+    }
+
+    /// A prismatic joint's column is mm, never converted; axis columns go through the controller.
+    #[test]
+    fn prismatic_values_and_axis_columns() {
+        let j = tracked();
+        let s = parse_with("q1,q2\n1500,90\n", &j).unwrap();
+        assert_eq!(s.rows[0].q[0], 1500.0);
+        assert!((s.rows[0].q[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+        // axis1 = 1400 -> q1 = 1500 mm; axis2 = -90 -> q2 = 90 deg.
+        let a = parse_with("id,axis2,axis1\nx,-90,1400\n", &j).unwrap();
+        assert_eq!(a.rows[0].q, s.rows[0].q);
+        assert_eq!(a.extra_columns, vec!["id"]);
+        // Written back as model values in display units: mm and degrees.
+        let text = String::from_utf8(measurements_csv(&a).unwrap()).unwrap();
+        assert_eq!(text, "q1,q2,id\n1500.000000000,90.000000000,x\n");
+        // Without a controller map axis values are the joint values.
+        let plain = JointSpace::revolute(2);
+        let p = parse_with("axis1,axis2\n10,20\n", &plain).unwrap();
+        assert!((p.rows[0].q[1] - 20f64.to_radians()).abs() < 1e-15);
+        // Small prismatic values do not look like radians; small angles do.
+        let w = parse_with("q1,q2\n1,1\n2,2\n3,3\n", &j).unwrap();
+        assert_eq!(w.warnings.len(), 1);
+        let w = parse_with("q1,q2\n1,10\n2,20\n3,30\n", &j).unwrap();
+        assert!(w.warnings.is_empty(), "{:?}", w.warnings);
+    }
+
+    /// Both kinds of joint columns: q is used, and axis must agree with it on every row.
+    #[test]
+    fn q_and_axis_columns_must_agree() {
+        let j = tracked();
+        let s = parse_with("q1,q2,axis1,axis2\n1500,90,1400,-90\n", &j).unwrap();
+        assert_eq!(s.rows[0].q[0], 1500.0);
+        let e = parse_with("q1,q2,axis1,axis2\n1500,90,1400,-90\n1500,90,1400,90\n", &j)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("m.csv:3: field `axis2`") && e.contains("disagrees"),
+            "{e}"
+        );
+        let e = parse_with("q1,q2,axis1\n1,2,3\n", &j)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("m.csv:1: field `axis2`: missing column"), "{e}");
+        let e = parse_with("axis1,axis3\n1,2\n", &j)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("field `axis3`") && e.contains("axis1..axis2"),
+            "{e}"
+        );
+        let e = parse_with("id\n1\n", &j).unwrap_err().to_string();
+        assert!(
+            e.contains("field `q1`: missing column") && e.contains("axis1..axis2"),
+            "{e}"
+        );
+    }
 }
