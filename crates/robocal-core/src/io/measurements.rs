@@ -252,9 +252,14 @@ impl<R: Read> MeasurementReader<R> {
             && self.max_abs_deg <= std::f64::consts::TAU + 1e-9
         {
             warnings.push(format!(
-                "{}: every revolute joint value is within ±{:.3} (±2π); they look like radians, \
-                 but files hold degrees",
+                "{}: every {}joint value is within ±{:.3} (±2π); they look like radians, but \
+                 files hold degrees",
                 self.path.display(),
+                if self.joints.any_prismatic() {
+                    "revolute "
+                } else {
+                    ""
+                },
                 self.max_abs_deg
             ));
         }
