@@ -115,7 +115,7 @@ impl Controller {
         }
         let sv = m.clone().singular_values();
         let (lo, hi) = (sv.min(), sv.max());
-        if !(lo > MIN_CONDITION_RATIO * hi) {
+        if !lo.is_finite() || lo <= MIN_CONDITION_RATIO * hi {
             return Err(Error::invalid(
                 "controller.coupling",
                 format!(
