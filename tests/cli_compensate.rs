@@ -44,7 +44,8 @@ fn joints_mode_writes_converged_commanded_joints() {
     let (h, rows) = read_csv(&out);
     assert_eq!(
         h.join(","),
-        "q1,q2,q3,q4,q5,q6,status,residual_mm,iterations,at_limit,x_desired,y_desired,z_desired,\
+        "q1,q2,q3,q4,q5,q6,axis1,axis2,axis3,axis4,axis5,axis6,status,residual_mm,iterations,\
+         at_limit,x_desired,y_desired,z_desired,\
          q1_desired,q2_desired,q3_desired,q4_desired,q5_desired,q6_desired,id"
     );
     assert_eq!(rows.len(), 75);
@@ -70,6 +71,15 @@ fn joints_mode_writes_converged_commanded_joints() {
         assert!(num(&r[col(&h, "residual_mm")]) <= 1e-6);
         // The correction is real: commanded joints differ from the desired ones.
         assert!((0..6).any(|i| (q[i] - qd[i]).abs() > 1e-6));
+        // The KUKA controller's axes: A = (-q1, q2, q3, -q4, q5, -q6) (DESIGN.md).
+        for (i, sign) in [-1.0, 1.0, 1.0, -1.0, 1.0, -1.0].iter().enumerate() {
+            let a = num(&r[col(&h, &format!("axis{}", i + 1))]);
+            assert!(
+                (a - sign * num(&r[i])).abs() < 1e-12,
+                "row {k}: axis{}",
+                i + 1
+            );
+        }
     }
 }
 

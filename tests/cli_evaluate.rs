@@ -217,7 +217,7 @@ fn bad_inputs_are_clear_errors() {
     // A bad desired cell names line and column.
     let set = MeasurementSet {
         path: d.join("v.csv"),
-        dof: 6,
+        joints: robocal_core::JointSpace::revolute(6),
         extra_columns: vec!["x_desired".into(), "y_desired".into(), "z_desired".into()],
         rows: vec![Measurement {
             line: 2,

@@ -30,7 +30,12 @@ fn stderr(o: &Output) -> String {
 }
 
 fn read(p: &Path) -> MeasurementSet {
-    read_measurements(p, 6, Positions::Required).unwrap()
+    read_measurements(
+        p,
+        &robocal_core::JointSpace::revolute(6),
+        Positions::Required,
+    )
+    .unwrap()
 }
 
 fn truth_of(csv: &Path) -> serde_json::Value {

@@ -16,10 +16,15 @@ fuzz_target!(|data: &[u8]| {
         1 => Against::Model,
         _ => Against::Desired,
     };
-    let Ok(set) = parse_measurements(rest, Path::new("fuzz.csv"), 6, Positions::Required) else {
+    let nominal = robocal_core::preset("kuka-kr480-r3330").expect("preset");
+    let Ok(set) = parse_measurements(
+        rest,
+        Path::new("fuzz.csv"),
+        nominal.joint_space(),
+        Positions::Required,
+    ) else {
         return;
     };
-    let nominal = robocal_core::preset("kuka-kr480-r3330").expect("preset");
     let truth = robocal_core::preset("kuka-kr480-r3330-table3").expect("preset");
     let frame = robocal_core::Frame::identity();
     if let Ok(ev) = evaluate(&nominal, &truth, &frame, &set, against) {

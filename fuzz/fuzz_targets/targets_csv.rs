@@ -11,7 +11,14 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let dof = 1 + (first % 8) as usize;
-    if let Ok(set) = parse_targets(rest, Path::new("fuzz.csv"), dof) {
+    // Six joints: the KUKA's (with its controller map, so axis1..axis6 are read too).
+    let kuka = robocal_core::preset("kuka-kr480-r3330").expect("preset");
+    let joints = if dof == 6 {
+        kuka.joint_space().clone()
+    } else {
+        robocal_core::JointSpace::revolute(dof)
+    };
+    if let Ok(set) = parse_targets(rest, Path::new("fuzz.csv"), &joints) {
         assert!(!set.rows.is_empty());
         for t in &set.rows {
             assert!(t.p.iter().all(|v| v.is_finite()));
@@ -22,7 +29,7 @@ fuzz_target!(|data: &[u8]| {
         }
         // With a 6-joint file, solve a few targets on the KUKA (the rest of `compensate`).
         if dof == 6 {
-            let nominal = robocal_core::preset("kuka-kr480-r3330").expect("preset");
+            let nominal = kuka;
             let solver = DampedLeastSquares {
                 max_iterations: 20,
                 ..DampedLeastSquares::default()

@@ -165,7 +165,7 @@ fn read(
     nominal_limits: bool,
     outside: &mut Vec<OutsideLimits>,
 ) -> anyhow::Result<robocal_core::identification::SplitData> {
-    let set = read_measurements(path, robot.dof(), Positions::Required)?;
+    let set = read_measurements(path, robot.joint_space(), Positions::Required)?;
     for w in &set.warnings {
         eprintln!("warning: {w}");
     }

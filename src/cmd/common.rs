@@ -43,7 +43,8 @@ pub fn model(robot_arg: &str, params: Option<&Path>) -> anyhow::Result<Model> {
     })
 }
 
-/// Parses `--joints q1,...,qn` (degrees) into radians, checking count and finiteness.
+/// Parses `--joints q1,...,qn` (model joint values: degrees, or mm for a prismatic joint) into
+/// internal units (radians or mm), checking count and finiteness.
 pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
     let mut q = Vec::new();
     for (i, part) in s.split(',').enumerate() {
@@ -60,13 +61,18 @@ pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
                 i + 1
             )));
         }
-        if let Err(msg) = robocal_core::ranges::JOINT.check(v) {
+        // An angle (deg) or, for a prismatic joint, a length (mm), within its plausible range.
+        let range = match robot.joint_types().get(i) {
+            Some(robocal_core::JointType::Prismatic) => &robocal_core::ranges::LENGTH,
+            _ => &robocal_core::ranges::JOINT,
+        };
+        if let Err(msg) = range.check(v) {
             return Err(crate::exit::usage(format!(
                 "--joints: value {}: {msg}",
                 i + 1
             )));
         }
-        q.push(v.to_radians());
+        q.push(v);
     }
     if q.len() != robot.dof() {
         return Err(crate::exit::usage(format!(
@@ -76,7 +82,7 @@ pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
             q.len()
         )));
     }
-    Ok(q)
+    Ok(robot.joints_from_display(&q))
 }
 
 /// Warns (stderr) when a result file is not a calibration: a partial result (`calibrate

@@ -10,7 +10,7 @@ use clap::Args;
 use robocal_core::compensation::commanded::{check_extra_columns, CommandedWriter};
 use robocal_core::compensation::{read_targets, Compensation, IkStatus};
 use robocal_core::io::{MeasurementReader, Positions};
-use robocal_core::{Compensator, DampedLeastSquares};
+use robocal_core::{Compensator, DampedLeastSquares, Robot, Unit};
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
@@ -21,17 +21,20 @@ pub struct CompensateArgs {
     /// The calibration result (`robocal calibrate --out`).
     #[arg(long)]
     params: PathBuf,
-    /// Desired joint values: CSV with q1..qn (degrees). Each row's target is its nominal tool
-    /// position (eq. 13); the solve starts from the row's joints. Other columns are carried;
-    /// x,y,z (old measurements), if present, are not.
+    /// Desired joint values: CSV with q1..qn (model joint values: degrees, mm for a prismatic
+    /// joint) or axis1..axisN (controller values, through the robot's [controller]). Each row's
+    /// target is its nominal tool position (eq. 13); the solve starts from the row's joints.
+    /// Other columns are carried; x,y,z (old measurements), if present, are not.
     #[arg(long, value_name = "DESIRED.csv", required_unless_present = "targets")]
     joints: Option<PathBuf>,
     /// Cartesian targets instead: CSV with x,y,z (mm, robot base frame) and optionally q1..qn
-    /// (degrees) to start from; without them, several start configurations are tried.
+    /// (or axis1..axisN) to start from; without them, several start configurations are tried.
     #[arg(long, value_name = "XYZ.csv", conflicts_with = "joints")]
     targets: Option<PathBuf>,
-    /// Output: commanded joints (degrees) with status, residual and the desired values. `-`:
-    /// standard output (written when complete; the summary then goes to standard error).
+    /// Output: commanded joints q1..qn (degrees, mm for a prismatic joint) and, when the robot
+    /// has a controller map, the controller's axis1..axisN, with status, residual and the
+    /// desired values. `-`: standard output (written when complete; the summary then goes to
+    /// standard error).
     #[arg(long, value_name = "COMMANDED.csv")]
     out: PathBuf,
     /// A solve has converged when the tool is this close to its target (mm).
@@ -113,6 +116,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         );
     }
     let dof = nominal.dof();
+    let joints = nominal.joint_space();
     let comp = Compensator::new(&nominal, &cal, solver)?;
     let pb = crate::progress::spinner("compensating");
     let mut tally = Tally::default();
@@ -122,16 +126,20 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
     let (input, writer) = if let Some(path) = &a.joints {
         let context = || format!("--joints {}", path.display());
         let mut reader =
-            MeasurementReader::open(path, dof, Positions::Optional).with_context(context)?;
-        check_extra_columns(path, dof, reader.extra_columns())?;
+            MeasurementReader::open(path, joints, Positions::Optional).with_context(context)?;
+        check_extra_columns(path, joints, reader.extra_columns())?;
         if reader.has_positions() {
             eprintln!(
                 "note: {}: the x,y,z columns (measured positions) are not used or carried",
                 path.display()
             );
         }
-        let mut w =
-            CommandedWriter::to_output(outputs.open(&a.out)?, dof, true, reader.extra_columns())?;
+        let mut w = CommandedWriter::to_output(
+            outputs.open(&a.out)?,
+            joints,
+            true,
+            reader.extra_columns(),
+        )?;
         let mut outside = Listing::default();
         while let Some(r) = reader.next_row().with_context(context)? {
             nominal.check_joints(&r.q, &format!("{}:{}", path.display(), r.line))?;
@@ -146,7 +154,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 commanded: q.clone(),
                 report,
             };
-            tally.add(r.line, &c, Some(&r.q));
+            tally.add(&nominal, r.line, &c, Some(&r.q));
             w.write(&c, Some(&r.q), &r.extra)?;
             tally.tick(&pb);
         }
@@ -169,10 +177,10 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
             .as_ref()
             .expect("clap requires --joints or --targets");
         let set =
-            read_targets(path, dof).with_context(|| format!("--targets {}", path.display()))?;
-        check_extra_columns(path, dof, &set.extra_columns)?;
+            read_targets(path, joints).with_context(|| format!("--targets {}", path.display()))?;
+        check_extra_columns(path, joints, &set.extra_columns)?;
         let mut w =
-            CommandedWriter::to_output(outputs.open(&a.out)?, dof, false, &set.extra_columns)?;
+            CommandedWriter::to_output(outputs.open(&a.out)?, joints, false, &set.extra_columns)?;
         for t in &set.rows {
             if let Some(s) = &t.seed {
                 cal.check_joints(s, &format!("{}:{}", path.display(), t.line))?;
@@ -183,7 +191,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 commanded: q.clone(),
                 report,
             };
-            tally.add(t.line, &c, None);
+            tally.add(&nominal, t.line, &c, None);
             w.write(&c, None, &t.extra)?;
             tally.tick(&pb);
         }
@@ -261,12 +269,13 @@ struct Tally {
     max_residual: f64,
     iterations: usize,
     max_iterations: usize,
-    /// The largest joint change among converged rows: (degrees, line, joint).
-    max_change: Option<(f64, usize, usize)>,
+    /// The largest joint change among converged rows, of revolute joints (degrees) and of
+    /// prismatic ones (mm): (change, line, joint).
+    max_change: [Option<(f64, usize, usize)>; 2],
 }
 
 impl Tally {
-    fn add(&mut self, line: usize, c: &Compensation, desired: Option<&[f64]>) {
+    fn add(&mut self, robot: &Robot, line: usize, c: &Compensation, desired: Option<&[f64]>) {
         let r = &c.report;
         self.rows += 1;
         if let Some(k) = IkStatus::ALL.iter().position(|s| *s == r.status) {
@@ -282,9 +291,11 @@ impl Tally {
         self.max_residual_converged = self.max_residual_converged.max(r.residual_mm);
         if let Some(d) = desired {
             for (i, (qc, qd)) in c.commanded.iter().zip(d).enumerate() {
-                let ch = (qc - qd).abs().to_degrees();
-                if !matches!(self.max_change, Some(b) if b.0 >= ch) {
-                    self.max_change = Some((ch, line, i));
+                let unit = robot.joint_unit(i);
+                let ch = unit.from_internal((qc - qd).abs());
+                let slot = &mut self.max_change[usize::from(unit == Unit::Mm)];
+                if !matches!(slot, Some(b) if b.0 >= ch) {
+                    *slot = Some((ch, line, i));
                 }
             }
         }
@@ -341,8 +352,13 @@ fn print_summary(a: &CompensateArgs, input: &std::path::Path, t: &Tally) {
         "  iterations     mean {it_mean:.1}, max {}",
         t.max_iterations
     );
-    if let Some((ch, line, i)) = t.max_change {
-        println!("  joint change   max {ch:.4} deg (line {line}, q{})", i + 1);
+    for (m, unit) in t.max_change.iter().zip(["deg", "mm"]) {
+        if let Some((ch, line, i)) = m {
+            println!(
+                "  joint change   max {ch:.4} {unit} (line {line}, q{})",
+                i + 1
+            );
+        }
     }
     println!("wrote {} ({} rows)", super::io_plan::shown(&a.out), t.rows);
 }

@@ -91,7 +91,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     };
     // Row by row: only the error norms are kept (16 bytes per row), so files of any length fit.
     let context = || format!("--data {}", a.data.display());
-    let mut reader = MeasurementReader::open(&a.data, nominal.dof(), Positions::Required)
+    let mut reader = MeasurementReader::open(&a.data, nominal.joint_space(), Positions::Required)
         .with_context(context)?;
     let header = reader.header();
     let frame = res.tracker_frame();

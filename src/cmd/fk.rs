@@ -9,7 +9,7 @@ pub struct FkArgs {
     /// A preset name or a TOML robot file.
     #[arg(long)]
     robot: String,
-    /// Joint values q1,...,qn in degrees (model joint values).
+    /// Joint values q1,...,qn: model joint values in degrees (mm for a prismatic joint).
     #[arg(long, allow_hyphen_values = true)]
     joints: String,
     /// Use the calibrated model of a result file (`robocal calibrate --out`).

@@ -7,6 +7,7 @@ use crate::exit;
 use anyhow::Context;
 use clap::Args;
 use robocal_core::io::{read_measurements, CalibrationResult, MeasurementSet, Positions};
+use robocal_core::JointSpace;
 use robocal_report::{write_report, ReportData, RunData, HISTOGRAM_FILE, HTML_FILE};
 use std::path::PathBuf;
 
@@ -66,11 +67,15 @@ fn file_arg(
     }
 }
 
-fn read(path: &Option<PathBuf>, dof: usize, flag: &str) -> anyhow::Result<Option<MeasurementSet>> {
+fn read(
+    path: &Option<PathBuf>,
+    joints: &JointSpace,
+    flag: &str,
+) -> anyhow::Result<Option<MeasurementSet>> {
     let Some(p) = path else {
         return Ok(None);
     };
-    let set = read_measurements(p, dof, Positions::Required)
+    let set = read_measurements(p, joints, Positions::Required)
         .with_context(|| format!("{flag} {}", p.display()))?;
     for w in &set.warnings {
         eprintln!("warning: {w}");
@@ -109,12 +114,12 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         }
     })?;
     super::common::warn_not_calibrated(&result, &a.result);
-    let dof = nominal.dof();
+    let joints = nominal.joint_space();
     let data_path = file_arg(&a.data, &result, "data", "--data");
     let val_path = file_arg(&a.validate, &result, "validate", "--validate");
-    let data = read(&data_path, dof, "--data")?;
-    let validation = read(&val_path, dof, "--validate")?;
-    let verification = read(&a.verify, dof, "--verify")?;
+    let data = read(&data_path, joints, "--data")?;
+    let validation = read(&val_path, joints, "--validate")?;
+    let verification = read(&a.verify, joints, "--verify")?;
     let mut report = ReportData::from_run(&RunData {
         result: &result,
         nominal: &nominal,

@@ -64,10 +64,24 @@ pub fn run(c: RobotCmd) -> anyhow::Result<()> {
                     .collect::<Vec<_>>()
                     .join(", ")
             );
-            println!("Joint limits (deg, model joint values):");
+            println!("Joint limits (model joint values):");
             for (i, l) in r.limits().iter().enumerate() {
-                let r6 = |v: f64| (v.to_degrees() * 1e6).round() / 1e6;
-                println!("  q{}: {} .. {}", i + 1, r6(l.min), r6(l.max));
+                let u = r.joint_unit(i);
+                let r6 = |v: f64| (u.from_internal(v) * 1e6).round() / 1e6;
+                println!(
+                    "  q{}: {} .. {} {} ({})",
+                    i + 1,
+                    r6(l.min),
+                    r6(l.max),
+                    u.as_str(),
+                    r.joint_type(i).as_str()
+                );
+            }
+            if let Some(c) = r.controller() {
+                println!("Controller axes (axis1..axis{}):", r.dof());
+                for line in crate::tables::controller_map(c, r) {
+                    println!("  {line}");
+                }
             }
             Ok(())
         }

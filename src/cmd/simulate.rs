@@ -282,7 +282,11 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     cfg.validate(&nominal)?;
 
     let joints = match &a.joints {
-        Some(p) => Some(read_measurements(p, nominal.dof(), Positions::Optional)?),
+        Some(p) => Some(read_measurements(
+            p,
+            nominal.joint_space(),
+            Positions::Optional,
+        )?),
         None => None,
     };
     let rows = match &joints {

@@ -46,6 +46,7 @@ pub fn result_for(nominal: &Robot, calibrated: &Robot, frame: &Frame) -> Calibra
             name: nominal.name().into(),
             dof: nominal.dof(),
             convention: nominal.convention().as_str().into(),
+            joint_types: nominal.joint_types().to_vec(),
         },
         parameters: CalibrationResult::parameter_entries(nominal, calibrated),
         tracker_frame: FrameVec::from_frame(frame),
@@ -114,8 +115,13 @@ pub fn measure_set(set: &MeasurementSet, tracker: &Tracker, seed: u64) -> Measur
 
 /// Reads a joint file, measures it (see [`measure_set`]) and writes the measurement file.
 pub fn simulate(joints: &Path, out: &Path, tracker: &Tracker, seed: u64) {
-    let set = robocal_core::io::read_measurements(joints, 6, robocal_core::io::Positions::Optional)
-        .unwrap();
+    let kuka = robocal_core::preset(NOMINAL).unwrap();
+    let set = robocal_core::io::read_measurements(
+        joints,
+        kuka.joint_space(),
+        robocal_core::io::Positions::Optional,
+    )
+    .unwrap();
     write_measurements(out, &measure_set(&set, tracker, seed)).unwrap();
 }
 

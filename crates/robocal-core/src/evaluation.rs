@@ -91,12 +91,12 @@ pub fn evaluate(
     data: &MeasurementSet,
     against: Against,
 ) -> Result<Evaluation> {
-    if nominal.dof() != data.dof || calibrated.dof() != data.dof {
+    if nominal.dof() != data.dof() || calibrated.dof() != data.dof() {
         return Err(Error::invalid(
             data.path.display().to_string(),
             format!(
                 "read for {} joints, the robot has {}",
-                data.dof,
+                data.dof(),
                 nominal.dof()
             ),
         ));
@@ -124,7 +124,7 @@ pub fn evaluate(
 
 /// Whether a data set carries desired positions or desired joints.
 pub fn has_desired_columns(data: &MeasurementSet) -> bool {
-    DesiredSource::find(data, data.dof).is_ok()
+    DesiredSource::find(data, data.dof()).is_ok()
 }
 
 /// Where the desired positions come from: columns of the extra columns.
@@ -163,7 +163,8 @@ impl DesiredSource {
             Some(&missing),
             format!(
                 "missing column: comparing with desired positions needs {} (mm, base frame) or \
-                 q1_desired..q{dof}_desired (degrees), as `robocal compensate` writes them",
+                 q1_desired..q{dof}_desired (degrees, mm for a prismatic joint), as `robocal \
+                 compensate` writes them",
                 DESIRED_POSITION_COLUMNS.join(",")
             ),
         ))
@@ -189,9 +190,17 @@ impl DesiredSource {
         match self {
             DesiredSource::Position(c) => Ok(Vector3::new(pos(c[0])?, pos(c[1])?, pos(c[2])?)),
             DesiredSource::Joints(c) => {
+                let s = nominal.joint_space();
                 let q = c
                     .iter()
-                    .map(|&k| num(k, &crate::ranges::JOINT).map(f64::to_radians))
+                    .enumerate()
+                    .map(|(i, &k)| {
+                        let range = match nominal.joint_type(i) {
+                            crate::model::JointType::Prismatic => &crate::ranges::LENGTH,
+                            crate::model::JointType::Revolute => &crate::ranges::JOINT,
+                        };
+                        num(k, range).map(|v| s.to_internal(i, v))
+                    })
                     .collect::<Result<Vec<_>>>()?;
                 Ok(nominal.tool_position(&q))
             }
@@ -200,7 +209,7 @@ impl DesiredSource {
 }
 
 impl Evaluation {
-    /// Writes the per-point errors atomically: `line`, `q1..qn` (degrees), the input's extra
+    /// Writes the per-point errors atomically: `line`, `q1..qn` (degrees or mm), the input's extra
     /// columns, then for each series `dx_<name>,dy_<name>,dz_<name>,norm_<name>` (mm, base frame).
     pub fn write_per_point(&self, path: &Path, data: &MeasurementSet) -> Result<()> {
         let mut w = PerPointWriter::create(path, data, [self.series[0].name, self.series[1].name])?;

@@ -30,5 +30,7 @@ pub use frame::{frame_vector, pose, Frame};
 pub use kinematics::poe::{Poe, Twist};
 pub use model::presets::{preset, PRESETS};
 pub use model::robot_file::{load_robot, load_robot_file, parse_robot_toml};
-pub use model::{Convention, JointLimit, Link, Param, Robot, Unit, MAX_JOINTS};
+pub use model::{
+    Controller, Convention, JointLimit, JointSpace, JointType, Link, Param, Robot, Unit, MAX_JOINTS,
+};
 pub use stats::ErrorStats;

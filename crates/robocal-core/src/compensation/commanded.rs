@@ -1,24 +1,29 @@
 //! The commanded-joints CSV written by `robocal compensate`.
 //!
 //! Columns, in order:
-//! - `q1..qn`: the commanded joint values theta_com (degrees, model joint values; eq. 14): what
-//!   to send to the controller (after the controller's own axis mapping);
+//! - `q1..qn`: the commanded joint values theta_com (model joint values: degrees, or mm for a
+//!   prismatic joint; eq. 14);
+//! - `axis1..axisN`, when the robot has a controller map (`[controller]`; the KUKA presets have
+//!   one): the same commanded joints as the controller's axis values, what to send to the
+//!   controller. Without a map axis values are the joint values, and the columns are left out;
 //! - `status` ([`IkStatus::as_str`]), `residual_mm`, `iterations`, `at_limit` (joints that end at a
 //!   limit, e.g. `q2 q5`, empty when none);
 //! - `x_desired,y_desired,z_desired`: the desired tool position P_des (mm, base frame; eq. 13, or
 //!   the given target);
-//! - `q1_desired..qn_desired`: the desired joint values theta_des (degrees; eq. 12), when the input
-//!   was a joint file;
+//! - `q1_desired..qn_desired`: the desired joint values theta_des (degrees or mm; eq. 12), when the
+//!   input was a joint file;
 //! - the input's other columns, unchanged.
 //!
 //! As a joint file it reads with [`crate::io::read_measurements`] (`q1..qn` are the commanded
-//! joints, the rest are extra columns), so a simulator or a measurement of the commanded poses
+//! joints, checked against `axis1..axisN`; the rest are extra columns), so a simulator or a measurement of the commanded poses
 //! carries the desired columns through, and `evaluate` compares the measured points with
 //! `x_desired,y_desired,z_desired` (the paper's verification, Table V).
 
 use super::{Compensation, IkStatus};
 use crate::error::{Error, Result};
 use crate::io::atomic::AtomicFile;
+use crate::io::columns::{axis_column, joint_column};
+use crate::model::JointSpace;
 use std::io::Write;
 use std::path::Path;
 
@@ -38,10 +43,14 @@ pub fn desired_joint_column(i: usize) -> String {
     format!("q{}_desired", i + 1)
 }
 
-/// The header of a commanded file for `dof` joints, with or without desired joints, before the
-/// input's extra columns.
-pub fn commanded_header(dof: usize, with_desired_joints: bool) -> Vec<String> {
-    let mut h: Vec<String> = (1..=dof).map(|i| format!("q{i}")).collect();
+/// The header of a commanded file for a robot with the joints `joints`, with or without desired
+/// joints, before the input's extra columns.
+pub fn commanded_header(joints: &JointSpace, with_desired_joints: bool) -> Vec<String> {
+    let dof = joints.dof();
+    let mut h: Vec<String> = (0..dof).map(joint_column).collect();
+    if joints.controller().is_some() {
+        h.extend((0..dof).map(axis_column));
+    }
     h.extend(
         [
             STATUS_COLUMN,
@@ -60,8 +69,12 @@ pub fn commanded_header(dof: usize, with_desired_joints: bool) -> Vec<String> {
 
 /// Checks that no extra column of the input (`input` names the file in the message) has the name
 /// of a column the commanded file adds (desired joints included, whichever the mode).
-pub fn check_extra_columns(input: &Path, dof: usize, extra_columns: &[String]) -> Result<()> {
-    let own = commanded_header(dof, true);
+pub fn check_extra_columns(
+    input: &Path,
+    joints: &JointSpace,
+    extra_columns: &[String],
+) -> Result<()> {
+    let own = commanded_header(joints, true);
     for c in extra_columns {
         if own.contains(c) {
             return Err(Error::parse(
@@ -77,11 +90,11 @@ pub fn check_extra_columns(input: &Path, dof: usize, extra_columns: &[String]) -
 }
 
 /// Writes a commanded file atomically (nothing is written if anything fails). `desired_joints`
-/// (rad) are the eq. 12 vectors in joint mode; `extra_rows[k]` are row k's values of
+/// (internal units) are the eq. 12 vectors in joint mode; `extra_rows[k]` are row k's values of
 /// `extra_columns`.
 pub fn write_commanded(
     path: &Path,
-    dof: usize,
+    joints: &JointSpace,
     rows: &[Compensation],
     desired_joints: Option<&[Vec<f64>]>,
     extra_columns: &[String],
@@ -93,7 +106,7 @@ pub fn write_commanded(
             "row counts of results, desired joints and extra columns differ",
         ));
     }
-    let mut w = CommandedWriter::create(path, dof, desired_joints.is_some(), extra_columns)?;
+    let mut w = CommandedWriter::create(path, joints, desired_joints.is_some(), extra_columns)?;
     for (k, c) in rows.iter().enumerate() {
         w.write(c, desired_joints.map(|d| d[k].as_slice()), extra_rows[k])?;
     }
@@ -104,7 +117,7 @@ pub fn write_commanded(
 /// ([`crate::io::write_all_atomic`]) or read it back as a joint file
 /// ([`crate::io::parse_measurements`]).
 pub fn commanded_csv(
-    dof: usize,
+    joints: &JointSpace,
     rows: &[Compensation],
     desired_joints: Option<&[Vec<f64>]>,
     extra_columns: &[String],
@@ -118,7 +131,7 @@ pub fn commanded_csv(
     }
     let mut w = CommandedWriter::in_memory(
         Path::new("commanded file"),
-        dof,
+        joints,
         desired_joints.is_some(),
         extra_columns,
     )?;
@@ -135,24 +148,24 @@ pub fn commanded_csv(
 pub struct CommandedWriter<W: Write = AtomicFile> {
     path: std::path::PathBuf,
     w: csv::Writer<W>,
-    dof: usize,
+    joints: JointSpace,
     with_desired_joints: bool,
     extra: usize,
     fields: Vec<String>,
 }
 
 impl CommandedWriter<AtomicFile> {
-    /// Starts the file: the header for `dof` joints, with or without the desired joints, and the
-    /// input's `extra_columns`.
+    /// Starts the file: the header for a robot with the joints `joints`, with or without the
+    /// desired joints, and the input's `extra_columns`.
     pub fn create(
         path: &Path,
-        dof: usize,
+        joints: &JointSpace,
         with_desired_joints: bool,
         extra_columns: &[String],
     ) -> Result<Self> {
         Self::to_output(
             AtomicFile::create(path)?,
-            dof,
+            joints,
             with_desired_joints,
             extra_columns,
         )
@@ -162,12 +175,12 @@ impl CommandedWriter<AtomicFile> {
     /// standard output, see [`AtomicFile::stream`]).
     pub fn to_output(
         out: AtomicFile,
-        dof: usize,
+        joints: &JointSpace,
         with_desired_joints: bool,
         extra_columns: &[String],
     ) -> Result<Self> {
         let path = out.target().to_owned();
-        Self::start(out, &path, dof, with_desired_joints, extra_columns)
+        Self::start(out, &path, joints, with_desired_joints, extra_columns)
     }
 
     /// Completes the file: renames it into place.
@@ -190,11 +203,11 @@ impl CommandedWriter<Vec<u8>> {
     /// Starts the text in memory (`path` only names it in messages).
     pub fn in_memory(
         path: &Path,
-        dof: usize,
+        joints: &JointSpace,
         with_desired_joints: bool,
         extra_columns: &[String],
     ) -> Result<Self> {
-        Self::start(Vec::new(), path, dof, with_desired_joints, extra_columns)
+        Self::start(Vec::new(), path, joints, with_desired_joints, extra_columns)
     }
 
     /// The complete text.
@@ -211,36 +224,37 @@ impl<W: Write> CommandedWriter<W> {
     fn start(
         sink: W,
         path: &Path,
-        dof: usize,
+        joints: &JointSpace,
         with_desired_joints: bool,
         extra_columns: &[String],
     ) -> Result<Self> {
-        let mut header = commanded_header(dof, with_desired_joints);
+        let mut header = commanded_header(joints, with_desired_joints);
         header.extend(extra_columns.iter().cloned());
         let mut w = csv::Writer::from_writer(sink);
         w.write_record(&header).map_err(|e| csv_io(path, e))?;
         Ok(CommandedWriter {
             path: path.to_owned(),
             w,
-            dof,
+            joints: joints.clone(),
             with_desired_joints,
             extra: extra_columns.len(),
             fields: Vec::with_capacity(header.len()),
         })
     }
 
-    /// Writes one row: the compensation, the desired joints (rad; exactly when the file was
-    /// created with them) and the input's extra values.
+    /// Writes one row: the compensation, the desired joints (internal units; exactly when the
+    /// file was created with them) and the input's extra values.
     pub fn write(
         &mut self,
         c: &Compensation,
         desired_joints: Option<&[f64]>,
         extra: &[String],
     ) -> Result<()> {
-        let lengths_ok = c.commanded.len() == self.dof
+        let dof = self.joints.dof();
+        let lengths_ok = c.commanded.len() == dof
             && extra.len() == self.extra
             && match desired_joints {
-                Some(d) => self.with_desired_joints && d.len() == self.dof,
+                Some(d) => self.with_desired_joints && d.len() == dof,
                 None => !self.with_desired_joints,
             };
         if !lengths_ok {
@@ -250,12 +264,23 @@ impl<W: Write> CommandedWriter<W> {
             ));
         }
         let f = &mut self.fields;
+        let joints = &self.joints;
+        let display = |q: &[f64]| -> Vec<String> {
+            q.iter()
+                .enumerate()
+                .map(|(i, v)| format!("{:.10}", joints.to_display(i, *v)))
+                .collect()
+        };
         f.clear();
-        f.extend(
-            c.commanded
-                .iter()
-                .map(|v| format!("{:.10}", v.to_degrees())),
-        );
+        f.extend(display(&c.commanded));
+        if joints.controller().is_some() {
+            f.extend(
+                joints
+                    .axes_from_joints(&c.commanded)
+                    .iter()
+                    .map(|v| format!("{v:.10}")),
+            );
+        }
         f.push(c.report.status.as_str().to_owned());
         f.push(format!("{:.3e}", c.report.residual_mm));
         f.push(c.report.iterations.to_string());
@@ -268,7 +293,7 @@ impl<W: Write> CommandedWriter<W> {
         );
         f.extend(c.desired_position.iter().map(|v| format!("{v:.9}")));
         if let Some(d) = desired_joints {
-            f.extend(d.iter().map(|v| format!("{:.10}", v.to_degrees())));
+            f.extend(display(d));
         }
         f.extend(extra.iter().cloned());
         self.w.write_record(&*f).map_err(|e| csv_io(&self.path, e))

@@ -5,8 +5,12 @@
 //! Jacobian, e the position error), so the iteration stays close to its start: in compensation the
 //! start is the desired joint vector (eq. 12), and the commanded joints (eq. 14) differ from it by
 //! about the smallest joint motion that moves the tool by the model difference, which also keeps the
-//! tool orientation close to the desired one. The norm is the plain Euclidean norm of the joint
-//! changes in radians.
+//! tool orientation close to the desired one. The norm is the Euclidean norm of the joint changes
+//! in radians, with a prismatic joint's change (mm) divided by
+//! [`DampedLeastSquares::prismatic_scale_mm`]: one radian of a revolute joint weighs as much as
+//! that many millimetres of a prismatic one (by default 1000 mm, the size of an industrial arm,
+//! so that a radian and a metre move the tool by comparable amounts). The same scaling applies
+//! to the trust region ([`DampedLeastSquares::max_step_rad`]) and the damping.
 //!
 //! Joint limits: an active set. A joint at a limit whose descent direction points out of the range
 //! is removed from the step (the others take over the motion, redundancy permitting); every step is
@@ -23,7 +27,7 @@
 
 use super::{IkReport, IkSolver, IkStatus};
 use crate::error::{Error, Result};
-use crate::model::{Robot, MAX_JOINTS};
+use crate::model::{JointType, Robot, MAX_JOINTS};
 use nalgebra::{Matrix3, Vector3};
 
 /// Damped least-squares / Levenberg–Marquardt position IK (see the module documentation).
@@ -36,8 +40,12 @@ pub struct DampedLeastSquares {
     /// Most Jacobian evaluations per solve. Default 500 (a few near the workspace boundary need a
     /// few hundred; most poses take 3 to 5).
     pub max_iterations: usize,
-    /// Largest change of any joint in one step (rad): a trust region. Default 0.25.
+    /// Largest change of any joint in one step (rad): a trust region. Default 0.25. For a
+    /// prismatic joint the bound is this times [`DampedLeastSquares::prismatic_scale_mm`] (mm).
     pub max_step_rad: f64,
+    /// How many mm of a prismatic joint's motion weigh as much as one radian of a revolute
+    /// joint's in the step norm, the trust region and the damping. Default 1000.
+    pub prismatic_scale_mm: f64,
     /// Initial damping, relative to the mean eigenvalue of `J J^T`. Default 1e-3.
     pub initial_damping: f64,
     /// A stop counts as a stationary point of the distance (target unreachable from there) when no
@@ -56,6 +64,7 @@ impl Default for DampedLeastSquares {
             tolerance_mm: 1e-6,
             max_iterations: 500,
             max_step_rad: 0.25,
+            prismatic_scale_mm: 1000.0,
             initial_damping: 1e-3,
             stationary_cosine: 1e-3,
         }
@@ -102,6 +111,7 @@ impl DampedLeastSquares {
         };
         pos("tolerance_mm", self.tolerance_mm)?;
         pos("max_step_rad", self.max_step_rad)?;
+        pos("prismatic_scale_mm", self.prismatic_scale_mm)?;
         pos("initial_damping", self.initial_damping)?;
         if self.max_iterations == 0 {
             return Err(Error::invalid("max_iterations", "must be at least 1"));
@@ -119,6 +129,13 @@ impl DampedLeastSquares {
     fn run(&self, robot: &Robot, target: &Vector3<f64>, q: &mut [f64], limits: bool) -> Run {
         let n = robot.dof();
         let lim = robot.limits();
+        // Joint i's change is measured in units of sc[i]: rad, or prismatic_scale_mm mm.
+        let mut sc = [1.0; MAX_JOINTS];
+        for (s, t) in sc.iter_mut().zip(robot.joint_types()) {
+            if *t == JointType::Prismatic {
+                *s = self.prismatic_scale_mm;
+            }
+        }
         let mut jq = [Vector3::zeros(); MAX_JOINTS];
         let mut jt = [Vector3::zeros(); MAX_JOINTS];
         let mut qt = [0.0; MAX_JOINTS];
@@ -147,7 +164,7 @@ impl DampedLeastSquares {
             }
             let mut a = Matrix3::zeros();
             for i in (0..n).filter(|i| free & (1 << i) != 0) {
-                a += jq[i] * jq[i].transpose();
+                a += jq[i] * jq[i].transpose() * (sc[i] * sc[i]);
             }
             let scale = a.trace() / 3.0;
             if scale <= 0.0 || !scale.is_finite() {
@@ -166,10 +183,11 @@ impl DampedLeastSquares {
                     continue;
                 };
                 let y = ch.solve(&e);
+                // The step in scaled units u = S J^T y (S = diag(sc)); the joints move by S u.
                 let mut largest = 0.0f64;
                 for i in 0..n {
                     qt[i] = if free & (1 << i) != 0 {
-                        jq[i].dot(&y)
+                        sc[i] * jq[i].dot(&y)
                     } else {
                         0.0
                     };
@@ -183,7 +201,7 @@ impl DampedLeastSquares {
                 // Predicted error after the step actually taken (after shrinking and clamping).
                 let mut predicted = e;
                 for i in 0..n {
-                    let mut v = q[i] + qt[i] * shrink;
+                    let mut v = q[i] + sc[i] * qt[i] * shrink;
                     if limits {
                         v = v.clamp(lim[i].min, lim[i].max);
                     }

@@ -20,7 +20,7 @@ pub use dls::DampedLeastSquares;
 pub use targets::{parse_targets, read_targets, Target, TargetSet};
 
 use crate::error::{Error, Result};
-use crate::model::{Robot, MAX_JOINTS};
+use crate::model::{JointType, Robot, MAX_JOINTS};
 use nalgebra::Vector3;
 
 /// How an inverse-kinematics solve ended.
@@ -101,8 +101,9 @@ impl IkReport {
 /// Implementations must keep the returned joints within the robot's limits and must not allocate
 /// per solve, so that batches run at full speed.
 pub trait IkSolver {
-    /// Finds joint values (rad) that put `robot`'s tool point at `target` (mm, base frame),
-    /// starting from `start` (rad; moved into the limits first). Writes them to `q`, which has
+    /// Finds joint values (rad, or mm for a prismatic joint) that put `robot`'s tool point at
+    /// `target` (mm, base frame), starting from `start` (same units; moved into the limits
+    /// first). Writes them to `q`, which has
     /// `robot.dof()` entries, and reports how the solve ended.
     ///
     /// Panics if `start` or `q` do not have `robot.dof()` entries (a programming error: check
@@ -278,9 +279,10 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
 }
 
 /// The `k`-th default start configuration for a Cartesian target without a seed, written to `q`
-/// (rad): `k = 0` is the middle of every joint's range; further ones are spread over the limits
-/// by a Halton sequence (deterministic, so the same file gives the same answer). Ranges wider than
-/// a full turn are sampled over one turn around their middle.
+/// (rad, mm for a prismatic joint): `k = 0` is the middle of every joint's range; further ones
+/// are spread over the limits by a Halton sequence (deterministic, so the same file gives the
+/// same answer). Revolute ranges wider than a full turn are sampled over one turn around their
+/// middle; prismatic ranges over their whole travel.
 pub fn default_seeds(robot: &Robot, count: usize) -> Vec<Vec<f64>> {
     (0..count)
         .map(|k| {
@@ -296,7 +298,10 @@ fn seed_configuration(robot: &Robot, k: usize, q: &mut [f64]) {
         [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37, 41, 43, 47, 53];
     for (i, (v, l)) in q.iter_mut().zip(robot.limits()).enumerate() {
         let mid = 0.5 * (l.min + l.max);
-        let half = (0.5 * (l.max - l.min)).min(std::f64::consts::PI);
+        let half = match robot.joint_type(i) {
+            JointType::Revolute => (0.5 * (l.max - l.min)).min(std::f64::consts::PI),
+            JointType::Prismatic => 0.5 * (l.max - l.min),
+        };
         // Halton value in (0, 1) shifted so that k = 0 gives the middle.
         let u = if k == 0 { 0.5 } else { halton(k, PRIMES[i]) };
         *v = mid + (2.0 * u - 1.0) * half;
@@ -314,17 +319,18 @@ fn halton(mut k: usize, base: usize) -> f64 {
     r
 }
 
-/// Turns joint 1 of `q` so that the tool point's azimuth about joint 1's axis matches the
-/// target's (when the result stays within joint 1's limits, trying a full turn either way).
+/// Turns the first revolute joint of `q` (joint 1, or the first after prismatic ones such as a
+/// linear track) so that the tool point's azimuth about its axis matches the target's (when the
+/// result stays within the joint's limits, trying a full turn either way).
 fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
-    // Joint 1's axis frame (as in `Robot::joint_axes`, without its allocation): MDH applies the
-    // link's constant part before the joint rotation, DH after it.
-    let f = match robot.convention() {
-        crate::model::Convention::Mdh => robot.base_frame() * robot.link_constant(0),
-        crate::model::Convention::Dh => *robot.base_frame(),
+    let Some(k) = robot
+        .joint_types()
+        .iter()
+        .position(|t| *t == JointType::Revolute)
+    else {
+        return;
     };
-    let axis: Vector3<f64> = f.rotation.matrix().column(2).into();
-    let origin = f.translation.vector;
+    let (axis, origin) = robot.joint_axis(q, k);
     let p = robot.tool_position(q);
     let flat = |v: Vector3<f64>| v - axis * axis.dot(&v);
     let (a, b) = (flat(p - origin), flat(target - origin));
@@ -332,12 +338,12 @@ fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
         return;
     }
     let angle = a.cross(&b).dot(&axis).atan2(a.dot(&b));
-    let l = robot.limits()[0];
+    let l = robot.limits()[k];
     let tau = std::f64::consts::TAU;
     for turn in [0.0, tau, -tau] {
-        let v = q[0] + angle + turn;
+        let v = q[k] + angle + turn;
         if l.contains(v) {
-            q[0] = v;
+            q[k] = v;
             return;
         }
     }

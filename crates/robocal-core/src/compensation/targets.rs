@@ -1,9 +1,11 @@
 //! Target files for `robocal compensate --targets`: a header row, columns `x,y,z` (mm, robot base
-//! frame = ACS) and, optionally, `q1..qn` (degrees), a start configuration for the solve. Other
-//! columns are carried through. Every rejection names the file, the line and the column.
+//! frame = ACS) and, optionally, `q1..qn` (degrees, mm for a prismatic joint) or the controller's
+//! `axis1..axisN`, a start configuration for the solve. Other columns are carried through. Every
+//! rejection names the file, the line and the column.
 
 use crate::error::{Error, Result};
 use crate::io::columns::{csv_reader, next_record, ColumnLayout};
+use crate::model::JointSpace;
 use crate::ranges;
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
@@ -15,7 +17,8 @@ pub struct Target {
     pub line: usize,
     /// The target point (mm, base frame).
     pub p: Vector3<f64>,
-    /// Start configuration (rad), when the file has `q1..qn`.
+    /// Start configuration (model joint values, internal units), when the file has `q1..qn` or
+    /// `axis1..axisN`.
     pub seed: Option<Vec<f64>>,
     /// Values of the extra columns, in [`TargetSet::extra_columns`] order.
     pub extra: Vec<String>,
@@ -26,20 +29,25 @@ pub struct Target {
 pub struct TargetSet {
     /// The file it was read from.
     pub path: PathBuf,
-    /// Names of the columns other than `x,y,z` and `q1..qn`.
+    /// Names of the columns other than `x,y,z` and the joint columns.
     pub extra_columns: Vec<String>,
     /// The targets, in file order.
     pub rows: Vec<Target>,
 }
 
-/// Reads a target file for a robot with `dof` joints.
-pub fn read_targets(path: &Path, dof: usize) -> Result<TargetSet> {
+/// Reads a target file for a robot with the joints `joints` (`Robot::joint_space`).
+pub fn read_targets(path: &Path, joints: &JointSpace) -> Result<TargetSet> {
     let file = crate::io::input::open_input(path)?;
-    parse_targets(std::io::BufReader::new(file), path, dof)
+    parse_targets(std::io::BufReader::new(file), path, joints)
 }
 
 /// Parses target CSV text from any reader; `path` is used in messages.
-pub fn parse_targets<R: std::io::Read>(reader: R, path: &Path, dof: usize) -> Result<TargetSet> {
+pub fn parse_targets<R: std::io::Read>(
+    reader: R,
+    path: &Path,
+    joints: &JointSpace,
+) -> Result<TargetSet> {
+    let dof = joints.dof();
     let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
         Error::parse(path, line, field, msg)
     };
@@ -53,33 +61,26 @@ pub fn parse_targets<R: std::io::Read>(reader: R, path: &Path, dof: usize) -> Re
             "missing column (targets need x,y,z in mm, robot base frame)".into(),
         ));
     };
-    let nq = layout.q.iter().filter(|c| c.is_some()).count();
-    if nq > 0 && nq < dof {
-        let j = layout.q.iter().position(Option::is_none).unwrap_or(0);
-        return Err(perr(
+    let q_cols = layout.joint_columns(path).map_err(|e| match e {
+        Error::Parse { field, .. } => perr(
             Some(1),
-            Some(&format!("q{}", j + 1)),
-            format!("missing column: a start configuration needs all of q1..q{dof}"),
-        ));
-    }
-    let q_cols: Vec<usize> = layout.q.iter().flatten().copied().collect();
+            field.as_deref(),
+            format!(
+                "missing column: a start configuration needs all of q1..q{dof} (or \
+                 axis1..axis{dof})"
+            ),
+        ),
+        other => other,
+    })?;
     let mut rows = Vec::new();
     let mut rec = csv::StringRecord::new();
     while let Some(line) = next_record(&mut rdr, &mut rec, path)? {
         let num = |k: usize, range, what| layout.number_in(&rec, k, path, line, range, what);
         let pos = |k| num(k, &ranges::LENGTH, "not a plausible target");
         let p = Vector3::new(pos(x)?, pos(y)?, pos(z)?);
-        let seed = if q_cols.len() == dof {
-            Some(
-                q_cols
-                    .iter()
-                    .map(|&c| {
-                        num(c, &ranges::JOINT, "not a plausible joint value").map(f64::to_radians)
-                    })
-                    .collect::<Result<Vec<f64>>>()?,
-            )
-        } else {
-            None
+        let seed = match &q_cols {
+            Some(c) => Some(layout.joint_values(&rec, c, joints, path, line)?.0),
+            None => None,
         };
         rows.push(Target {
             line,
@@ -103,7 +104,7 @@ mod tests {
     use super::*;
 
     fn parse(s: &str) -> Result<TargetSet> {
-        parse_targets(s.as_bytes(), Path::new("t.csv"), 2)
+        parse_targets(s.as_bytes(), Path::new("t.csv"), &JointSpace::revolute(2))
     }
 
     #[test]

@@ -366,3 +366,74 @@ fn seed_turning_uses_joint_1_axis() {
         assert!((q[0] - 1.0).abs() < 1e-9, "{}: {}", r.name(), q[0]);
     }
 }
+
+/// The KR 480 on a linear track (`examples/kr480-track.toml`) and a "calibrated" copy with
+/// seeded random errors of the paper's size (0.5 mm, 0.03 deg).
+fn track() -> (Robot, Robot) {
+    let nom = crate::load_robot_file(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/kr480-track.toml"
+    )))
+    .unwrap();
+    let cal = crate::simulation::GeometricErrors::default()
+        .apply(&nom, &mut ChaCha8Rng::seed_from_u64(3))
+        .unwrap();
+    (nom, cal)
+}
+
+/// Compensation (eq. 12-14) of 2,000 random desired poses of the tracked robot: every row
+/// converges to 1e-6 mm within the limits (the track's too), or is reported unreachable; the
+/// correction mixes mm of track and radians of arm, and stays small in both.
+#[test]
+fn compensation_converges_on_the_tracked_robot() {
+    let (nom, cal) = track();
+    assert_eq!(nom.joint_type(0), crate::JointType::Prismatic);
+    let comp = Compensator::new(&nom, &cal, DampedLeastSquares::default()).unwrap();
+    let mut q = vec![0.0; 7];
+    let (mut converged, mut unreachable) = (0, 0);
+    let (mut max_track, mut max_angle) = (0.0f64, 0.0f64);
+    for d in uniform_poses(&nom, 2000, 4) {
+        let (target, rep) = comp.compensate(&d, &mut q);
+        let r = (cal.tool_position(&q) - target).norm();
+        assert!((r - rep.residual_mm).abs() < 1e-9);
+        assert!(within_limits(&cal, &q), "{q:?}");
+        match rep.status {
+            IkStatus::Converged => {
+                converged += 1;
+                assert!(r <= 1e-6, "{d:?}: residual {r}");
+                max_track = max_track.max((q[0] - d[0]).abs());
+                for i in 1..7 {
+                    max_angle = max_angle.max((q[i] - d[i]).abs());
+                }
+            }
+            IkStatus::Unreachable => unreachable += 1,
+            _ => panic!("{d:?}: {rep:?}"),
+        }
+    }
+    eprintln!(
+        "converged {converged}, unreachable {unreachable}, largest change {max_track:.3} mm of \
+         track, {max_angle:.4} rad of arm"
+    );
+    assert!(converged >= 1990, "{converged} converged");
+    assert!(
+        max_track > 0.0 && max_track < 20.0,
+        "track moved {max_track} mm"
+    );
+    assert!(max_angle < 0.6, "arm moved {max_angle} rad");
+}
+
+/// Cartesian targets along the whole track, without start configurations: the default seeds
+/// (spread over the track's travel) and the turn of the arm's first axis find every one.
+#[test]
+fn reach_along_the_track_without_seeds() {
+    let (nom, cal) = track();
+    let comp = Compensator::new(&nom, &cal, DampedLeastSquares::default()).unwrap();
+    let mut q = vec![0.0; 7];
+    for t in uniform_poses(&cal, 300, 5) {
+        let target = cal.tool_position(&t);
+        let rep = comp.reach(&target, None, &mut q);
+        assert_eq!(rep.status, IkStatus::Converged, "{t:?}: {rep:?}");
+        assert!((cal.tool_position(&q) - target).norm() <= 1e-6);
+        assert!(within_limits(&cal, &q), "{q:?}");
+    }
+}

@@ -34,12 +34,15 @@ impl<'a> Evaluator<'a> {
         header: &'a MeasurementSet,
         against: Against,
     ) -> Result<Evaluator<'a>> {
-        if nominal.dof() != header.dof || calibrated.dof() != header.dof {
+        if nominal.dof() != header.dof()
+            || calibrated.dof() != header.dof()
+            || nominal.joint_types() != header.joints.types()
+        {
             return Err(Error::invalid(
                 header.path.display().to_string(),
                 format!(
                     "read for {} joints, the robot has {}",
-                    header.dof,
+                    header.dof(),
                     nominal.dof()
                 ),
             ));
@@ -109,9 +112,11 @@ impl<'a> Evaluator<'a> {
 }
 
 /// The per-point error file, written row by row and made visible only by
-/// [`PerPointWriter::commit`]: `line`, `q1..qn` (degrees), the input's extra columns, then for
+/// [`PerPointWriter::commit`]: `line`, `q1..qn` (degrees, or mm for a prismatic joint), the
+/// input's extra columns, then for
 /// each series `dx_<name>,dy_<name>,dz_<name>,norm_<name>` (mm, base frame).
 pub struct PerPointWriter {
+    joints: crate::model::JointSpace,
     path: std::path::PathBuf,
     w: csv::Writer<AtomicFile>,
     fields: Vec<String>,
@@ -130,7 +135,7 @@ impl PerPointWriter {
         let path = out.target().to_owned();
         let path = path.as_path();
         let mut head = vec!["line".to_owned()];
-        head.extend((1..=header.dof).map(|i| format!("q{i}")));
+        head.extend((0..header.dof()).map(crate::io::columns::joint_column));
         let own_start = head.len();
         for name in names {
             for c in ["dx", "dy", "dz", "norm"] {
@@ -151,6 +156,7 @@ impl PerPointWriter {
         let mut w = csv::Writer::from_writer(out);
         w.write_record(&head).map_err(|e| csv_io(path, e))?;
         Ok(PerPointWriter {
+            joints: header.joints.clone(),
             path: path.to_owned(),
             w,
             fields: Vec::with_capacity(head.len()),
@@ -162,7 +168,11 @@ impl PerPointWriter {
         let f = &mut self.fields;
         f.clear();
         f.push(r.line.to_string());
-        f.extend(r.q.iter().map(|v| format!("{:.9}", v.to_degrees())));
+        f.extend(
+            r.q.iter()
+                .enumerate()
+                .map(|(i, v)| format!("{:.9}", self.joints.to_display(i, *v))),
+        );
         f.extend(r.extra.iter().cloned());
         for e in errors {
             f.extend([e.x, e.y, e.z, e.norm()].iter().map(|v| format!("{v:.6}")));

@@ -24,7 +24,7 @@ fn measure(
 ) -> MeasurementSet {
     MeasurementSet {
         path: PathBuf::from(path),
-        dof: truth.dof(),
+        joints: truth.joint_space().clone(),
         extra_columns: vec!["id".into()],
         rows: qs
             .iter()
@@ -122,8 +122,16 @@ fn verification_reduces_measured_errors_5x_and_matches_the_prediction() {
     let path = dir.join("commanded.csv");
     let extra: Vec<Vec<String>> = (0..rows.len()).map(|k| vec![format!("p{k}")]).collect();
     let extra_refs: Vec<&[String]> = extra.iter().map(|v| v.as_slice()).collect();
-    write_commanded(&path, 6, &rows, Some(&desired), &["id".into()], &extra_refs).unwrap();
-    let commanded = read_measurements(&path, 6, Positions::Optional).unwrap();
+    write_commanded(
+        &path,
+        nom.joint_space(),
+        &rows,
+        Some(&desired),
+        &["id".into()],
+        &extra_refs,
+    )
+    .unwrap();
+    let commanded = read_measurements(&path, nom.joint_space(), Positions::Optional).unwrap();
     assert!(!commanded.has_positions());
 
     // Verification measurement of the commanded joints, same tracker.
@@ -163,8 +171,8 @@ fn desired_positions_from_joints_or_positions() {
     let dir = tmp("desired");
     let path = dir.join("c.csv");
     let none: Vec<&[String]> = vec![&[]; rows.len()];
-    write_commanded(&path, 6, &rows, Some(&desired), &[], &none).unwrap();
-    let mut set = read_measurements(&path, 6, Positions::Optional).unwrap();
+    write_commanded(&path, nom.joint_space(), &rows, Some(&desired), &[], &none).unwrap();
+    let mut set = read_measurements(&path, nom.joint_space(), Positions::Optional).unwrap();
     for r in &mut set.rows {
         r.p = Some(t.exact(&truth.tool_position(&r.q)));
     }
@@ -264,6 +272,7 @@ fn results_of_another_robot_are_rejected() {
             name: n.name().into(),
             dof: n.dof(),
             convention: n.convention().as_str().into(),
+            joint_types: vec![],
         },
         parameters: CalibrationResult::parameter_entries(n, c),
         tracker_frame: crate::io::result::FrameVec::from_frame(&Frame::identity()),

@@ -39,7 +39,7 @@ use crate::identification::{
 use crate::io::measurements::{measurements_csv, parse_measurements};
 use crate::io::{CalibrationResult, MeasurementSet, Positions};
 use crate::model::presets::preset;
-use crate::model::Robot;
+use crate::model::{JointSpace, Robot};
 use crate::simulation::{
     simulate, simulate_joints, GravityModel, Simulation, SimulationConfig, TruthFile, TruthSpec,
     SET_CALIBRATION, SET_VALIDATION,
@@ -254,8 +254,13 @@ impl Experiment {
     }
 }
 
-fn parse_csv(bytes: &[u8], name: &str, dof: usize, positions: Positions) -> Result<MeasurementSet> {
-    parse_measurements(bytes, Path::new(name), dof, positions)
+fn parse_csv(
+    bytes: &[u8],
+    name: &str,
+    joints: &JointSpace,
+    positions: Positions,
+) -> Result<MeasurementSet> {
+    parse_measurements(bytes, Path::new(name), joints, positions)
 }
 
 fn csv_bytes(set: &MeasurementSet, name: &str) -> Result<Vec<u8>> {
@@ -272,7 +277,7 @@ pub fn run_experiment(
     progress: &mut dyn FnMut(Phase, usize, usize),
 ) -> Result<Experiment> {
     let nominal = &config.nominal;
-    let dof = nominal.dof();
+    let joints = nominal.joint_space();
 
     // 1. The measurement session, split into the files `simulate --validation-out` writes.
     progress(Phase::Measurement, 0, 1);
@@ -302,15 +307,15 @@ pub fn run_experiment(
     let cell_csv = csv_bytes(&main, files::CELL)?;
     let val_csv = csv_bytes(&val, files::VALIDATION)?;
     let truth_json = truth_file.to_json()?;
-    let data = parse_csv(&cell_csv, files::CELL, dof, Positions::Required)?;
-    let validation = parse_csv(&val_csv, files::VALIDATION, dof, Positions::Required)?;
+    let data = parse_csv(&cell_csv, files::CELL, joints, Positions::Required)?;
+    let validation = parse_csv(&val_csv, files::VALIDATION, joints, Positions::Required)?;
     // The desired poses of the verification: the calibration rows, joints only.
     let mut desired_set = session.select(SET_CALIBRATION, true);
     for r in &mut desired_set.rows {
         r.p = None;
     }
     let desired_csv = csv_bytes(&desired_set, files::DESIRED)?;
-    let desired = parse_csv(&desired_csv, files::DESIRED, dof, Positions::Optional)?;
+    let desired = parse_csv(&desired_csv, files::DESIRED, joints, Positions::Optional)?;
     progress(Phase::Measurement, 1, 1);
 
     // 2. Calibration from the files, as `robocal calibrate --data cell.csv --validate
@@ -353,13 +358,18 @@ pub fn run_experiment(
     let compensation = comp.compensate_all(&qs, &mut |d, t| progress(Phase::Compensation, d, t))?;
     let extra_rows: Vec<&[String]> = desired.rows.iter().map(|r| r.extra.as_slice()).collect();
     let commanded_bytes = commanded_csv(
-        dof,
+        joints,
         &compensation,
         Some(&qs),
         &desired.extra_columns,
         &extra_rows,
     )?;
-    let commanded = parse_csv(&commanded_bytes, files::COMMANDED, dof, Positions::Optional)?;
+    let commanded = parse_csv(
+        &commanded_bytes,
+        files::COMMANDED,
+        joints,
+        Positions::Optional,
+    )?;
 
     // 4. Verification: the commanded joints measured in the same cell (the truth and tracker
     //    frame as `simulate --truth cell.truth.json` reads them), against the desired positions.
@@ -378,7 +388,7 @@ pub fn run_experiment(
         &mut |d, t| progress(Phase::Verification, d, t),
     )?;
     let verify_csv = csv_bytes(&verification.measurements, files::VERIFY)?;
-    let verify = parse_csv(&verify_csv, files::VERIFY, dof, Positions::Required)?;
+    let verify = parse_csv(&verify_csv, files::VERIFY, joints, Positions::Required)?;
     let verification_errors = evaluate(
         nominal,
         &calibrated,

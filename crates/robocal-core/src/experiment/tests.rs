@@ -112,8 +112,10 @@ fn files_are_the_data_used_and_reproducible() {
     let text = std::str::from_utf8(file(&e, files::RESULT)).unwrap();
     let r = CalibrationResult::parse(text, Path::new("r.json")).unwrap();
     assert_eq!(r, e.result);
-    let parse =
-        |name: &str, pos| parse_measurements(file(&e, name), Path::new(name), 6, pos).unwrap();
+    let kuka = crate::model::presets::preset("kuka-kr480-r3330").unwrap();
+    let parse = |name: &str, pos| {
+        parse_measurements(file(&e, name), Path::new(name), kuka.joint_space(), pos).unwrap()
+    };
     assert_eq!(parse(files::CELL, Positions::Required), e.data);
     assert_eq!(parse(files::VALIDATION, Positions::Required), e.validation);
     assert_eq!(parse(files::DESIRED, Positions::Optional), e.desired);

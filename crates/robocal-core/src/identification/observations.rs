@@ -181,7 +181,7 @@ pub struct SplitData {
 /// Sorts a measurement file's rows by their `set` column (see [`SplitData`]). Every row must have
 /// a measured position, and every `set` label must be known ([`MeasurementSet::set_labels`]).
 pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
-    let mk = || Observations::with_source(set.dof, &set.path);
+    let mk = || Observations::with_source(set.dof(), &set.path);
     let mut out = SplitData {
         calibration: mk(),
         validation: mk(),

@@ -290,11 +290,7 @@ impl Calibration {
             extra.insert("status".into(), json!(crate::io::result::STATUS_CALIBRATED));
         }
         CalibrationResult {
-            robot: RobotInfo {
-                name: self.nominal.name().to_owned(),
-                dof: self.nominal.dof(),
-                convention: self.nominal.convention().as_str().to_owned(),
-            },
+            robot: RobotInfo::of(&self.nominal),
             parameters,
             tracker_frame: FrameVec::from_frame(&self.registration.frame),
             errors,

@@ -629,3 +629,59 @@ fn solver_reports_why_it_stopped() {
     );
     assert!(matches!(rep.termination, Termination::Failed(_)), "{rep:?}");
 }
+
+/// The KR 480 on a 4 m linear track (`examples/kr480-track.toml`): a prismatic joint and six
+/// revolute ones.
+fn track() -> Robot {
+    crate::load_robot_file(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/kr480-track.toml"
+    )))
+    .unwrap()
+}
+
+/// Noise-free data of the tracked robot with random errors on every parameter are explained
+/// exactly (to 1e-6 mm on calibration and validation points), as for the 6R arm: the prismatic
+/// joint's column and its row's parameter columns are right. `d4` is left alone for the
+/// reason `random_truth` leaves `d3` (axes 3 and 4 are the arm's parallel pair).
+#[test]
+fn noise_free_tracked_robot_with_random_errors_is_reproduced_exactly() {
+    let nom = track();
+    let mut rng = ChaCha8Rng::seed_from_u64(13);
+    for _ in 0..2 {
+        let mut truth = nom.clone();
+        for p in truth.params() {
+            if p == Param::D(3) {
+                continue;
+            }
+            let dv = match p.unit() {
+                crate::model::Unit::Mm => rng.gen_range(-1.0..1.0),
+                crate::model::Unit::Deg => rng.gen_range(-0.05f64..0.05).to_radians(),
+            };
+            truth.set(p, truth.get(p) + dv);
+        }
+        let tr = tracker(0.0, 0.0);
+        let cal = measure(&truth, &tr, 100, &mut rng);
+        let val = measure(&truth, &tr, 73, &mut rng);
+        let c = run(&nom, &cal, Some(&val), &CalibrationSettings::default());
+        let before = c.calibration.before_stats();
+        let after = c.calibration.after_stats();
+        let vafter = c.validation.as_ref().unwrap().after_stats();
+        assert!(before.mean_mm > 1.0, "{before:?}");
+        assert!(after.rms_mm < 1e-6, "after {after:?} {:?}", c.stages);
+        assert!(vafter.rms_mm < 1e-6, "validation {vafter:?}");
+        // The track's own row is absorbed by the base frame, as joint 1 of the arm is; the
+        // track's direction against the arm is identified: two parameters more than the arm's
+        // 26.
+        let id = &c.identifiability;
+        assert_eq!(id.identified.len(), 28, "{:?}", names(&id.identified));
+        for p in [Param::Alpha(0), Param::D(0), Param::A(0), Param::Phi(0)] {
+            assert!(id.fixed_reason(p).is_some(), "{p} identified");
+        }
+        assert!(id.identified.contains(&Param::Alpha(1)));
+        assert_eq!(
+            id.fixed_reason(Param::D(0)).unwrap().describe(),
+            "same effect as base_x"
+        );
+    }
+}

@@ -1,11 +1,36 @@
 //! What every CSV reader of robocal shares: a trimmed reader, the header split into joint
-//! columns `q1..qn`, position columns `x,y,z` and extra columns (with the checks every file gets:
-//! empty file, unnamed or repeated columns, joints the robot does not have), blank rows skipped,
-//! and numeric cells that must be finite. Each file format then decides which columns it requires.
+//! columns (`q1..qn`, model joint values, or `axis1..axisN`, controller values), position
+//! columns `x,y,z` and extra columns (with the checks every file gets: empty file, unnamed or
+//! repeated columns, joints the robot does not have), blank rows skipped, numeric cells that must
+//! be finite, and joint values turned into model values (internal units) through the robot's
+//! [`JointSpace`]. Each file format then decides which columns it requires.
+//!
+//! Joint columns: a file gives `q1..qn` (degrees, or mm for a prismatic joint) or
+//! `axis1..axisN` (the controller's values, same units, converted through the robot's
+//! `[controller]` map; the identity without one). A file with both (a commanded file written by
+//! `compensate` has both) uses `q1..qn`, and every axis value must be the controller value of
+//! that row's joints (to [`AXIS_AGREEMENT`]), else the row is rejected naming the column: the two
+//! can never silently disagree.
 
 use crate::error::{Error, Result};
+use crate::model::{JointSpace, JointType};
 use std::io::Read;
 use std::path::Path;
+
+/// How closely the `axis` columns of a file that also has `q` columns must agree with the
+/// controller values of its joints (degrees or mm): the rounding of values written with 9
+/// decimals, with room for the map's arithmetic.
+pub const AXIS_AGREEMENT: f64 = 1e-6;
+
+/// The column of model joint `i` (0-based): `q{i+1}`.
+pub fn joint_column(i: usize) -> String {
+    format!("q{}", i + 1)
+}
+
+/// The column of controller axis `i` (0-based): `axis{i+1}`.
+pub fn axis_column(i: usize) -> String {
+    format!("axis{}", i + 1)
+}
 
 /// The header of a CSV file, split by role.
 pub(crate) struct ColumnLayout {
@@ -13,6 +38,8 @@ pub(crate) struct ColumnLayout {
     pub headers: Vec<String>,
     /// Column of joint `j` (`q{j+1}`), where present.
     pub q: Vec<Option<usize>>,
+    /// Column of controller axis `j` (`axis{j+1}`), where present.
+    pub axis: Vec<Option<usize>>,
     /// Columns of `x,y,z`, where present (only when positions are read).
     pub xyz: [Option<usize>; 3],
     /// Columns carried through unchanged.
@@ -30,12 +57,26 @@ pub(crate) fn csv_reader<R: Read>(reader: R) -> csv::Reader<R> {
         .from_reader(reader)
 }
 
-fn joint_column(name: &str) -> Option<usize> {
-    let num = name.strip_prefix('q')?;
+/// `q{k}` or `axis{k}`: whether it is an axis column, and k.
+fn joint_column_index(name: &str) -> Option<(bool, usize)> {
+    let (axis, num) = match name.strip_prefix("axis") {
+        Some(num) => (true, num),
+        None => (false, name.strip_prefix('q')?),
+    };
     if num.is_empty() || !num.bytes().all(|b| b.is_ascii_digit()) {
         return None;
     }
-    num.parse().ok()
+    num.parse().ok().map(|k| (axis, k))
+}
+
+/// Where a file's joint values come from (see the module documentation).
+pub(crate) enum JointColumns {
+    /// `q1..qn`.
+    Model(Vec<usize>),
+    /// `axis1..axisN`.
+    Axes(Vec<usize>),
+    /// Both: `q` is used, `axis` must agree.
+    Both(Vec<usize>, Vec<usize>),
 }
 
 impl ColumnLayout {
@@ -64,6 +105,7 @@ impl ColumnLayout {
         }
         let mut layout = ColumnLayout {
             q: vec![None; dof],
+            axis: vec![None; dof],
             xyz: [None; 3],
             extra: Vec::new(),
             extra_columns: Vec::new(),
@@ -76,16 +118,25 @@ impl ColumnLayout {
             if headers[..k].contains(h) {
                 return Err(perr(Some(h), "column appears twice".into()));
             }
-            if let Some(j) = joint_column(h) {
+            if let Some((axis, j)) = joint_column_index(h) {
                 if j == 0 || j > dof {
+                    let range = if axis {
+                        format!("axis1..axis{dof}")
+                    } else {
+                        format!("q1..q{dof}")
+                    };
                     return Err(perr(
                         Some(h),
                         format!(
-                            "the robot has {dof} joints (q1..q{dof}); this file has a column `{h}`"
+                            "the robot has {dof} joints ({range}); this file has a column `{h}`"
                         ),
                     ));
                 }
-                layout.q[j - 1] = Some(k);
+                if axis {
+                    layout.axis[j - 1] = Some(k);
+                } else {
+                    layout.q[j - 1] = Some(k);
+                }
                 continue;
             }
             match ["x", "y", "z"].iter().position(|a| a == h) {
@@ -144,6 +195,104 @@ impl ColumnLayout {
                 format!("{what}: {msg}"),
             )
         })
+    }
+
+    /// The file's joint columns: all of `q1..qn`, all of `axis1..axisN`, or both; `None` when
+    /// it has neither. A file with some but not all of one kind is rejected naming the first
+    /// missing column.
+    pub fn joint_columns(&self, path: &Path) -> Result<Option<JointColumns>> {
+        let dof = self.q.len();
+        let complete = |cols: &[Option<usize>], name: fn(usize) -> String| -> Result<Vec<usize>> {
+            match cols.iter().position(Option::is_none) {
+                None => Ok(cols.iter().flatten().copied().collect()),
+                Some(j) => Err(Error::parse(
+                    path,
+                    Some(1),
+                    Some(&name(j)),
+                    format!(
+                        "missing column (the robot has {dof} joints: {}..{}; header is `{}`)",
+                        name(0),
+                        name(dof - 1),
+                        self.headers.join(",")
+                    ),
+                )),
+            }
+        };
+        let has = |cols: &[Option<usize>]| cols.iter().any(Option::is_some);
+        Ok(match (has(&self.q), has(&self.axis)) {
+            (false, false) => None,
+            (true, false) => Some(JointColumns::Model(complete(&self.q, joint_column)?)),
+            (false, true) => Some(JointColumns::Axes(complete(&self.axis, axis_column)?)),
+            (true, true) => Some(JointColumns::Both(
+                complete(&self.q, joint_column)?,
+                complete(&self.axis, axis_column)?,
+            )),
+        })
+    }
+
+    /// The model joint values (internal units: rad, or mm for a prismatic joint) of `record`
+    /// from the joint columns `cols`, converted through `joints`; with the largest magnitude of a
+    /// revolute joint's cell (degrees as written), for the radians warning.
+    pub fn joint_values(
+        &self,
+        record: &csv::StringRecord,
+        cols: &JointColumns,
+        joints: &JointSpace,
+        path: &Path,
+        line: usize,
+    ) -> Result<(Vec<f64>, f64)> {
+        // Joint j's cell within its plausible range: an angle (deg, multi-turn axes allowed) or,
+        // for a prismatic joint, a length (mm).
+        let read = |c: &[usize]| -> Result<Vec<f64>> {
+            c.iter()
+                .zip(joints.types())
+                .map(|(&k, t)| {
+                    let range = match t {
+                        JointType::Revolute => &crate::ranges::JOINT,
+                        JointType::Prismatic => &crate::ranges::LENGTH,
+                    };
+                    self.number_in(record, k, path, line, range, "not a plausible joint value")
+                })
+                .collect()
+        };
+        let largest_angle = |v: &[f64]| {
+            v.iter()
+                .zip(joints.types())
+                .filter(|(_, t)| **t == JointType::Revolute)
+                .fold(0.0f64, |m, (x, _)| m.max(x.abs()))
+        };
+        match cols {
+            JointColumns::Model(c) => {
+                let v = read(c)?;
+                Ok((joints.joints_from_display(&v), largest_angle(&v)))
+            }
+            JointColumns::Axes(c) => {
+                let v = read(c)?;
+                Ok((joints.joints_from_axes(&v), largest_angle(&v)))
+            }
+            JointColumns::Both(qc, ac) => {
+                let v = read(qc)?;
+                let a = read(ac)?;
+                let q = joints.joints_from_display(&v);
+                let expected = joints.axes_from_joints(&q);
+                for (j, (x, e)) in a.iter().zip(&expected).enumerate() {
+                    if (x - e).abs() > AXIS_AGREEMENT {
+                        return Err(Error::parse(
+                            path,
+                            Some(line),
+                            Some(&self.headers[ac[j]]),
+                            format!(
+                                "{x} disagrees with {e:.9}, the controller value of this row's \
+                                 q1..q{n} (a file with both q and axis columns must give the \
+                                 same joints twice; remove one kind)",
+                                n = q.len()
+                            ),
+                        ));
+                    }
+                }
+                Ok((q, largest_angle(&v)))
+            }
+        }
     }
 
     /// The values of the extra columns of `record`.

@@ -4,26 +4,29 @@
 //! listing the lines.
 
 use crate::error::Error;
-use crate::model::{JointLimit, Robot};
+use crate::model::{JointLimit, JointSpace, Robot};
 use crate::ranges::LIMIT_TOLERANCE_DEG;
 use std::path::{Path, PathBuf};
 
 /// Rows described one by one in messages; the rest are counted.
 pub const LISTED: usize = 20;
 
-/// One row's first joint value outside its limit (degrees).
+/// One row's first joint value outside its limit (display units: degrees, or mm for a prismatic
+/// joint).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LimitViolation {
     /// 1-based line of the row.
     pub line: usize,
     /// 0-based joint.
     pub joint: usize,
-    /// The joint value (deg).
+    /// The joint value (deg, or mm for a prismatic joint).
     pub value_deg: f64,
-    /// The joint's limits (deg).
+    /// The joint's limits (deg, or mm for a prismatic joint).
     pub min_deg: f64,
     /// See `min_deg`.
     pub max_deg: f64,
+    /// The unit of the three values above (`deg` or `mm`).
+    pub unit: &'static str,
     /// How many joints of the row are outside their limits.
     pub joints_outside: usize,
 }
@@ -35,10 +38,11 @@ impl LimitViolation {
             n => format!("; {} more joint(s) outside", n - 1),
         };
         format!(
-            "line {} (q{} = {} deg, limits {}..{}{more})",
+            "line {} (q{} = {} {}, limits {}..{}{more})",
             self.line,
             self.joint + 1,
             crate::ranges::fmt_value(self.value_deg),
+            self.unit,
             crate::ranges::fmt_value(self.min_deg),
             crate::ranges::fmt_value(self.max_deg)
         )
@@ -51,6 +55,7 @@ pub struct OutsideLimits {
     path: PathBuf,
     robot: String,
     limits: Vec<JointLimit>,
+    joints: JointSpace,
     lines: Vec<usize>,
     listed: Vec<LimitViolation>,
 }
@@ -62,18 +67,20 @@ impl OutsideLimits {
             path: path.to_owned(),
             robot: robot.name().to_owned(),
             limits: robot.limits().to_vec(),
+            joints: robot.joint_space().clone(),
             lines: Vec::new(),
             listed: Vec::new(),
         }
     }
 
-    /// Checks the joint values `q` (rad) of the row on `line`. A value beyond a limit by less
-    /// than [`LIMIT_TOLERANCE_DEG`] (rounding in files) counts as within it.
+    /// Checks the joint values `q` (rad, or mm for a prismatic joint) of the row on `line`. A
+    /// value beyond a limit by less than [`LIMIT_TOLERANCE_DEG`] (or as many mm: rounding in
+    /// files) counts as within it.
     pub fn check(&mut self, line: usize, q: &[f64]) {
-        let tol = LIMIT_TOLERANCE_DEG.to_radians();
         let mut first = None;
         let mut n = 0;
         for (j, (v, l)) in q.iter().zip(&self.limits).enumerate() {
+            let tol = self.joints.to_internal(j, LIMIT_TOLERANCE_DEG);
             if *v < l.min - tol || *v > l.max + tol {
                 n += 1;
                 first.get_or_insert((j, *v, *l));
@@ -82,12 +89,14 @@ impl OutsideLimits {
         let Some((joint, v, l)) = first else { return };
         self.lines.push(line);
         if self.listed.len() < LISTED {
+            let shown = |x: f64| rounded(self.joints.to_display(joint, x));
             self.listed.push(LimitViolation {
                 line,
                 joint,
-                value_deg: deg(v),
-                min_deg: deg(l.min),
-                max_deg: deg(l.max),
+                value_deg: shown(v),
+                min_deg: shown(l.min),
+                max_deg: shown(l.max),
+                unit: self.joints.unit(joint).as_str(),
                 joints_outside: n,
             });
         }
@@ -147,12 +156,13 @@ impl OutsideLimits {
             Some(v.line),
             Some(&format!("q{}", v.joint + 1)),
             format!(
-                "{} deg is outside the joint limits of robot `{}` (q{}: {}..{} deg); {rows}",
+                "{} {u} is outside the joint limits of robot `{}` (q{}: {}..{} {u}); {rows}",
                 crate::ranges::fmt_value(v.value_deg),
                 self.robot,
                 v.joint + 1,
                 crate::ranges::fmt_value(v.min_deg),
                 crate::ranges::fmt_value(v.max_deg),
+                u = v.unit,
             ),
         ))
     }
@@ -172,9 +182,9 @@ impl OutsideLimits {
     }
 }
 
-/// Radians as degrees to the 9 decimals files hold (`1000080`, not `1000080.0000000001`).
-fn deg(rad: f64) -> f64 {
-    (rad.to_degrees() * 1e9).round() / 1e9
+/// A display value to the 9 decimals files hold (`1000080`, not `1000080.0000000001`).
+fn rounded(v: f64) -> f64 {
+    (v * 1e9).round() / 1e9
 }
 
 #[cfg(test)]

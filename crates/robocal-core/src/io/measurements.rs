@@ -1,5 +1,7 @@
-//! Measurement CSV files (DESIGN.md): a header row, columns `q1..qn` (joint values, degrees) and
-//! `x,y,z` (mm, tracker frame); other columns (`id`, `set`, ...) are carried through.
+//! Measurement CSV files (DESIGN.md): a header row, columns `q1..qn` (model joint values:
+//! degrees, or mm for a prismatic joint) or `axis1..axisN` (the controller's values, converted
+//! through the robot's `[controller]`; see [`crate::io::columns`]) and `x,y,z` (mm, tracker
+//! frame); other columns (`id`, `set`, ...) are carried through.
 //!
 //! The same reader serves joint-only files (desired or commanded joints) with
 //! [`Positions::Forbidden`] or [`Positions::Optional`]. CRLF line endings and a UTF-8 byte-order
@@ -7,7 +9,8 @@
 //! positions must be within their plausible ranges ([`crate::ranges`]).
 
 use crate::error::{Error, Result};
-use crate::io::columns::{csv_reader, next_record, ColumnLayout};
+use crate::io::columns::{csv_reader, joint_column, next_record, ColumnLayout, JointColumns};
+use crate::model::JointSpace;
 use crate::ranges;
 use nalgebra::Vector3;
 use std::io::Read;
@@ -29,7 +32,7 @@ pub enum Positions {
 pub struct Measurement {
     /// 1-based line of the row in the file.
     pub line: usize,
-    /// Joint values (model values, radians).
+    /// Joint values (model values, internal units: radians, or mm for a prismatic joint).
     pub q: Vec<f64>,
     /// Measured tool point (mm, tracker frame), when the file has positions.
     pub p: Option<Vector3<f64>>,
@@ -42,9 +45,10 @@ pub struct Measurement {
 pub struct MeasurementSet {
     /// The file it was read from (for messages).
     pub path: PathBuf,
-    /// Number of joints.
-    pub dof: usize,
-    /// Names of the columns other than `q1..qn` and `x,y,z`, in file order.
+    /// The robot's joints (types and controller map): how the joint values were read and are
+    /// written.
+    pub joints: JointSpace,
+    /// Names of the columns other than the joint columns and `x,y,z`, in file order.
     pub extra_columns: Vec<String>,
     /// The rows, in file order.
     pub rows: Vec<Measurement>,
@@ -53,6 +57,11 @@ pub struct MeasurementSet {
 }
 
 impl MeasurementSet {
+    /// Number of joints.
+    pub fn dof(&self) -> usize {
+        self.joints.dof()
+    }
+
     /// Whether every row has a position.
     pub fn has_positions(&self) -> bool {
         !self.rows.is_empty() && self.rows.iter().all(|r| r.p.is_some())
@@ -83,19 +92,23 @@ impl MeasurementSet {
     }
 }
 
-/// Reads a measurement CSV for a robot with `dof` joints.
-pub fn read_measurements(path: &Path, dof: usize, positions: Positions) -> Result<MeasurementSet> {
-    MeasurementReader::open(path, dof, positions)?.read_all()
+/// Reads a measurement CSV for a robot with the joints `joints` (`Robot::joint_space`).
+pub fn read_measurements(
+    path: &Path,
+    joints: &JointSpace,
+    positions: Positions,
+) -> Result<MeasurementSet> {
+    MeasurementReader::open(path, joints, positions)?.read_all()
 }
 
 /// Parses measurement CSV text from any reader; `path` is used in messages.
 pub fn parse_measurements<R: Read>(
     reader: R,
     path: &Path,
-    dof: usize,
+    joints: &JointSpace,
     positions: Positions,
 ) -> Result<MeasurementSet> {
-    MeasurementReader::new(reader, path, dof, positions)?.read_all()
+    MeasurementReader::new(reader, path, joints, positions)?.read_all()
 }
 
 /// A measurement (or joint) file read one row at a time, so that files of millions of rows need
@@ -106,9 +119,9 @@ pub fn parse_measurements<R: Read>(
 pub struct MeasurementReader<R: Read> {
     rdr: csv::Reader<R>,
     path: PathBuf,
-    dof: usize,
+    joints: JointSpace,
     layout: ColumnLayout,
-    q_col: Vec<usize>,
+    q_col: JointColumns,
     xyz_col: Option<[usize; 3]>,
     record: csv::StringRecord,
     rows: usize,
@@ -116,45 +129,40 @@ pub struct MeasurementReader<R: Read> {
 }
 
 impl MeasurementReader<std::io::BufReader<std::fs::File>> {
-    /// Opens a measurement file for a robot with `dof` joints and checks its header.
-    pub fn open(path: &Path, dof: usize, positions: Positions) -> Result<Self> {
+    /// Opens a measurement file for a robot with the joints `joints` and checks its header.
+    pub fn open(path: &Path, joints: &JointSpace, positions: Positions) -> Result<Self> {
         let file = crate::io::input::open_input(path)?;
-        MeasurementReader::new(std::io::BufReader::new(file), path, dof, positions)
+        MeasurementReader::new(std::io::BufReader::new(file), path, joints, positions)
     }
 }
 
 impl<R: Read> MeasurementReader<R> {
     /// Reads and checks the header of measurement CSV text; `path` is used in messages.
-    pub fn new(reader: R, path: &Path, dof: usize, positions: Positions) -> Result<Self> {
+    pub fn new(reader: R, path: &Path, joints: &JointSpace, positions: Positions) -> Result<Self> {
         let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
             Error::parse(path, line, field, msg)
         };
+        let dof = joints.dof();
         let mut rdr = csv_reader(reader);
         let layout = ColumnLayout::read(
             &mut rdr,
             path,
             dof,
             positions != Positions::Ignored,
-            &format!("q1..q{dof} and x,y,z"),
+            &format!("q1..q{dof} (or axis1..axis{dof}) and x,y,z"),
         )?;
-        let (q_col, xyz_col, headers) = (&layout.q, layout.xyz, &layout.headers);
-        let mut q = Vec::with_capacity(dof);
-        for (j, c) in q_col.iter().enumerate() {
-            match c {
-                Some(c) => q.push(*c),
-                None => {
-                    return Err(perr(
-                        Some(1),
-                        Some(&format!("q{}", j + 1)),
-                        format!(
-                            "missing column (the robot has {dof} joints: q1..q{dof}; header is \
-                             `{}`)",
-                            headers.join(",")
-                        ),
-                    ))
-                }
-            }
-        }
+        let Some(q) = layout.joint_columns(path)? else {
+            return Err(perr(
+                Some(1),
+                Some(&joint_column(0)),
+                format!(
+                    "missing column (the robot has {dof} joints: q1..q{dof}, or the controller's \
+                     axis1..axis{dof}; header is `{}`)",
+                    layout.headers.join(",")
+                ),
+            ));
+        };
+        let xyz_col = layout.xyz;
         let n_xyz = xyz_col.iter().filter(|c| c.is_some()).count();
         let xyz_col = match xyz_col {
             [Some(x), Some(y), Some(z)] => Some([x, y, z]),
@@ -171,7 +179,7 @@ impl<R: Read> MeasurementReader<R> {
         Ok(MeasurementReader {
             rdr,
             path: path.to_owned(),
-            dof,
+            joints: joints.clone(),
             q_col: q,
             xyz_col,
             layout,
@@ -181,7 +189,7 @@ impl<R: Read> MeasurementReader<R> {
         })
     }
 
-    /// Names of the columns other than `q1..qn` and `x,y,z`, in file order.
+    /// Names of the columns other than the joint columns and `x,y,z`, in file order.
     pub fn extra_columns(&self) -> &[String] {
         &self.layout.extra_columns
     }
@@ -196,7 +204,7 @@ impl<R: Read> MeasurementReader<R> {
     pub fn header(&self) -> MeasurementSet {
         MeasurementSet {
             path: self.path.clone(),
-            dof: self.dof,
+            joints: self.joints.clone(),
             extra_columns: self.layout.extra_columns.clone(),
             rows: Vec::new(),
             warnings: Vec::new(),
@@ -210,14 +218,19 @@ impl<R: Read> MeasurementReader<R> {
             return Ok(None);
         };
         let (layout, record, path) = (&self.layout, &self.record, &self.path);
-        let num = |k: usize, range, what| layout.number_in(record, k, path, line, range, what);
-        let mut q = Vec::with_capacity(self.dof);
-        for &c in &self.q_col {
-            let v = num(c, &ranges::JOINT, "not a plausible joint value")?;
-            self.max_abs_deg = self.max_abs_deg.max(v.abs());
-            q.push(v.to_radians());
-        }
-        let pos = |k| num(k, &ranges::LENGTH, "not a plausible tracker reading");
+        let (q, largest_angle) =
+            layout.joint_values(record, &self.q_col, &self.joints, path, line)?;
+        self.max_abs_deg = self.max_abs_deg.max(largest_angle);
+        let pos = |k| {
+            layout.number_in(
+                record,
+                k,
+                path,
+                line,
+                &ranges::LENGTH,
+                "not a plausible tracker reading",
+            )
+        };
         let p = match self.xyz_col {
             Some([x, y, z]) => Some(Vector3::new(pos(x)?, pos(y)?, pos(z)?)),
             None => None,
@@ -244,15 +257,20 @@ impl<R: Read> MeasurementReader<R> {
         }
         let mut warnings = Vec::new();
         // Radians of any joint range (up to a full turn each way) are within ±2π; a real session
-        // in degrees moves some joint further than 6.3 degrees.
+        // in degrees moves some revolute joint further than 6.3 degrees.
         if self.rows >= 3
             && self.max_abs_deg > 0.0
             && self.max_abs_deg <= std::f64::consts::TAU + 1e-9
         {
             warnings.push(format!(
-                "{}: every joint value is within ±{:.3} (±2π); they look like radians, but files \
-                 hold degrees",
+                "{}: every {}joint value is within ±{:.3} (±2π); they look like radians, but \
+                 files hold degrees",
                 self.path.display(),
+                if self.joints.any_prismatic() {
+                    "revolute "
+                } else {
+                    ""
+                },
                 self.max_abs_deg
             ));
         }
@@ -270,8 +288,9 @@ impl<R: Read> MeasurementReader<R> {
     }
 }
 
-/// Writes a measurement (or joint) CSV atomically: `q1..qn` in degrees, then `x,y,z` in mm if
-/// every row has a position, then the extra columns.
+/// Writes a measurement (or joint) CSV atomically: `q1..qn` (model joint values: degrees, or mm
+/// for a prismatic joint), then `x,y,z` in mm if every row has a position, then the extra
+/// columns.
 pub fn write_measurements(path: &Path, set: &MeasurementSet) -> Result<()> {
     let bytes = measurements_csv(set).map_err(|e| Error::Io {
         path: path.to_owned(),
@@ -280,12 +299,12 @@ pub fn write_measurements(path: &Path, set: &MeasurementSet) -> Result<()> {
     crate::io::atomic::write_atomic(path, &bytes)
 }
 
-/// The CSV text [`write_measurements`] writes (`q` with 9 decimals of a degree, `x,y,z` with 6
-/// decimals of a millimetre), for callers that write several files together
+/// The CSV text [`write_measurements`] writes (`q` with 9 decimals of a degree or mm, `x,y,z`
+/// with 6 decimals of a millimetre), for callers that write several files together
 /// ([`crate::io::write_all_atomic`]).
 pub fn measurements_csv(set: &MeasurementSet) -> std::io::Result<Vec<u8>> {
     let with_p = set.has_positions();
-    let mut header: Vec<String> = (1..=set.dof).map(|i| format!("q{i}")).collect();
+    let mut header: Vec<String> = (0..set.dof()).map(joint_column).collect();
     if with_p {
         header.extend(["x", "y", "z"].map(String::from));
     }
@@ -295,7 +314,11 @@ pub fn measurements_csv(set: &MeasurementSet) -> std::io::Result<Vec<u8>> {
     let mut fields = Vec::with_capacity(header.len());
     for r in &set.rows {
         fields.clear();
-        fields.extend(r.q.iter().map(|v| format!("{:.9}", v.to_degrees())));
+        fields.extend(
+            r.q.iter()
+                .enumerate()
+                .map(|(i, v)| format!("{:.9}", set.joints.to_display(i, *v))),
+        );
         if let (true, Some(p)) = (with_p, r.p) {
             fields.extend([p.x, p.y, p.z].iter().map(|v| format!("{v:.6}")));
         }
@@ -311,7 +334,12 @@ mod tests {
     use super::*;
 
     fn parse(s: &str, pos: Positions) -> Result<MeasurementSet> {
-        parse_measurements(s.as_bytes(), Path::new("m.csv"), 2, pos)
+        parse_measurements(
+            s.as_bytes(),
+            Path::new("m.csv"),
+            &JointSpace::revolute(2),
+            pos,
+        )
     }
 
     #[test]
@@ -413,10 +441,76 @@ mod tests {
         let s = parse("id,q1,q2,x,y,z\na,10,20,1,2,3\n", Positions::Required).unwrap();
         let p = std::env::temp_dir().join(format!("robocal-m-{}.csv", std::process::id()));
         write_measurements(&p, &s).unwrap();
-        let t = read_measurements(&p, 2, Positions::Required).unwrap();
+        let t = read_measurements(&p, &JointSpace::revolute(2), Positions::Required).unwrap();
         std::fs::remove_file(&p).unwrap();
         assert_eq!(t.rows[0].extra, s.rows[0].extra);
         assert!((t.rows[0].q[0] - s.rows[0].q[0]).abs() < 1e-12);
         assert_eq!(t.rows[0].p, s.rows[0].p);
+    }
+
+    fn tracked() -> JointSpace {
+        use crate::model::{Controller, JointType};
+        let c = Controller::new(vec![1.0, -1.0], vec![100.0, 0.0], vec![]).unwrap();
+        JointSpace::new(vec![JointType::Prismatic, JointType::Revolute], Some(c)).unwrap()
+    }
+
+    fn parse_with(s: &str, j: &JointSpace) -> Result<MeasurementSet> {
+        parse_measurements(s.as_bytes(), Path::new("m.csv"), j, Positions::Optional)
+    }
+
+    /// A prismatic joint's column is mm, never converted; axis columns go through the controller.
+    #[test]
+    fn prismatic_values_and_axis_columns() {
+        let j = tracked();
+        let s = parse_with("q1,q2\n1500,90\n", &j).unwrap();
+        assert_eq!(s.rows[0].q[0], 1500.0);
+        assert!((s.rows[0].q[1] - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+        // axis1 = 1400 -> q1 = 1500 mm; axis2 = -90 -> q2 = 90 deg.
+        let a = parse_with("id,axis2,axis1\nx,-90,1400\n", &j).unwrap();
+        assert_eq!(a.rows[0].q, s.rows[0].q);
+        assert_eq!(a.extra_columns, vec!["id"]);
+        // Written back as model values in display units: mm and degrees.
+        let text = String::from_utf8(measurements_csv(&a).unwrap()).unwrap();
+        assert_eq!(text, "q1,q2,id\n1500.000000000,90.000000000,x\n");
+        // Without a controller map axis values are the joint values.
+        let plain = JointSpace::revolute(2);
+        let p = parse_with("axis1,axis2\n10,20\n", &plain).unwrap();
+        assert!((p.rows[0].q[1] - 20f64.to_radians()).abs() < 1e-15);
+        // Small prismatic values do not look like radians; small angles do.
+        let w = parse_with("q1,q2\n1,1\n2,2\n3,3\n", &j).unwrap();
+        assert_eq!(w.warnings.len(), 1);
+        let w = parse_with("q1,q2\n1,10\n2,20\n3,30\n", &j).unwrap();
+        assert!(w.warnings.is_empty(), "{:?}", w.warnings);
+    }
+
+    /// Both kinds of joint columns: q is used, and axis must agree with it on every row.
+    #[test]
+    fn q_and_axis_columns_must_agree() {
+        let j = tracked();
+        let s = parse_with("q1,q2,axis1,axis2\n1500,90,1400,-90\n", &j).unwrap();
+        assert_eq!(s.rows[0].q[0], 1500.0);
+        let e = parse_with("q1,q2,axis1,axis2\n1500,90,1400,-90\n1500,90,1400,90\n", &j)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("m.csv:3: field `axis2`") && e.contains("disagrees"),
+            "{e}"
+        );
+        let e = parse_with("q1,q2,axis1\n1,2,3\n", &j)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("m.csv:1: field `axis2`: missing column"), "{e}");
+        let e = parse_with("axis1,axis3\n1,2\n", &j)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("field `axis3`") && e.contains("axis1..axis2"),
+            "{e}"
+        );
+        let e = parse_with("id\n1\n", &j).unwrap_err().to_string();
+        assert!(
+            e.contains("field `q1`: missing column") && e.contains("axis1..axis2"),
+            "{e}"
+        );
     }
 }

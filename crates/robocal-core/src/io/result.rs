@@ -6,7 +6,7 @@
 
 use crate::error::{Error, Result};
 use crate::frame::{self, Frame};
-use crate::model::{Param, Robot, Unit};
+use crate::model::{JointType, Param, Robot, Unit};
 use crate::stats::ErrorStats;
 use indexmap::IndexMap;
 use serde::{Deserialize, Serialize};
@@ -59,6 +59,52 @@ pub struct RobotInfo {
     pub dof: usize,
     /// `"mdh"` or `"dh"`.
     pub convention: String,
+    /// Each joint's type, `"revolute"` or `"prismatic"`. Empty (absent) in files written before
+    /// joint types existed: all revolute.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joint_types: Vec<JointType>,
+}
+
+impl RobotInfo {
+    /// The description of `robot`.
+    pub fn of(robot: &Robot) -> RobotInfo {
+        RobotInfo {
+            name: robot.name().to_owned(),
+            dof: robot.dof(),
+            convention: robot.convention().as_str().to_owned(),
+            joint_types: robot.joint_types().to_vec(),
+        }
+    }
+
+    /// Checks that the joint types match `robot`'s (an absent list means all revolute); `what`
+    /// describes the file's robot in the message. The error names the field `robot.joint_types`.
+    pub fn check_joint_types(&self, robot: &Robot, path: &Path, what: &str) -> Result<()> {
+        let mine = robot.joint_types();
+        let same = if self.joint_types.is_empty() {
+            mine.iter().all(|t| *t == JointType::Revolute)
+        } else {
+            self.joint_types == mine
+        };
+        if same {
+            return Ok(());
+        }
+        let list = |v: &[JointType]| v.iter().map(|t| t.as_str()).collect::<Vec<_>>().join(", ");
+        let theirs = if self.joint_types.is_empty() {
+            "all revolute".to_owned()
+        } else {
+            list(&self.joint_types)
+        };
+        Err(Error::parse(
+            path,
+            None,
+            Some("robot.joint_types"),
+            format!(
+                "{what} has joints {theirs}; the robot given ({}) has {}",
+                robot.name(),
+                list(mine)
+            ),
+        ))
+    }
 }
 
 /// One parameter's entry: nominal and calibrated value in display units.
@@ -289,6 +335,8 @@ impl CalibrationResult {
                 ),
             ));
         }
+        self.robot
+            .check_joint_types(nominal, path, "the result's robot")?;
         let mut r = nominal.clone();
         for name in self.parameters.keys() {
             if let Some(Param::Beta(i)) = Param::parse(name) {

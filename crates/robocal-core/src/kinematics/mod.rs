@@ -8,12 +8,13 @@
 //! along, or a rotation about, an axis of one of the chain's frames), so every column is a cross
 //! product with frames the forward pass computes anyway.
 //!
-//! Joint values are model values in **radians**; lengths in mm.
+//! Joint values are model values in internal units: **radians** for a revolute joint, mm for a
+//! prismatic one (its value adds to the row's d, its phi is a constant); lengths in mm.
 
 pub mod poe;
 
 use crate::frame::{euler_axes, Frame};
-use crate::model::{mul_rot_z, Convention, Robot, MAX_JOINTS};
+use crate::model::{mul_rot_z, Convention, JointType, Link, Robot, MAX_JOINTS};
 use nalgebra::{Matrix3, Point3, Vector3};
 
 /// The frames of one forward pass: for each joint i, the frame whose z axis is joint i's axis
@@ -33,17 +34,18 @@ impl Robot {
     pub fn flange_pose(&self, q: &[f64]) -> Frame {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut f = *self.base_frame();
+        let types = self.joint_types();
         for (i, &qi) in q.iter().enumerate() {
             let l = &self.links()[i];
             let c = self.link_constant(i);
-            let (s, co) = (qi + l.phi).sin_cos();
+            let (s, co, d) = joint_motion(types[i], l, qi);
             match self.convention() {
                 Convention::Mdh => {
                     f *= c;
-                    rotate_z_translate(&mut f, s, co, l.d);
+                    rotate_z_translate(&mut f, s, co, d);
                 }
                 Convention::Dh => {
-                    rotate_z_translate(&mut f, s, co, l.d);
+                    rotate_z_translate(&mut f, s, co, d);
                     f *= c;
                 }
             }
@@ -71,20 +73,21 @@ impl Robot {
             flange: *self.base_frame(),
         };
         let mut f = *self.base_frame();
+        let types = self.joint_types();
         for (i, &qi) in q.iter().enumerate() {
             let l = &self.links()[i];
             let c = self.link_constant(i);
-            let (s, co) = (qi + l.phi).sin_cos();
+            let (s, co, d) = joint_motion(types[i], l, qi);
             match self.convention() {
                 Convention::Mdh => {
                     ch.link[i] = f;
                     f *= c;
                     ch.axis[i] = f;
-                    rotate_z_translate(&mut f, s, co, l.d);
+                    rotate_z_translate(&mut f, s, co, d);
                 }
                 Convention::Dh => {
                     ch.axis[i] = f;
-                    rotate_z_translate(&mut f, s, co, l.d);
+                    rotate_z_translate(&mut f, s, co, d);
                     ch.link[i] = f;
                     f *= c;
                 }
@@ -95,8 +98,12 @@ impl Robot {
     }
 
     /// The tool point and, optionally, its Jacobians with respect to the joint values
-    /// (`jq`, one column per joint, mm/rad) and to every parameter of [`Robot::params`] in that
-    /// order (`jp`, mm per internal unit: mm/mm or mm/rad). Allocation-free.
+    /// (`jq`, one column per joint: mm/rad for a revolute joint, the unit axis direction (mm/mm)
+    /// for a prismatic one) and to every parameter of [`Robot::params`] in that order (`jp`, mm
+    /// per internal unit: mm/mm or mm/rad). Allocation-free.
+    ///
+    /// For a prismatic row the parameter columns keep their meaning: d moves the tool along the
+    /// joint axis (like the joint value), phi turns it about the axis (a constant rotation).
     ///
     /// Panics if `q`, `jq` or `jp` have the wrong length (programming errors: validate user joint
     /// vectors with [`Robot::check_joints`] first).
@@ -115,8 +122,12 @@ impl Robot {
         let org = |f: &Frame| -> Vector3<f64> { f.translation.vector };
         if let Some(jq) = jq {
             assert_eq!(jq.len(), n, "joint Jacobian length");
-            for (j, f) in jq.iter_mut().zip(&ch.axis[..n]) {
-                *j = col(f, 2).cross(&(p - org(f)));
+            let types = self.joint_types();
+            for ((j, f), t) in jq.iter_mut().zip(&ch.axis[..n]).zip(types) {
+                *j = match t {
+                    JointType::Revolute => col(f, 2).cross(&(p - org(f))),
+                    JointType::Prismatic => col(f, 2),
+                };
             }
         }
         let Some(jp) = jp else { return p };
@@ -143,7 +154,7 @@ impl Robot {
             jp[k] = col(&ch.link[i], 0);
             k += 1;
         }
-        // phi_i: same as the joint value.
+        // phi_i: rotation about the joint axis (the joint value's column for a revolute joint).
         for i in 0..n {
             jp[k] = col(&ch.axis[i], 2).cross(&(p - org(&ch.axis[i])));
             k += 1;
@@ -197,8 +208,9 @@ impl Robot {
         p
     }
 
-    /// Each joint's axis in the ACS at joint values `q` (rad): its unit direction and the origin
-    /// of its axis frame (a point on the axis).
+    /// Each joint's axis in the ACS at joint values `q` (rad or mm): its unit direction and the
+    /// origin of its axis frame (a point on the axis; for a prismatic joint, where its motion
+    /// starts: the frame before the joint's translation).
     pub fn joint_axes(&self, q: &[f64]) -> Vec<(Vector3<f64>, Vector3<f64>)> {
         let ch = self.chain(q);
         ch.axis[..self.dof()]
@@ -207,10 +219,33 @@ impl Robot {
             .collect()
     }
 
+    /// Joint `i`'s axis (0-based) at joint values `q`: as one entry of [`Robot::joint_axes`],
+    /// without allocating.
+    pub(crate) fn joint_axis(&self, q: &[f64], i: usize) -> (Vector3<f64>, Vector3<f64>) {
+        let f = &self.chain(q).axis[i];
+        (f.rotation.matrix().column(2).into(), f.translation.vector)
+    }
+
     /// Transforms a point given in the tracker frame into the base frame:
     /// `pose(tracker_frame) * m` (the paper's MF to ACS mapping).
     pub fn map_point(frame: &Frame, m: &Vector3<f64>) -> Vector3<f64> {
         (frame * Point3::from(*m)).coords
+    }
+}
+
+/// The joint's rotation (sin, cos) and translation along its axis at joint value `qi`:
+/// `Rz(qi + phi) Tz(d)` for a revolute joint, `Rz(phi) Tz(d + qi)` for a prismatic one.
+#[inline(always)]
+fn joint_motion(t: JointType, l: &Link, qi: f64) -> (f64, f64, f64) {
+    match t {
+        JointType::Revolute => {
+            let (s, c) = (qi + l.phi).sin_cos();
+            (s, c, l.d)
+        }
+        JointType::Prismatic => {
+            let (s, c) = l.phi.sin_cos();
+            (s, c, l.d + qi)
+        }
     }
 }
 

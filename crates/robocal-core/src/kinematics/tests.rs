@@ -1,5 +1,5 @@
 use super::poe::Poe;
-use crate::model::{presets::preset, Convention, JointLimit, Link, Param, Robot};
+use crate::model::{presets::preset, Convention, JointLimit, JointType, Link, Param, Robot};
 use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -210,4 +210,172 @@ fn parallel_axes_detection() {
     let mut r = preset("kuka-kr480-r3330").unwrap();
     // Axes 2 and 3 are parallel (alpha3 = 0).
     assert_eq!(r.enable_beta_for_parallel_axes(), vec![2]);
+}
+
+/// A random robot whose joints in `prismatic` (0-based) are prismatic.
+fn random_robot_with_prismatic(
+    rng: &mut ChaCha8Rng,
+    conv: Convention,
+    n: usize,
+    betas: bool,
+    prismatic: &[usize],
+) -> Robot {
+    let mut r = random_robot(rng, conv, n, betas);
+    let types = (0..n)
+        .map(|i| {
+            if prismatic.contains(&i) {
+                JointType::Prismatic
+            } else {
+                JointType::Revolute
+            }
+        })
+        .collect();
+    r.set_joint_types(types).unwrap();
+    r
+}
+
+/// Joint values within ±3.1 rad, or ±800 mm for a prismatic joint.
+fn random_q_for(rng: &mut ChaCha8Rng, r: &Robot) -> Vec<f64> {
+    r.joint_types()
+        .iter()
+        .map(|t| match t {
+            JointType::Revolute => rng.gen_range(-3.1..3.1),
+            JointType::Prismatic => rng.gen_range(-800.0..800.0),
+        })
+        .collect()
+}
+
+fn track_robot() -> Robot {
+    crate::load_robot_file(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/kr480-track.toml"
+    )))
+    .unwrap()
+}
+
+#[test]
+fn prismatic_joint_adds_to_d_and_leaves_phi_constant() {
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    for conv in [Convention::Mdh, Convention::Dh] {
+        let r = random_robot_with_prismatic(&mut rng, conv, 4, false, &[1]);
+        let q = random_q_for(&mut rng, &r);
+        // The same chain with the joint value moved into d2 and joint 2 held at 0.
+        let mut moved = r.clone();
+        moved.set(Param::D(1), r.get(Param::D(1)) + q[1]);
+        let mut q0 = q.clone();
+        q0[1] = 0.0;
+        let d = (r.tool_position(&q) - moved.tool_position(&q0)).norm();
+        assert!(d < 1e-9, "{conv:?}: {d}");
+        // The joint value does not turn anything: phi2 stays what it is.
+        let a = r.tool_pose(&q).rotation;
+        let b = r.tool_pose(&q0).rotation;
+        assert!((a.matrix() - b.matrix()).norm() < 1e-12, "{conv:?}");
+    }
+    // The track example: the arm is the KR 480 of Table I carried along x, 500 mm up.
+    let track = track_robot();
+    let kuka = preset("kuka-kr480-r3330").unwrap();
+    for _ in 0..100 {
+        let q = random_q(&mut rng, 6);
+        let s = rng.gen_range(0.0..4000.0);
+        let mut qt = vec![s];
+        qt.extend_from_slice(&q);
+        let want = kuka.tool_position(&q) + Vector3::new(s, 0.0, 500.0);
+        assert!((track.tool_position(&qt) - want).norm() < 1e-9);
+    }
+}
+
+#[test]
+fn poe_equals_dh_product_with_prismatic_joints() {
+    let mut rng = ChaCha8Rng::seed_from_u64(6);
+    let mut robots = vec![track_robot()];
+    for (conv, n, betas, prismatic) in [
+        (Convention::Mdh, 6, false, vec![0]),
+        (Convention::Dh, 6, false, vec![0]),
+        (Convention::Mdh, 7, true, vec![0, 3]),
+        (Convention::Dh, 7, true, vec![2, 6]),
+        (Convention::Mdh, 3, false, vec![0, 1, 2]),
+        (Convention::Dh, 3, false, vec![0, 1, 2]),
+    ] {
+        robots.push(random_robot_with_prismatic(
+            &mut rng, conv, n, betas, &prismatic,
+        ));
+    }
+    for r in robots {
+        let poe = Poe::from_robot(&r);
+        for (t, tw) in r.joint_types().iter().zip(&poe.twists) {
+            assert_eq!(*t == JointType::Prismatic, tw.w == Vector3::zeros());
+        }
+        for _ in 0..250 {
+            let q = random_q_for(&mut rng, &r);
+            let a = r.tool_pose(&q);
+            let b = poe.tool_pose(&q);
+            let dp = (a.translation.vector - b.translation.vector).norm();
+            let dr = (a.rotation.matrix() - b.rotation.matrix()).norm();
+            let what = format!("{} {:?} {:?}", r.name(), r.convention(), r.joint_types());
+            assert!(dp < 1e-9, "{what}: position differs by {dp} mm");
+            assert!(dr < 1e-12, "{what}: rotation differs by {dr}");
+        }
+    }
+}
+
+#[test]
+fn jacobians_match_finite_differences_with_prismatic_joints() {
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut robots = vec![track_robot()];
+    for (conv, n, betas, prismatic) in [
+        (Convention::Mdh, 7, true, vec![0]),
+        (Convention::Dh, 7, true, vec![0]),
+        (Convention::Mdh, 6, true, vec![1, 4]),
+        (Convention::Dh, 6, true, vec![2, 5]),
+        (Convention::Dh, 7, false, vec![3]),
+    ] {
+        robots.push(random_robot_with_prismatic(
+            &mut rng, conv, n, betas, &prismatic,
+        ));
+    }
+    for r in robots {
+        let n = r.dof();
+        let params = r.params();
+        let mut jq = vec![Vector3::zeros(); n];
+        let mut jp = vec![Vector3::zeros(); params.len()];
+        for _ in 0..20 {
+            let q = random_q_for(&mut rng, &r);
+            let p = r.tool_position_jacobians(&q, Some(&mut jq), Some(&mut jp));
+            assert!((p - r.tool_position(&q)).norm() < 1e-9);
+            let scale = p.norm().max(1.0) * 1e-3;
+            let what = |s: String| format!("{} {:?}: {s}", r.name(), r.convention());
+            for i in 0..n {
+                let h = match r.joint_type(i) {
+                    JointType::Revolute => 1e-6,
+                    JointType::Prismatic => 1e-4,
+                };
+                let mut qp = q.clone();
+                qp[i] += h;
+                let mut qm = q.clone();
+                qm[i] -= h;
+                let fd = (r.tool_position(&qp) - r.tool_position(&qm)) / (2.0 * h);
+                check_close(&jq[i], &fd, scale, &what(format!("dp/dq{}", i + 1)));
+                if r.joint_type(i) == JointType::Prismatic {
+                    // A prismatic column is the unit axis: the d column of the same row.
+                    assert!((jq[i].norm() - 1.0).abs() < 1e-12);
+                    let k = params.iter().position(|x| *x == Param::D(i)).unwrap();
+                    assert!((jq[i] - jp[k]).norm() < 1e-12);
+                }
+            }
+            for (k, &prm) in params.iter().enumerate() {
+                let h = if prm.unit() == crate::Unit::Mm {
+                    1e-4
+                } else {
+                    1e-7
+                };
+                let v = r.get(prm);
+                let mut rp = r.clone();
+                rp.set(prm, v + h);
+                let mut rm = r.clone();
+                rm.set(prm, v - h);
+                let fd = (rp.tool_position(&q) - rm.tool_position(&q)) / (2.0 * h);
+                check_close(&jp[k], &fd, scale, &what(format!("dp/d{prm}")));
+            }
+        }
+    }
 }

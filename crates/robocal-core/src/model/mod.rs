@@ -1,5 +1,6 @@
-//! Robot models: a serial chain of revolute joints described by a modified (Craig) or standard
-//! Denavit–Hartenberg parameter table, joint limits, a base frame and a tool (paper, section II.B).
+//! Robot models: a serial chain of revolute and prismatic joints described by a modified (Craig)
+//! or standard Denavit–Hartenberg parameter table, joint limits, a base frame and a tool (paper,
+//! section II.B), and the controller's axis map.
 //!
 //! Every geometric quantity that calibration may change is a [`Param`], addressable by its
 //! DESIGN.md name (`alpha1`, `d3`, `base_z`, `tool_c`, ...). Values are stored in millimetres and
@@ -8,10 +9,14 @@
 //! The per-joint constant part of each link transform is cached, so forward kinematics costs one
 //! `sin_cos` per joint; every mutation goes through [`Robot::set`] which keeps the cache valid.
 
+pub mod controller;
+mod joints;
 mod params;
 pub mod presets;
 pub mod robot_file;
 
+pub use controller::{Controller, Coupling};
+pub use joints::{JointSpace, JointType};
 pub use params::{Param, Unit};
 
 use crate::error::{Error, Result};
@@ -60,23 +65,27 @@ pub struct Link {
     pub beta: f64,
 }
 
-/// The range a joint may move in (radians, model joint values).
+/// The range a joint may move in (model joint values, internal units: radians for a revolute
+/// joint, mm for a prismatic one).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointLimit {
-    /// Lower bound (rad).
+    /// Lower bound (rad or mm).
     pub min: f64,
-    /// Upper bound (rad).
+    /// Upper bound (rad or mm).
     pub max: f64,
 }
 
 impl JointLimit {
-    /// Whether `q` (rad) lies within the limit (inclusive).
+    /// Whether `q` (rad or mm) lies within the limit (inclusive).
     pub fn contains(&self, q: f64) -> bool {
         q >= self.min && q <= self.max
     }
 }
 
-/// A serial robot with revolute joints: parameter table, limits, base frame and tool.
+/// A serial robot: parameter table, joint types, limits, base frame, tool and controller map.
+///
+/// Joints are revolute unless made prismatic with [`Robot::set_joint_types`]: a prismatic joint's
+/// value (mm) adds to its row's d, its phi is a constant (DESIGN.md, "Robot file additions").
 ///
 /// The tool point is `pose(B) * T1 * ... * Tn * pose(T0 + T)` applied to the origin, where `B` is
 /// the base frame vector, `T0` the nominal tool vector (paper eq. 7) and `T` its correction (the
@@ -88,6 +97,7 @@ pub struct Robot {
     links: Vec<Link>,
     beta_enabled: Vec<bool>,
     limits: Vec<JointLimit>,
+    joints: JointSpace,
     base: [f64; 6],
     tool0: [f64; 6],
     tool: [f64; 6],
@@ -98,8 +108,9 @@ pub struct Robot {
 }
 
 impl Robot {
-    /// Builds a robot. Angles in radians, lengths in mm. Checks that every value is finite, that
-    /// limits are ordered, and that the chain has 1..=[`MAX_JOINTS`] joints.
+    /// Builds a robot with revolute joints (see [`Robot::set_joint_types`] for prismatic ones)
+    /// and no controller map. Angles in radians, lengths in mm. Checks that every value is
+    /// finite, that limits are ordered, and that the chain has 1..=[`MAX_JOINTS`] joints.
     pub fn new(
         name: impl Into<String>,
         convention: Convention,
@@ -137,24 +148,8 @@ impl Robot {
                 }
             }
         }
-        for (i, l) in limits.iter().enumerate() {
-            if !l.min.is_finite() || !l.max.is_finite() {
-                return Err(Error::invalid(
-                    format!("limits of joint {}", i + 1),
-                    "not a finite number",
-                ));
-            }
-            if l.min > l.max {
-                return Err(Error::invalid(
-                    format!("limits of joint {}", i + 1),
-                    format!(
-                        "min {:.4} deg is greater than max {:.4} deg",
-                        l.min.to_degrees(),
-                        l.max.to_degrees()
-                    ),
-                ));
-            }
-        }
+        let joints = JointSpace::revolute(n);
+        check_limits(&limits, &joints)?;
         for (what, v) in [("base", &base), ("tool", &tool0)] {
             if v.iter().any(|x| !x.is_finite()) {
                 return Err(Error::invalid(what, "not a finite number"));
@@ -166,6 +161,7 @@ impl Robot {
             beta_enabled: vec![false; n],
             links,
             limits,
+            joints,
             base,
             tool0,
             tool: [0.0; 6],
@@ -217,7 +213,7 @@ impl Robot {
         &self.limits
     }
 
-    /// Replaces the joint limits.
+    /// Replaces the joint limits (internal units: rad or mm).
     pub fn set_limits(&mut self, limits: Vec<JointLimit>) -> Result<()> {
         if limits.len() != self.dof() {
             return Err(Error::invalid(
@@ -225,8 +221,65 @@ impl Robot {
                 format!("{} joint limits for {} joints", limits.len(), self.dof()),
             ));
         }
+        check_limits(&limits, &self.joints)?;
         self.limits = limits;
         Ok(())
+    }
+
+    /// The joints' types and the controller map: what converts joint values at the interfaces.
+    pub fn joint_space(&self) -> &JointSpace {
+        &self.joints
+    }
+
+    /// Every joint's type.
+    pub fn joint_types(&self) -> &[JointType] {
+        self.joints.types()
+    }
+
+    /// Joint `i`'s type (0-based).
+    pub fn joint_type(&self, i: usize) -> JointType {
+        self.joints.joint_type(i)
+    }
+
+    /// Joint `i`'s display unit: degrees (revolute) or mm (prismatic).
+    pub fn joint_unit(&self, i: usize) -> Unit {
+        self.joints.unit(i)
+    }
+
+    /// Sets the joint types (one per joint). The limits keep their numbers, now read in the new
+    /// types' internal units; the controller map is kept (its offsets are display values).
+    pub fn set_joint_types(&mut self, types: Vec<JointType>) -> Result<()> {
+        if types.len() != self.dof() {
+            return Err(Error::invalid(
+                "joint types",
+                format!("{} types for {} joints", types.len(), self.dof()),
+            ));
+        }
+        self.joints = JointSpace::new(types, self.joints.controller().cloned())?;
+        Ok(())
+    }
+
+    /// The controller's axis map, if the robot has one (else axis values are joint values).
+    pub fn controller(&self) -> Option<&Controller> {
+        self.joints.controller()
+    }
+
+    /// Sets (or, with `None`, removes) the controller's axis map.
+    pub fn set_controller(&mut self, controller: Option<Controller>) -> Result<()> {
+        self.joints = JointSpace::new(self.joints.types().to_vec(), controller)?;
+        Ok(())
+    }
+
+    /// A joint vector from display units (degrees, or mm for a prismatic joint) to internal
+    /// units (rad or mm).
+    pub fn joints_from_display(&self, v: &[f64]) -> Vec<f64> {
+        self.joints.joints_from_display(v)
+    }
+
+    /// A joint vector from internal units to display units (degrees, or mm for a prismatic
+    /// joint).
+    pub fn joints_to_display(&self, q: &[f64]) -> Vec<f64> {
+        self.joints.joints_to_display(q)
     }
 
     /// The base frame vector B (mm, rad).
@@ -431,7 +484,7 @@ impl Robot {
         Ok(())
     }
 
-    /// Checks a joint vector (rad): length and finiteness. `context` names its origin in errors.
+    /// Checks a joint vector (rad or mm): length and finiteness. `context` names its origin in errors.
     pub fn check_joints(&self, q: &[f64], context: &str) -> Result<()> {
         if q.len() != self.dof() {
             return Err(Error::JointCount {
@@ -449,7 +502,7 @@ impl Robot {
         Ok(())
     }
 
-    /// The joints (0-based) whose value in `q` (rad) lies outside the limits.
+    /// The joints (0-based) whose value in `q` (rad or mm) lies outside the limits.
     pub fn joints_outside_limits(&self, q: &[f64]) -> Vec<usize> {
         q.iter()
             .zip(&self.limits)
@@ -458,6 +511,31 @@ impl Robot {
             .map(|(i, _)| i)
             .collect()
     }
+}
+
+/// Checks that every limit is finite and ordered; messages give values in display units.
+fn check_limits(limits: &[JointLimit], joints: &JointSpace) -> Result<()> {
+    for (i, l) in limits.iter().enumerate() {
+        if !l.min.is_finite() || !l.max.is_finite() {
+            return Err(Error::invalid(
+                format!("limits of joint {}", i + 1),
+                "not a finite number",
+            ));
+        }
+        if l.min > l.max {
+            let u = joints.unit(i);
+            return Err(Error::invalid(
+                format!("limits of joint {}", i + 1),
+                format!(
+                    "min {:.4} {u} is greater than max {:.4} {u}",
+                    u.from_internal(l.min),
+                    u.from_internal(l.max),
+                    u = u.as_str()
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The constant part of a link transform (see [`Robot::link_constant`]).

@@ -1,11 +1,13 @@
 //! Built-in robots.
 //!
 //! - `kuka-kr480-r3330`: the paper's Table I (modified DH), the nominal tool T0 of eq. 7 and the
-//!   joint limits of DESIGN.md (model joint values).
+//!   joint limits of DESIGN.md (model joint values), and KUKA's axis map
+//!   q = (-A1, A2, A3, -A4, A5, -A6) (DESIGN.md) as its `[controller]`.
 //! - `kuka-kr480-r3330-table3`: the paper's calibrated parameters (Table III), with the base and
-//!   tool corrections of its columns B and T; the simulator uses it as a "true" robot.
+//!   tool corrections of its columns B and T and the same axis map; the simulator uses it as a
+//!   "true" robot.
 
-use super::{Convention, JointLimit, Link, Param, Robot};
+use super::{Controller, Convention, JointLimit, Link, Param, Robot};
 use crate::error::{Error, Result};
 
 /// Names of the built-in presets.
@@ -49,6 +51,10 @@ const KR480_LIMITS: [[f64; 2]; 6] = [
     [-350.0, 350.0],
 ];
 
+/// KUKA's controller axes A1..A6 against the model joints of Table I: q = (-A1, A2, A3, -A4, A5,
+/// -A6) (DESIGN.md).
+pub const KUKA_AXIS_SIGNS: [f64; 6] = [-1.0, 1.0, 1.0, -1.0, 1.0, -1.0];
+
 fn kr480(name: &str, table: &[[f64; 4]; 6]) -> Robot {
     let links = table
         .iter()
@@ -67,7 +73,7 @@ fn kr480(name: &str, table: &[[f64; 4]; 6]) -> Robot {
             max: l[1].to_radians(),
         })
         .collect();
-    Robot::new(
+    let mut r = Robot::new(
         name,
         Convention::Mdh,
         links,
@@ -75,7 +81,12 @@ fn kr480(name: &str, table: &[[f64; 4]; 6]) -> Robot {
         [0.0; 6],
         crate::frame::vec_deg_to_rad(&KR480_T0),
     )
-    .expect("built-in preset is valid")
+    .expect("built-in preset is valid");
+    let kuka = Controller::new(KUKA_AXIS_SIGNS.to_vec(), vec![0.0; 6], Vec::new())
+        .expect("KUKA axis map is valid");
+    r.set_controller(Some(kuka))
+        .expect("KUKA axis map has 6 axes");
+    r
 }
 
 /// Returns a built-in robot by name.

@@ -7,15 +7,24 @@
 //! tool = [0, 0, 31, 0, 0, 0]   # nominal tool vector T0, same units (optional, default zero)
 //!
 //! [[joints]]                   # one table per joint, base to tip
+//! type = "revolute"            # or "prismatic" (optional, default revolute)
 //! alpha = 90                   # deg
-//! d = 89.159                   # mm
+//! d = 89.159                   # mm (a prismatic joint's value adds to it)
 //! a = 0                        # mm
-//! phi = 0                      # deg, offset added to the joint value (optional, default 0)
-//! limits = [-360, 360]         # deg, model joint values (optional, default [-360, 360])
+//! phi = 0                      # deg, offset added to the joint value (a constant for a
+//!                              # prismatic joint) (optional, default 0)
+//! limits = [-360, 360]         # model joint values: deg, or mm for a prismatic joint
+//!                              # (optional for a revolute joint, default [-360, 360])
 //! beta = 0                     # deg, Hayati tilt (optional; giving it makes beta a parameter)
+//!
+//! [controller]                 # optional: controller axes -> model joints (see `controller`)
+//! sign = [1, 1, -1, 1, 1, 1]   # +1 or -1 per joint (default all +1)
+//! offset = [0, 0, 0, 0, 0, 0]  # deg, or mm for a prismatic joint (default all 0)
+//! coupling = [[3, 2, -1.0]]    # rows [i, j, k]: q_i gets k * axis_j (1-based; default none)
 //! ```
 
-use super::{presets, Convention, JointLimit, Link, Robot};
+use super::controller::{Controller, Coupling};
+use super::{presets, Convention, JointLimit, JointType, Link, Robot};
 use crate::error::{Error, Result};
 use crate::ranges;
 use serde::Deserialize;
@@ -30,17 +39,30 @@ struct RobotFile {
     base: Option<Spanned<Vec<Spanned<f64>>>>,
     tool: Option<Spanned<Vec<Spanned<f64>>>>,
     joints: Vec<JointEntry>,
+    controller: Option<Spanned<ControllerEntry>>,
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct JointEntry {
+    #[serde(rename = "type")]
+    kind: Option<Spanned<String>>,
     alpha: Spanned<f64>,
     d: Spanned<f64>,
     a: Spanned<f64>,
     phi: Option<Spanned<f64>>,
     beta: Option<Spanned<f64>>,
     limits: Option<Spanned<Vec<Spanned<f64>>>>,
+}
+
+type Numbers = Spanned<Vec<Spanned<f64>>>;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ControllerEntry {
+    sign: Option<Numbers>,
+    offset: Option<Numbers>,
+    coupling: Option<Spanned<Vec<Numbers>>>,
 }
 
 /// Default joint range (degrees) when a robot file gives none.
@@ -166,9 +188,25 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
     let tool0 = frame_vec(&file.tool, "tool")?;
     let mut links = Vec::with_capacity(file.joints.len());
     let mut limits = Vec::with_capacity(file.joints.len());
+    let mut types = Vec::with_capacity(file.joints.len());
     let mut betas = Vec::new();
     for (i, j) in file.joints.iter().enumerate() {
         let f = |name: &str| format!("joints[{}].{name}", i + 1);
+        let kind = match &j.kind {
+            None => JointType::Revolute,
+            Some(k) => JointType::parse(k.get_ref()).ok_or_else(|| {
+                err(
+                    k.span(),
+                    f("type"),
+                    format!(
+                        "`{}` is not a joint type: use \"revolute\" or \"prismatic\"",
+                        k.get_ref()
+                    ),
+                )
+            })?,
+        };
+        types.push(kind);
+        let unit = kind.unit();
         let phi = match &j.phi {
             Some(v) => angle(v, f("phi"))?,
             None => 0.0,
@@ -188,6 +226,14 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
             beta: beta.to_radians(),
         });
         let (min, max) = match &j.limits {
+            None if kind == JointType::Prismatic => {
+                return Err(Error::parse(
+                    path,
+                    j.kind.as_ref().map(|k| line_of(text, k.span().start)),
+                    Some(&f("limits")),
+                    "a prismatic joint needs its travel: limits = [min, max] in mm",
+                ))
+            }
             None => (-DEFAULT_LIMIT_DEG, DEFAULT_LIMIT_DEG),
             Some(l) => {
                 if l.get_ref().len() != 2 {
@@ -195,7 +241,8 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
                         l.span(),
                         f("limits"),
                         format!(
-                            "expected [min, max] in degrees, got {} numbers",
+                            "expected [min, max] in {}, got {} numbers",
+                            unit_word(kind),
                             l.get_ref().len()
                         ),
                     ));
@@ -206,17 +253,24 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
                     return Err(err(
                         l.span(),
                         f("limits"),
-                        format!("min {min} deg is greater than max {max} deg"),
+                        format!(
+                            "min {min} {u} is greater than max {max} {u}",
+                            u = unit.as_str()
+                        ),
                     ));
                 }
                 (min, max)
             }
         };
         limits.push(JointLimit {
-            min: min.to_radians(),
-            max: max.to_radians(),
+            min: unit.to_internal(min),
+            max: unit.to_internal(max),
         });
     }
+    let controller = match &file.controller {
+        None => None,
+        Some(c) => Some(controller_section(c, &types, text, path)?),
+    };
     let name = file.name.unwrap_or_else(|| {
         path.file_stem()
             .map(|s| s.to_string_lossy().into_owned())
@@ -224,15 +278,155 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
     });
     let mut robot = Robot::new(name, convention, links, limits, base, tool0)
         .map_err(|e| Error::parse(path, None, None, e.to_string()))?;
+    robot
+        .set_joint_types(types)
+        .and_then(|()| robot.set_controller(controller))
+        .map_err(|e| Error::parse(path, None, None, e.to_string()))?;
     for i in betas {
         robot.enable_beta(i)?;
     }
     Ok(robot)
 }
 
+fn unit_word(t: JointType) -> &'static str {
+    match t {
+        JointType::Revolute => "degrees",
+        JointType::Prismatic => "mm",
+    }
+}
+
+/// The `[controller]` section: each field checked where it stands (line and entry in errors),
+/// then the map built (an error on the coupling's line if it cannot be inverted).
+fn controller_section(
+    c: &Spanned<ControllerEntry>,
+    types: &[JointType],
+    text: &str,
+    path: &Path,
+) -> Result<Controller> {
+    let n = types.len();
+    let err = |span: std::ops::Range<usize>, field: String, msg: String| Error::Parse {
+        path: path.to_owned(),
+        line: Some(line_of(text, span.start)),
+        field: Some(field),
+        message: msg,
+    };
+    let per_joint = |v: &Option<Numbers>, name: &str, default: f64| -> Result<Vec<f64>> {
+        let Some(v) = v else {
+            return Ok(vec![default; n]);
+        };
+        if v.get_ref().len() != n {
+            return Err(err(
+                v.span(),
+                format!("controller.{name}"),
+                format!(
+                    "expected {n} values (one per joint), got {}",
+                    v.get_ref().len()
+                ),
+            ));
+        }
+        v.get_ref()
+            .iter()
+            .enumerate()
+            .map(|(k, x)| {
+                let val = *x.get_ref();
+                if val.is_finite() {
+                    Ok(val)
+                } else {
+                    Err(err(
+                        x.span(),
+                        format!("controller.{name}[{}]", k + 1),
+                        format!("{val} is not a finite number"),
+                    ))
+                }
+            })
+            .collect()
+    };
+    let entry = c.get_ref();
+    let sign = per_joint(&entry.sign, "sign", 1.0)?;
+    if let Some(v) = &entry.sign {
+        for (k, x) in v.get_ref().iter().enumerate() {
+            let s = *x.get_ref();
+            if s != 1.0 && s != -1.0 {
+                return Err(err(
+                    x.span(),
+                    format!("controller.sign[{}]", k + 1),
+                    format!("{s} is not 1 or -1"),
+                ));
+            }
+        }
+    }
+    let offset = per_joint(&entry.offset, "offset", 0.0)?;
+    let mut coupling = Vec::new();
+    if let Some(rows) = &entry.coupling {
+        for (r, row) in rows.get_ref().iter().enumerate() {
+            let field = format!("controller.coupling[{}]", r + 1);
+            let v = row.get_ref();
+            if v.len() != 3 {
+                return Err(err(
+                    row.span(),
+                    field,
+                    format!(
+                        "expected [i, j, k] (joint i gets k times axis j), got {} numbers",
+                        v.len()
+                    ),
+                ));
+            }
+            let index = |x: &Spanned<f64>, what: &str| -> Result<usize> {
+                let val = *x.get_ref();
+                if val.fract() == 0.0 && val >= 1.0 && val <= n as f64 {
+                    Ok(val as usize - 1)
+                } else {
+                    Err(err(
+                        x.span(),
+                        field.clone(),
+                        format!("{what} {val} is not a joint number 1..{n}"),
+                    ))
+                }
+            };
+            let joint = index(&v[0], "i")?;
+            let axis = index(&v[1], "j")?;
+            let factor = *v[2].get_ref();
+            if !factor.is_finite() {
+                return Err(err(
+                    v[2].span(),
+                    field,
+                    format!("factor {factor} is not a finite number"),
+                ));
+            }
+            if joint == axis {
+                return Err(err(
+                    row.span(),
+                    field,
+                    format!(
+                        "couples joint {} with its own axis; use sign (and offset) for that",
+                        joint + 1
+                    ),
+                ));
+            }
+            coupling.push(Coupling {
+                joint,
+                axis,
+                factor,
+            });
+        }
+    }
+    Controller::new(sign, offset, coupling).map_err(|e| {
+        let span = entry
+            .coupling
+            .as_ref()
+            .map_or_else(|| c.span(), |x| x.span());
+        let (field, message) = match &e {
+            Error::Invalid { field, message } => (field.clone(), message.clone()),
+            other => ("controller".to_owned(), other.to_string()),
+        };
+        err(span, field, message)
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::model::JointType;
 
     const GOOD: &str = r#"
 name = "two"
@@ -373,5 +567,210 @@ beta = 0
     fn missing_file() {
         let e = load_robot("no/such/robot.toml").err().unwrap().to_string();
         assert!(e.contains("no/such/robot.toml"), "{e}");
+    }
+
+    const TRACKED: &str = r#"
+name = "tracked"
+convention = "mdh"
+[[joints]]
+type = "prismatic"
+alpha = 90
+d = 10
+a = 0
+limits = [0, 4000]
+[[joints]]
+alpha = -90
+d = 1045
+a = 0
+phi = -90
+limits = [-185, 185]
+[[joints]]
+alpha = -90
+d = 0
+a = 500
+[controller]
+sign = [1, -1, 1]
+offset = [100, 0, 0]
+coupling = [[3, 2, -1.0]]
+"#;
+
+    #[test]
+    fn prismatic_joint_and_controller() {
+        let r = parse(TRACKED).unwrap();
+        assert_eq!(r.joint_type(0), JointType::Prismatic);
+        assert_eq!(r.joint_type(1), JointType::Revolute);
+        // Prismatic limits are mm, not converted; revolute ones degrees.
+        assert_eq!(r.limits()[0].min, 0.0);
+        assert_eq!(r.limits()[0].max, 4000.0);
+        assert!((r.limits()[1].max - 185f64.to_radians()).abs() < 1e-15);
+        assert_eq!(r.joint_unit(0), super::super::Unit::Mm);
+        let c = r.controller().unwrap();
+        assert_eq!(c.sign(), &[1.0, -1.0, 1.0]);
+        assert_eq!(c.offset(), &[100.0, 0.0, 0.0]);
+        // q1 = axis1 + 100 mm, q2 = -axis2, q3 = axis3 - axis2.
+        let q = r.joint_space().joints_from_axes(&[5.0, 10.0, 30.0]);
+        assert_eq!(q[0], 105.0);
+        assert!((q[1] + 10f64.to_radians()).abs() < 1e-15);
+        assert!((q[2] - 20f64.to_radians()).abs() < 1e-15);
+        // Without [controller]: no map.
+        let plain = parse(GOOD).unwrap();
+        assert!(plain.controller().is_none());
+        assert!(plain
+            .joint_types()
+            .iter()
+            .all(|t| *t == JointType::Revolute));
+    }
+
+    #[test]
+    fn bad_joint_type_and_prismatic_without_limits() {
+        expect_err(
+            &TRACKED.replace("\"prismatic\"", "\"linear\""),
+            &[
+                "robot.toml:5",
+                "joints[1].type",
+                "`linear` is not a joint type",
+            ],
+        );
+        expect_err(
+            &TRACKED.replace("limits = [0, 4000]\n", ""),
+            &[
+                "robot.toml:5",
+                "joints[1].limits",
+                "prismatic joint needs",
+                "mm",
+            ],
+        );
+        expect_err(
+            &TRACKED.replace("[0, 4000]", "[4000, 0]"),
+            &[
+                "robot.toml:9",
+                "joints[1].limits",
+                "min 4000 mm is greater than max 0 mm",
+            ],
+        );
+    }
+
+    /// Every bad `[controller]` names the file, the line and the field.
+    #[test]
+    fn bad_controller_sections() {
+        let cases: &[(&str, &str, &[&str])] = &[
+            (
+                "sign = [1, -1, 1]",
+                "sign = [1, -1]",
+                &[
+                    "robot.toml:21",
+                    "`controller.sign`",
+                    "expected 3 values",
+                    "got 2",
+                ],
+            ),
+            (
+                "sign = [1, -1, 1]",
+                "sign = [1, -2, 1]",
+                &["robot.toml:21", "`controller.sign[2]`", "-2 is not 1 or -1"],
+            ),
+            (
+                "offset = [100, 0, 0]",
+                "offset = [100, 0, 0, 0]",
+                &["robot.toml:22", "`controller.offset`", "expected 3 values"],
+            ),
+            (
+                "offset = [100, 0, 0]",
+                "offset = [100, nan, 0]",
+                &["robot.toml:22", "`controller.offset[2]`", "not a finite"],
+            ),
+            (
+                "[[3, 2, -1.0]]",
+                "[[4, 2, -1.0]]",
+                &[
+                    "robot.toml:23",
+                    "`controller.coupling[1]`",
+                    "i 4 is not a joint number 1..3",
+                ],
+            ),
+            (
+                "[[3, 2, -1.0]]",
+                "[[3, 2.5, -1.0]]",
+                &[
+                    "robot.toml:23",
+                    "`controller.coupling[1]`",
+                    "j 2.5 is not a joint number",
+                ],
+            ),
+            (
+                "[[3, 2, -1.0]]",
+                "[[3, 2]]",
+                &[
+                    "robot.toml:23",
+                    "`controller.coupling[1]`",
+                    "expected [i, j, k]",
+                ],
+            ),
+            (
+                "[[3, 2, -1.0]]",
+                "[[3, 3, -1.0]]",
+                &["robot.toml:23", "`controller.coupling[1]`", "its own axis"],
+            ),
+            // q2 = -axis2 + axis3 and q3 = axis3 - axis2: two joints follow one combination.
+            (
+                "[[3, 2, -1.0]]",
+                "[[2, 3, 1.0], [3, 2, -1.0]]",
+                &["robot.toml:23", "`controller.coupling`", "singular"],
+            ),
+            (
+                "sign = [1, -1, 1]",
+                "sign = [1, -1, 1]\nscale = 2",
+                &["robot.toml", "unknown field `scale`"],
+            ),
+        ];
+        for (from, to, needles) in cases {
+            let text = TRACKED.replace(from, to);
+            assert_ne!(text, TRACKED, "{from}");
+            expect_err(&text, needles);
+        }
+    }
+
+    /// The KUKA presets' signs and the FANUC-style example's J2/J3 coupling go axis -> q -> axis
+    /// to 1e-12 (through the whole joint space: display units, radians and back).
+    #[test]
+    fn kuka_and_fanuc_maps_round_trip() {
+        let kuka = load_robot("kuka-kr480-r3330").unwrap();
+        let q = kuka
+            .joint_space()
+            .joints_from_axes(&[10.0, -20.0, 30.0, 40.0, -50.0, 60.0]);
+        let want = [-10.0, -20.0, 30.0, -40.0, -50.0, -60.0];
+        for (a, b) in q.iter().zip(want) {
+            assert!((a.to_degrees() - b).abs() < 1e-12, "{q:?}");
+        }
+        assert_eq!(
+            load_robot("kuka-kr480-r3330-table3")
+                .unwrap()
+                .controller()
+                .unwrap()
+                .sign(),
+            kuka.controller().unwrap().sign()
+        );
+        let fanuc = load_robot(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/fanuc-like.toml"
+        ))
+        .unwrap();
+        let q = fanuc
+            .joint_space()
+            .joints_from_axes(&[0.0, 20.0, 15.0, 0.0, 0.0, 0.0]);
+        assert!((q[2].to_degrees() + 35.0).abs() < 1e-12, "q3 = -(J2 + J3)");
+        for r in [&kuka, &fanuc] {
+            for k in 0..200 {
+                let axis: Vec<f64> = (0..6)
+                    .map(|i| ((k * 31 + i * 17) % 341) as f64 - 170.0 + 0.123 * i as f64)
+                    .collect();
+                let back = r
+                    .joint_space()
+                    .axes_from_joints(&r.joint_space().joints_from_axes(&axis));
+                for (a, b) in axis.iter().zip(&back) {
+                    assert!((a - b).abs() <= 1e-12, "{}: {axis:?} -> {back:?}", r.name());
+                }
+            }
+        }
     }
 }

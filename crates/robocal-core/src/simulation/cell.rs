@@ -184,7 +184,7 @@ impl VirtualCell {
         self.seed
     }
 
-    /// `n` random calibration poses (rad, quantized to the CSV's 1e-9 degree), uniform within
+    /// `n` random calibration poses (rad or mm, quantized to the CSV's 1e-9 degree or mm), uniform within
     /// the joint limits, rejecting nominal tool points below the floor or inside the footprint
     /// (paper, section II.A). Successive calls continue the `Calibration` stream.
     pub fn random_poses(&mut self, n: usize) -> Result<Vec<Vec<f64>>> {
@@ -280,7 +280,7 @@ fn draw(
 ) -> Result<Vec<Vec<f64>>> {
     let mut qs = random_poses(robot, n, sampler, rng)?;
     for q in &mut qs {
-        quantize_joints(q);
+        quantize_joints(robot, q);
     }
     Ok(qs)
 }

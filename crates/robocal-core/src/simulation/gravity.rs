@@ -3,9 +3,10 @@
 //!
 //! # Model
 //! - Link j (the body moved by joint j) is a point mass `m_j` at the midpoint between a point on
-//!   joint j's axis (the origin of its axis frame) and the origin of joint j+1's axis frame; for
-//!   the last link, between joint n's axis origin and the tool point. Both points are fixed in
-//!   body j, so the mass moves rigidly with it.
+//!   joint j's axis (the origin of its axis frame; for a prismatic joint, that origin moved along
+//!   the axis by the joint's travel `d_j + q_j`) and the origin of joint j+1's axis frame; for
+//!   the last link, between that point and the tool point. Both points are fixed in body j, so
+//!   the mass moves rigidly with it.
 //! - The payload `m_p` is a point mass at the tool point.
 //! - Gravity `g` (default 9.80665 m/s² along −z of the base frame) pulls on every mass. The
 //!   torque about joint j is the moment of the weights of all masses beyond it about its axis:
@@ -15,11 +16,17 @@
 //!   robot really stands at `q + dq` while the controller reports `q`.
 //! - First order: the torques are evaluated at the commanded `q` (the change of torque caused by
 //!   `dq` is of second order for realistic stiffnesses).
+//! - A prismatic joint (e.g. a linear track) has no torque-driven rotation. Its generalized force
+//!   is the weight's component along its axis, `f_j = u_j . sum_{k >= j} m_k g` (N; equal to
+//!   `-dV/dq_j` with `q_j` in metres), which [`GravityModel::torques`] reports in its place; the
+//!   joint is taken as rigid along its axis (its position-controlled drive holds the carriage, and
+//!   a horizontal track carries no axial weight at all), so it does not deflect and its
+//!   compliance entry is not used. The masses beyond it still load the revolute joints.
 //!
 //! Link elasticity, gear backlash and the robot's own counterbalance are not modelled.
 
 use crate::error::{Error, Result};
-use crate::model::Robot;
+use crate::model::{JointType, Robot};
 use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
@@ -115,52 +122,69 @@ impl GravityModel {
     /// The point masses (kg) and their positions (mm, base frame) at joint values `q` (rad):
     /// one per link, then the payload.
     pub fn masses(&self, robot: &Robot, q: &[f64]) -> Vec<(f64, Vector3<f64>)> {
-        self.masses_on(&robot.joint_axes(q), robot.tool_position(q))
+        self.masses_on(robot, q, &robot.joint_axes(q), robot.tool_position(q))
     }
 
     fn masses_on(
         &self,
+        robot: &Robot,
+        q: &[f64],
         axes: &[(Vector3<f64>, Vector3<f64>)],
         tool: Vector3<f64>,
     ) -> Vec<(f64, Vector3<f64>)> {
         let n = axes.len();
         let mut out = Vec::with_capacity(n + 1);
         for j in 0..n {
+            let (u, o) = axes[j];
+            let start = match robot.joint_type(j) {
+                JointType::Revolute => o,
+                JointType::Prismatic => o + u * (robot.links()[j].d + q[j]),
+            };
             let next = if j + 1 < n { axes[j + 1].1 } else { tool };
-            out.push((self.link_masses_kg[j], (axes[j].1 + next) * 0.5));
+            out.push((self.link_masses_kg[j], (start + next) * 0.5));
         }
         out.push((self.payload_kg, tool));
         out
     }
 
-    /// The gravity torque about each joint axis (N·m) at joint values `q` (rad).
+    /// The gravity torque about each joint axis (N·m) at joint values `q` (rad, or mm for a
+    /// prismatic joint); for a prismatic joint, the axial force (N) instead.
     pub fn torques(&self, robot: &Robot, q: &[f64]) -> Vec<f64> {
         let axes = robot.joint_axes(q);
-        let masses = self.masses_on(&axes, robot.tool_position(q));
+        let masses = self.masses_on(robot, q, &axes, robot.tool_position(q));
         let g = Vector3::from(self.gravity_m_s2);
         // Mass k (k < n) belongs to link k and hangs beyond joints 0..=k; the payload (k = n)
         // beyond all joints.
         axes.iter()
+            .zip(robot.joint_types())
             .enumerate()
-            .map(|(j, (u, o))| {
+            .map(|(j, ((u, o), t))| {
                 masses[j..]
                     .iter()
-                    .map(|(m, r)| u.dot(&((r - o) * 1e-3).cross(&(g * *m))))
+                    .map(|(m, r)| match t {
+                        JointType::Revolute => u.dot(&((r - o) * 1e-3).cross(&(g * *m))),
+                        JointType::Prismatic => u.dot(&(g * *m)),
+                    })
                     .sum()
             })
             .collect()
     }
 
-    /// The joint deflections `dq_j = c_j tau_j` (rad) at joint values `q` (rad).
+    /// The joint deflections `dq_j = c_j tau_j` (rad) at joint values `q` (rad or mm); zero for
+    /// a prismatic joint (rigid along its axis, see the module documentation).
     pub fn deflection(&self, robot: &Robot, q: &[f64]) -> Vec<f64> {
         self.torques(robot, q)
             .iter()
             .zip(&self.compliance_rad_per_nm)
-            .map(|(t, c)| t * c)
+            .zip(robot.joint_types())
+            .map(|((t, c), jt)| match jt {
+                JointType::Revolute => t * c,
+                JointType::Prismatic => 0.0,
+            })
             .collect()
     }
 
-    /// Where the robot really stands when commanded to `q`: `q + dq` (rad).
+    /// Where the robot really stands when commanded to `q`: `q + dq` (rad or mm).
     pub fn deflected(&self, robot: &Robot, q: &[f64]) -> Vec<f64> {
         self.deflection(robot, q)
             .iter()
@@ -239,5 +263,52 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("needs a mass"));
+    }
+
+    /// On the KR 480 on a track: the revolute joints' torques are still `-dV/dq`; the track's
+    /// entry is the axial force `-dV/dq1` (q1 in metres), and the track does not deflect.
+    #[test]
+    fn a_prismatic_joint_carries_an_axial_force_and_does_not_deflect() {
+        let r = crate::load_robot_file(std::path::Path::new(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../examples/kr480-track.toml"
+        )))
+        .unwrap();
+        let mut m = GravityModel::new(
+            vec![1e-6; 7],
+            vec![900.0, 700.0, 600.0, 300.0, 150.0, 60.0, 20.0],
+            300.0,
+        );
+        // Tilt gravity so that it has a component along the track (+x).
+        m.gravity_m_s2 = [1.5, 0.0, -9.7];
+        let potential = |q: &[f64]| -> f64 {
+            let g = Vector3::from(m.gravity_m_s2);
+            -m.masses(&r, q)
+                .iter()
+                .map(|(mass, p)| mass * g.dot(&(p * 1e-3)))
+                .sum::<f64>()
+        };
+        let q = [1200.0, 0.3, -0.9, 0.4, 1.1, -0.7, 2.0];
+        let tau = m.torques(&r, &q);
+        for j in 0..7 {
+            let (h, per_unit) = if j == 0 { (1e-3, 1e3) } else { (1e-6, 1.0) };
+            let mut qp = q;
+            qp[j] += h;
+            let mut qm = q;
+            qm[j] -= h;
+            let fd = -(potential(&qp) - potential(&qm)) / (2.0 * h) * per_unit;
+            assert!(
+                (fd - tau[j]).abs() < 1e-5 * (1.0 + fd.abs()),
+                "joint {}: {fd} vs {}",
+                j + 1,
+                tau[j]
+            );
+        }
+        // The axial force is the whole weight's x component: 1.5 m/s² times all masses.
+        let total: f64 = m.link_masses_kg.iter().sum::<f64>() + m.payload_kg;
+        assert!((tau[0] - 1.5 * total).abs() < 1e-9, "{}", tau[0]);
+        let dq = m.deflection(&r, &q);
+        assert_eq!(dq[0], 0.0);
+        assert!(dq[2].abs() > 0.0);
     }
 }

@@ -9,7 +9,7 @@
 
 use super::poses::{random_poses, PoseSampler};
 use crate::error::{Error, Result};
-use crate::model::Robot;
+use crate::model::{JointType, Robot};
 use nalgebra::{Matrix3, Vector3};
 use rand::Rng;
 
@@ -21,10 +21,14 @@ const STARTS_PER_CORNER: usize = 25;
 const ORIENTATIONS: usize = 12;
 /// Plane poses keep this far from the joint limits (degrees), as a careful operator would.
 const LIMIT_MARGIN_DEG: f64 = 5.0;
+/// The same for a prismatic joint (mm).
+const LIMIT_MARGIN_MM: f64 = 5.0;
 
-/// Joint values (rad) that put the nominal tool point at `target` (mm, base frame), starting
-/// from `start`, by damped least squares on the position Jacobian, staying within the joint
-/// limits. `None` if it does not converge to `tol_mm` within `max_iter` steps.
+/// Joint values (rad, or mm for a prismatic joint) that put the nominal tool point at `target`
+/// (mm, base frame), starting from `start`, by damped least squares on the position Jacobian,
+/// staying within the joint limits. `None` if it does not converge to `tol_mm` within
+/// `max_iter` steps. A prismatic joint's motion is weighed as in
+/// [`crate::DampedLeastSquares::prismatic_scale_mm`] (its default).
 pub fn reach_position(
     robot: &Robot,
     start: &[f64],
@@ -32,26 +36,45 @@ pub fn reach_position(
     tol_mm: f64,
     max_iter: usize,
 ) -> Option<Vec<f64>> {
-    reach_within(robot, start, target, tol_mm, max_iter, 0.0)
+    reach_within(robot, start, target, tol_mm, max_iter, false)
 }
 
-/// [`reach_position`] keeping `margin` (rad, at most a quarter of each joint's range) away from
-/// the joint limits.
+/// The margin kept from joint `i`'s limits by the plane poses (rad or mm).
+fn limit_margin(robot: &Robot, i: usize) -> f64 {
+    match robot.joint_type(i) {
+        JointType::Revolute => LIMIT_MARGIN_DEG.to_radians(),
+        JointType::Prismatic => LIMIT_MARGIN_MM,
+    }
+}
+
+/// [`reach_position`], with `margin` keeping [`limit_margin`] (at most a quarter of each joint's
+/// range) away from the joint limits.
 fn reach_within(
     robot: &Robot,
     start: &[f64],
     target: &Vector3<f64>,
     tol_mm: f64,
     max_iter: usize,
-    margin: f64,
+    margin: bool,
 ) -> Option<Vec<f64>> {
     let n = robot.dof();
     let bounds: Vec<(f64, f64)> = robot
         .limits()
         .iter()
-        .map(|l| {
-            let m = margin.min(0.25 * (l.max - l.min));
+        .enumerate()
+        .map(|(i, l)| {
+            let m = if margin { limit_margin(robot, i) } else { 0.0 };
+            let m = m.min(0.25 * (l.max - l.min));
             (l.min + m, l.max - m)
+        })
+        .collect();
+    let scale = crate::DampedLeastSquares::default().prismatic_scale_mm;
+    let sc: Vec<f64> = robot
+        .joint_types()
+        .iter()
+        .map(|t| match t {
+            JointType::Revolute => 1.0,
+            JointType::Prismatic => scale,
         })
         .collect();
     let mut q = start.to_vec();
@@ -62,30 +85,33 @@ fn reach_within(
         if e.norm() < tol_mm {
             return Some(q);
         }
-        // dq = J^T (J J^T + lambda^2 I)^-1 e, with lambda small against J's scale (mm/rad).
+        // du = Js^T (Js Js^T + lambda^2 I)^-1 e with the scaled Jacobian Js = J S, dq = S du;
+        // lambda small against Js's scale (mm/rad).
         let mut jjt = Matrix3::zeros();
-        for c in &jq {
-            jjt += c * c.transpose();
+        for (c, s) in jq.iter().zip(&sc) {
+            jjt += c * c.transpose() * (s * s);
         }
         let lambda2 = 1e-8 * jjt.trace() + 1e-12;
         let w = (jjt + Matrix3::identity() * lambda2).lu().solve(&e)?;
-        let mut dq: Vec<f64> = jq.iter().map(|c| c.dot(&w)).collect();
-        let big = dq.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let mut du: Vec<f64> = jq.iter().zip(&sc).map(|(c, s)| s * c.dot(&w)).collect();
+        let big = du.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         if big > 0.2 {
-            dq.iter_mut().for_each(|v| *v *= 0.2 / big);
+            du.iter_mut().for_each(|v| *v *= 0.2 / big);
         }
-        for ((v, d), (lo, hi)) in q.iter_mut().zip(&dq).zip(&bounds) {
-            *v = (*v + d).clamp(*lo, *hi);
+        for (((v, d), (lo, hi)), s) in q.iter_mut().zip(&du).zip(&bounds).zip(&sc) {
+            *v = (*v + s * d).clamp(*lo, *hi);
         }
     }
     None
 }
 
-/// Rounds joint values (rad) to the 1e-9 degree resolution of the measurement CSV, so that the
-/// positions computed from them are those of the values written.
-pub fn quantize_joints(q: &mut [f64]) {
-    for v in q {
-        *v = ((v.to_degrees() * 1e9).round() / 1e9).to_radians();
+/// Rounds joint values (rad, or mm for a prismatic joint) of `robot` to the resolution of the
+/// measurement CSV (1e-9 degree or mm), so that the positions computed from them are those of
+/// the values written.
+pub fn quantize_joints(robot: &Robot, q: &mut [f64]) {
+    let s = robot.joint_space();
+    for (i, v) in q.iter_mut().enumerate() {
+        *v = s.to_internal(i, (s.to_display(i, *v) * 1e9).round() / 1e9);
     }
 }
 
@@ -95,8 +121,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Three poses whose nominal tool points lie on the plane `z = z_mm` (base frame), at the corners
-/// of an equilateral triangle centred on the base axis, with every joint at least 5 degrees (or a
-/// quarter of its range) inside its limits. `plane_z_mm: None` picks the median tool
+/// of an equilateral triangle centred on the base axis, with every joint at least 5 degrees (5 mm
+/// for a prismatic joint; or a quarter of its range) inside its limits. `plane_z_mm: None` picks the median tool
 /// height of random poses; the triangle's radius is their median distance from the base axis.
 /// Returns the poses (rad, quantized as in the CSV) and the plane's height.
 pub fn plane_poses<R: Rng + ?Sized>(
@@ -134,9 +160,8 @@ pub fn plane_poses<R: Rng + ?Sized>(
                     .total_cmp(&(pos[b] - target).norm())
             });
             let hit = order.iter().take(STARTS_PER_CORNER).find_map(|&i| {
-                let margin = LIMIT_MARGIN_DEG.to_radians();
-                let mut q = reach_within(robot, &cands[i], &target, 1e-7, 200, margin)?;
-                quantize_joints(&mut q);
+                let mut q = reach_within(robot, &cands[i], &target, 1e-7, 200, true)?;
+                quantize_joints(robot, &mut q);
                 let p = robot.tool_position(&q);
                 ((p - target).norm() < 1e-5 && sampler.accepts(&p)).then_some(q)
             });

@@ -135,7 +135,7 @@ pub fn simulate(
     rows.extend(rows_of(val, &pts[b..], "V", SET_VALIDATION, 2 + b));
     let measurements = MeasurementSet {
         path: PathBuf::from("<simulated>"),
-        dof: nominal.dof(),
+        joints: nominal.joint_space().clone(),
         extra_columns: vec!["id".into(), "set".into()],
         rows,
         warnings: Vec::new(),
@@ -164,11 +164,11 @@ pub fn simulate_joints(
     joints: &MeasurementSet,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Simulation> {
-    if joints.dof != nominal.dof() {
+    if joints.dof() != nominal.dof() {
         return Err(Error::JointCount {
             context: joints.path.display().to_string(),
             expected: nominal.dof(),
-            got: joints.dof,
+            got: joints.dof(),
         });
     }
     if joints.rows.is_empty() {
@@ -208,7 +208,7 @@ pub fn simulate_joints(
         .collect();
     let measurements = MeasurementSet {
         path: PathBuf::from("<simulated>"),
-        dof: nominal.dof(),
+        joints: nominal.joint_space().clone(),
         extra_columns: joints.extra_columns.clone(),
         rows,
         warnings: Vec::new(),
@@ -344,11 +344,7 @@ impl Simulation {
             .collect();
         TruthFile {
             generator: format!("robocal-core {}", env!("CARGO_PKG_VERSION")),
-            robot: RobotInfo {
-                name: truth.name().to_owned(),
-                dof: truth.dof(),
-                convention: truth.convention().as_str().to_owned(),
-            },
+            robot: RobotInfo::of(truth),
             nominal: nominal.name().to_owned(),
             truth: self.truth_label.clone(),
             parameters: TruthFile::parameter_entries(nominal, truth),

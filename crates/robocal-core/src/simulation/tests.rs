@@ -311,7 +311,7 @@ fn joints_are_measured_in_order_with_their_columns() {
     ];
     let joints = MeasurementSet {
         path: PathBuf::from("cmd.csv"),
-        dof: 6,
+        joints: r.joint_space().clone(),
         extra_columns: vec!["name".into()],
         rows: qs
             .iter()

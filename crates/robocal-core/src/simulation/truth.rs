@@ -104,8 +104,8 @@ impl TruthSpec {
     }
 }
 
-/// Checks that a truth robot can stand for the nominal one: same joint count and convention
-/// (the joint values commanded on the nominal model drive the truth robot).
+/// Checks that a truth robot can stand for the nominal one: same joint count, convention and
+/// joint types (the joint values commanded on the nominal model drive the truth robot).
 pub fn check_truth_matches(nominal: &Robot, truth: &Robot) -> Result<()> {
     if truth.dof() != nominal.dof() {
         return Err(Error::invalid(
@@ -128,6 +128,25 @@ pub fn check_truth_matches(nominal: &Robot, truth: &Robot) -> Result<()> {
                 truth.convention().as_str(),
                 nominal.name(),
                 nominal.convention().as_str()
+            ),
+        ));
+    }
+    if truth.joint_types() != nominal.joint_types() {
+        let list = |r: &Robot| {
+            r.joint_types()
+                .iter()
+                .map(|t| t.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        return Err(Error::invalid(
+            "--truth",
+            format!(
+                "truth robot `{}` has joints {}, the nominal robot `{}` has {}",
+                truth.name(),
+                list(truth),
+                nominal.name(),
+                list(nominal)
             ),
         ));
     }

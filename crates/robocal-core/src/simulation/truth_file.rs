@@ -136,6 +136,8 @@ impl TruthFile {
                 ),
             ));
         }
+        self.robot
+            .check_joint_types(nominal, path, "the truth robot")?;
         // The file's nominal values must be this robot's: a truth file made for another robot of
         // the same shape would otherwise simulate nonsense.
         for p in nominal.params() {
