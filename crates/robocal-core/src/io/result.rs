@@ -479,11 +479,7 @@ mod tests {
         let mut extra = serde_json::Map::new();
         extra.insert("status".into(), json!(STATUS_CALIBRATED));
         let r = CalibrationResult {
-            robot: RobotInfo {
-                name: nom.name().into(),
-                dof: 6,
-                convention: "mdh".into(),
-            },
+            robot: RobotInfo::of(&nom),
             parameters: CalibrationResult::parameter_entries(&nom, &nom),
             tracker_frame: FrameVec::from_frame(&Frame::identity()),
             errors: ErrorTables {

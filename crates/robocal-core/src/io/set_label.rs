@@ -116,9 +116,14 @@ mod tests {
     use std::path::Path;
 
     fn labels(csv: &str) -> Result<Vec<SetLabel>> {
-        parse_measurements(csv.as_bytes(), Path::new("m.csv"), 1, Positions::Required)
-            .unwrap()
-            .set_labels()
+        parse_measurements(
+            csv.as_bytes(),
+            Path::new("m.csv"),
+            &crate::model::JointSpace::revolute(1),
+            Positions::Required,
+        )
+        .unwrap()
+        .set_labels()
     }
 
     #[test]
