@@ -23,7 +23,8 @@ pub struct CalibrateArgs {
     /// The nominal robot: a preset name or a TOML robot file.
     #[arg(long)]
     robot: String,
-    /// Calibration measurements (CSV: q1..qn in degrees, x,y,z in mm in the tracker frame).
+    /// Calibration measurements (CSV: q1..qn in degrees (mm for a prismatic joint) or the
+    /// controller's axis1..axisN, x,y,z in mm in the tracker frame).
     /// Rows with `set` = `plane` give the initial frame; rows with `set` = `validation` are
     /// validation points; any other label than these, `calibration` or empty is an error.
     #[arg(long)]

@@ -23,7 +23,8 @@ pub struct EvaluateArgs {
     /// The calibration result (`robocal calibrate --out`): calibrated model and tracker frame.
     #[arg(long)]
     params: PathBuf,
-    /// Measured data: q1..qn (degrees), x,y,z (mm, tracker frame), other columns carried.
+    /// Measured data: q1..qn (degrees, mm for a prismatic joint) or axis1..axisN, x,y,z (mm,
+    /// tracker frame), other columns carried.
     #[arg(long)]
     data: PathBuf,
     /// What the measured points are compared with. `auto`: the desired positions when the data

@@ -17,7 +17,8 @@ use clap::{Parser, Subcommand};
 
 /// Kinematic calibration of industrial robots from laser-tracker measurements.
 ///
-/// Units everywhere: millimetres and degrees. Joint values are model joint values.
+/// Units everywhere: millimetres and degrees. Joint values are model joint values (mm for a
+/// prismatic joint), or controller axis values in axis1..axisN columns.
 #[derive(Parser, Debug)]
 #[command(name = "robocal", version, about, long_about = None)]
 pub struct Cli {

@@ -32,7 +32,8 @@ pub struct SimulateArgs {
     /// 10000000 in all.
     #[arg(long, required_unless_present = "joints")]
     poses: Option<usize>,
-    /// Measure the joint values of this CSV (q1..qn in degrees) instead of random poses, e.g.
+    /// Measure the joint values of this CSV (q1..qn in degrees, mm for a prismatic joint, or
+    /// axis1..axisN) instead of random poses, e.g.
     /// commanded joints in the verification phase. Rows keep their order and extra columns; any
     /// x,y,z columns are replaced by the new readings.
     #[arg(long, conflicts_with_all = ["poses", "validation", "no_plane", "plane_z_mm"])]

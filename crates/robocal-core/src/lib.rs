@@ -7,7 +7,9 @@
 //! and verification.
 //!
 //! Units: millimetres and radians inside the library; millimetres and degrees at every interface
-//! (files, reports). See `DESIGN.md` for the conventions.
+//! (files, reports). A prismatic joint's value is millimetres everywhere; every conversion of joint
+//! values goes through [`JointSpace`] (`Robot::joint_space`), which also holds the controller's
+//! axis map. See `DESIGN.md` for the conventions.
 #![warn(missing_docs)]
 
 pub mod compensation;

@@ -12,6 +12,10 @@ use nalgebra::{Point3, Vector3};
 use std::io::Write;
 use std::path::Path;
 
+fn types(t: &[crate::model::JointType]) -> String {
+    t.iter().map(|x| x.as_str()).collect::<Vec<_>>().join(", ")
+}
+
 /// Computes the errors of measured rows of one file (see the module docs of
 /// [`crate::evaluation`]).
 pub struct Evaluator<'a> {
@@ -41,9 +45,11 @@ impl<'a> Evaluator<'a> {
             return Err(Error::invalid(
                 header.path.display().to_string(),
                 format!(
-                    "read for {} joints, the robot has {}",
+                    "read for {} joints ({}), the robot has {} ({})",
                     header.dof(),
-                    nominal.dof()
+                    types(header.joints.types()),
+                    nominal.dof(),
+                    types(nominal.joint_types())
                 ),
             ));
         }

@@ -1,7 +1,7 @@
 //! Measurement CSV files (DESIGN.md): a header row, columns `q1..qn` (model joint values:
 //! degrees, or mm for a prismatic joint) or `axis1..axisN` (the controller's values, converted
-//! through the robot's `[controller]`; see [`crate::io::columns`]) and `x,y,z` (mm, tracker
-//! frame); other columns (`id`, `set`, ...) are carried through.
+//! through the robot's `[controller]`, and checked against `q1..qn` when a file has both) and
+//! `x,y,z` (mm, tracker frame); other columns (`id`, `set`, ...) are carried through.
 //!
 //! The same reader serves joint-only files (desired or commanded joints) with
 //! [`Positions::Forbidden`] or [`Positions::Optional`]. CRLF line endings and a UTF-8 byte-order

@@ -32,13 +32,23 @@ struct Chain {
 impl Robot {
     /// The flange frame `pose(B) * T1(q1) * ... * Tn(qn)` (direct DH product).
     pub fn flange_pose(&self, q: &[f64]) -> Frame {
+        // All-revolute chains (the common case) run a loop without the per-joint type test.
+        if self.joint_space().any_prismatic() {
+            self.flange_pose_with::<true>(q)
+        } else {
+            self.flange_pose_with::<false>(q)
+        }
+    }
+
+    #[inline(always)]
+    fn flange_pose_with<const MIXED: bool>(&self, q: &[f64]) -> Frame {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut f = *self.base_frame();
         let types = self.joint_types();
         for (i, &qi) in q.iter().enumerate() {
             let l = &self.links()[i];
             let c = self.link_constant(i);
-            let (s, co, d) = joint_motion(types[i], l, qi);
+            let (s, co, d) = joint_motion::<MIXED>(types, i, l, qi);
             match self.convention() {
                 Convention::Mdh => {
                     f *= c;
@@ -66,6 +76,15 @@ impl Robot {
     }
 
     fn chain(&self, q: &[f64]) -> Chain {
+        if self.joint_space().any_prismatic() {
+            self.chain_with::<true>(q)
+        } else {
+            self.chain_with::<false>(q)
+        }
+    }
+
+    #[inline(always)]
+    fn chain_with<const MIXED: bool>(&self, q: &[f64]) -> Chain {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut ch = Chain {
             axis: [Frame::identity(); MAX_JOINTS],
@@ -77,7 +96,7 @@ impl Robot {
         for (i, &qi) in q.iter().enumerate() {
             let l = &self.links()[i];
             let c = self.link_constant(i);
-            let (s, co, d) = joint_motion(types[i], l, qi);
+            let (s, co, d) = joint_motion::<MIXED>(types, i, l, qi);
             match self.convention() {
                 Convention::Mdh => {
                     ch.link[i] = f;
@@ -122,12 +141,15 @@ impl Robot {
         let org = |f: &Frame| -> Vector3<f64> { f.translation.vector };
         if let Some(jq) = jq {
             assert_eq!(jq.len(), n, "joint Jacobian length");
-            let types = self.joint_types();
-            for ((j, f), t) in jq.iter_mut().zip(&ch.axis[..n]).zip(types) {
-                *j = match t {
-                    JointType::Revolute => col(f, 2).cross(&(p - org(f))),
-                    JointType::Prismatic => col(f, 2),
-                };
+            for (j, f) in jq.iter_mut().zip(&ch.axis[..n]) {
+                *j = col(f, 2).cross(&(p - org(f)));
+            }
+            if self.joint_space().any_prismatic() {
+                for ((j, f), t) in jq.iter_mut().zip(&ch.axis[..n]).zip(self.joint_types()) {
+                    if *t == JointType::Prismatic {
+                        *j = col(f, 2);
+                    }
+                }
             }
         }
         let Some(jp) = jp else { return p };
@@ -233,19 +255,22 @@ impl Robot {
     }
 }
 
-/// The joint's rotation (sin, cos) and translation along its axis at joint value `qi`:
-/// `Rz(qi + phi) Tz(d)` for a revolute joint, `Rz(phi) Tz(d + qi)` for a prismatic one.
+/// Joint `i`'s rotation (sin, cos) and translation along its axis at joint value `qi`:
+/// `Rz(qi + phi) Tz(d)` for a revolute joint, `Rz(phi) Tz(d + qi)` for a prismatic one. Without
+/// `MIXED` every joint is revolute (the caller knows) and `types` is not read.
 #[inline(always)]
-fn joint_motion(t: JointType, l: &Link, qi: f64) -> (f64, f64, f64) {
-    match t {
-        JointType::Revolute => {
-            let (s, c) = (qi + l.phi).sin_cos();
-            (s, c, l.d)
-        }
-        JointType::Prismatic => {
-            let (s, c) = l.phi.sin_cos();
-            (s, c, l.d + qi)
-        }
+fn joint_motion<const MIXED: bool>(
+    types: &[JointType],
+    i: usize,
+    l: &Link,
+    qi: f64,
+) -> (f64, f64, f64) {
+    if MIXED && types[i] == JointType::Prismatic {
+        let (s, c) = l.phi.sin_cos();
+        (s, c, l.d + qi)
+    } else {
+        let (s, c) = (qi + l.phi).sin_cos();
+        (s, c, l.d)
     }
 }
 

@@ -38,16 +38,24 @@ impl Twist {
     /// The rigid motion `exp(xi^ theta)`: for `w != 0` Rodrigues' formula for the rotation and
     /// `(I - R)(w x v) + w w^T v theta` for the translation (Murray, Li & Sastry eq. 2.36); for
     /// `w = 0` the translation `v theta` (eq. 2.32).
+    #[inline]
     pub fn exp(&self, theta: f64) -> Frame {
         let w = self.w;
-        if w == Vector3::zeros() {
-            return frame(Matrix3::identity(), self.v * theta);
+        if w.x == 0.0 && w.y == 0.0 && w.z == 0.0 {
+            return self.translation(theta);
         }
         let (s, c) = theta.sin_cos();
         let k = Matrix3::new(0.0, -w.z, w.y, w.z, 0.0, -w.x, -w.y, w.x, 0.0);
         let r = Matrix3::identity() + k * s + k * k * (1.0 - c);
         let p = (Matrix3::identity() - r) * w.cross(&self.v) + w * w.dot(&self.v) * theta;
         frame(r, p)
+    }
+}
+
+impl Twist {
+    #[cold]
+    fn translation(&self, theta: f64) -> Frame {
+        frame(Matrix3::identity(), self.v * theta)
     }
 }
 

@@ -60,6 +60,8 @@ impl JointType {
 pub struct JointSpace {
     types: Vec<JointType>,
     controller: Option<Controller>,
+    /// Whether any joint is prismatic (kept for the kinematics' fast all-revolute path).
+    prismatic: bool,
 }
 
 impl JointSpace {
@@ -68,6 +70,7 @@ impl JointSpace {
         JointSpace {
             types: vec![JointType::Revolute; n],
             controller: None,
+            prismatic: false,
         }
     }
 
@@ -86,7 +89,12 @@ impl JointSpace {
                 ));
             }
         }
-        Ok(JointSpace { types, controller })
+        let prismatic = types.contains(&JointType::Prismatic);
+        Ok(JointSpace {
+            types,
+            controller,
+            prismatic,
+        })
     }
 
     /// Number of joints.
@@ -105,8 +113,9 @@ impl JointSpace {
     }
 
     /// Whether any joint is prismatic.
+    #[inline]
     pub fn any_prismatic(&self) -> bool {
-        self.types.contains(&JointType::Prismatic)
+        self.prismatic
     }
 
     /// Joint `i`'s display unit (degrees or mm).
