@@ -501,7 +501,10 @@ fn a_link_to_a_regular_file_is_written_through() {
     let link = std::fs::symlink_metadata(d.join("link.csv")).unwrap();
     assert!(link.file_type().is_symlink(), "the link was replaced");
     let text = std::fs::read_to_string(d.join("real.csv")).unwrap();
-    assert!(text.starts_with("q1,q2,q3,q4,q5,q6,axis1,axis2,axis3,axis4,axis5,axis6,status"), "{text}");
+    assert!(
+        text.starts_with("q1,q2,q3,q4,q5,q6,axis1,axis2,axis3,axis4,axis5,axis6,status"),
+        "{text}"
+    );
     assert!(temporaries(d).is_empty());
 }
 
@@ -523,7 +526,10 @@ fn dash_is_standard_output_where_it_makes_sense() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let csv = stdout(&o);
-    assert!(csv.starts_with("q1,q2,q3,q4,q5,q6,axis1,axis2,axis3,axis4,axis5,axis6,status"), "{csv}");
+    assert!(
+        csv.starts_with("q1,q2,q3,q4,q5,q6,axis1,axis2,axis3,axis4,axis5,axis6,status"),
+        "{csv}"
+    );
     assert_eq!(csv.lines().count(), 6, "{csv}");
     let err = stderr(&o);
     assert!(err.contains("converged             5"), "{err}");
