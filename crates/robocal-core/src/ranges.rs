@@ -6,6 +6,7 @@
 //! Each limit is generous for real equipment and tight enough that the arithmetic downstream
 //! (squares, sums, sines) keeps its precision; the reason is given beside each.
 
+use crate::error::{Error, Result};
 use crate::model::Unit;
 
 /// A closed interval of accepted values, with the unit and the kind of quantity for messages.
@@ -182,6 +183,15 @@ pub fn fmt_value(v: f64) -> String {
     } else {
         format!("{v}")
     }
+}
+
+/// Checks a setting against its plausible range; `name` names it in the error
+/// ([`Error::Invalid`]).
+pub(crate) fn in_range(name: &str, v: f64, range: &Range) -> Result<()> {
+    range
+        .check(v)
+        .map(|_| ())
+        .map_err(|msg| Error::invalid(name, msg))
 }
 
 #[cfg(test)]

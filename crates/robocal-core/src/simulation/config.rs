@@ -6,7 +6,7 @@ use super::poses::PoseSampler;
 use crate::error::{Error, Result};
 use crate::io::result::FrameVec;
 use crate::model::Robot;
-use crate::ranges;
+use crate::ranges::{self, in_range};
 use serde::{Deserialize, Serialize};
 
 /// The default pose of the tracker in the robot's base frame (mm, deg): 3.8 m away horizontally
@@ -89,14 +89,6 @@ impl Default for SimulationConfig {
             outliers: None,
         }
     }
-}
-
-/// Checks a setting against its plausible range ([`crate::ranges`]); `name` names it.
-pub(crate) fn in_range(name: &str, v: f64, range: &ranges::Range) -> Result<()> {
-    range
-        .check(v)
-        .map(|_| ())
-        .map_err(|msg| Error::invalid(name, msg))
 }
 
 impl SimulationConfig {

@@ -106,7 +106,7 @@ impl GravityModel {
                 format!("{} must be a finite number >= 0", self.payload_kg),
             ));
         }
-        super::config::in_range("--payload-kg", self.payload_kg, &crate::ranges::MASS)?;
+        crate::ranges::in_range("--payload-kg", self.payload_kg, &crate::ranges::MASS)?;
         if self.gravity_m_s2.iter().any(|g| !g.is_finite()) {
             return Err(Error::invalid("gravity", "not a finite vector"));
         }

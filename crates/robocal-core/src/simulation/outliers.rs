@@ -61,7 +61,7 @@ impl OutlierModel {
                     format!("{v} must be a finite distance >= 0"),
                 ));
             }
-            super::config::in_range(name, v, &crate::ranges::SIZE_MM)?;
+            crate::ranges::in_range(name, v, &crate::ranges::SIZE_MM)?;
         }
         if self.min_mm > self.max_mm {
             return Err(Error::invalid(

@@ -57,7 +57,7 @@ impl GeometricErrors {
                     format!("{v} is not a valid standard deviation (must be >= 0)"),
                 ));
             }
-            super::config::in_range(name, v, range)?;
+            crate::ranges::in_range(name, v, range)?;
         }
         Ok(())
     }
