@@ -203,6 +203,17 @@ impl Robot {
         self.links.len()
     }
 
+    /// An upper bound of the chain's reach (mm): `sum(|a_i| + |d_i|)` plus the length of the
+    /// nominal tool translation, at least 1 mm. The scale for "how large is this robot": the
+    /// plausibility gate's limits and the simulator's default footprint are fractions of it
+    /// (4968 mm for the KR 480 R3330 preset, 1224 mm for the UR5 example).
+    pub fn reach_mm(&self) -> f64 {
+        let links: f64 = self.links.iter().map(|l| l.a.abs() + l.d.abs()).sum();
+        let t = &self.tool0;
+        let tool = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
+        (links + tool).max(1.0)
+    }
+
     /// The link parameters (mm, rad).
     pub fn links(&self) -> &[Link] {
         &self.links

@@ -133,12 +133,8 @@ impl SimulationConfig {
     /// chain's total length `sum(|a_i| + |d_i|) + |tool translation|` (an upper bound of its
     /// reach): about 750 mm for the KR 480 R3330, 180 mm for a UR5.
     pub fn footprint_radius(&self, nominal: &Robot) -> f64 {
-        self.footprint_radius_mm.unwrap_or_else(|| {
-            let links: f64 = nominal.links().iter().map(|l| l.a.abs() + l.d.abs()).sum();
-            let t = nominal.tool0();
-            let tool = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
-            FOOTPRINT_FRACTION * (links + tool)
-        })
+        self.footprint_radius_mm
+            .unwrap_or_else(|| FOOTPRINT_FRACTION * nominal.reach_mm())
     }
 
     /// The pose sampler of these settings for `nominal`.

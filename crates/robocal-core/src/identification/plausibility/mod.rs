@@ -168,13 +168,9 @@ pub struct Fit<'a> {
     pub max_iterations: usize,
 }
 
-/// The robot's reach: the chain's total length `sum(|a_i| + |d_i|)` plus the nominal tool's
-/// offset (mm), an upper bound of the distance of the tool from the first axis (at least 1 mm).
+/// The robot's reach ([`Robot::reach_mm`]): the scale of the gate's length limits.
 pub fn reach_mm(robot: &Robot) -> f64 {
-    let links: f64 = robot.links().iter().map(|l| l.a.abs() + l.d.abs()).sum();
-    let t = robot.tool0();
-    let tool = (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt();
-    (links + tool).max(1.0)
+    robot.reach_mm()
 }
 
 /// Whether every joint value is within ±2π "degrees" while the limits span far more: values in
