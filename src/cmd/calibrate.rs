@@ -175,30 +175,8 @@ fn read(
     for r in &set.rows {
         o.check(r.line, &r.q);
     }
-    check_limits(o, nominal_limits, outside)?;
+    common::check_limits(o, nominal_limits, outside)?;
     Ok(split)
-}
-
-/// Refuses rows outside the joint limits (exit code 3), or with `--nominal-limits` warns about
-/// them and keeps them in `outside` for the result.
-pub(super) fn check_limits(
-    o: OutsideLimits,
-    nominal_limits: bool,
-    outside: &mut Vec<OutsideLimits>,
-) -> anyhow::Result<()> {
-    if nominal_limits {
-        if let Some(w) = o.to_warning() {
-            eprintln!("warning: {w} (used anyway: --nominal-limits)");
-            outside.push(o);
-        }
-        return Ok(());
-    }
-    match o.to_error() {
-        None => Ok(()),
-        Some(e) => Err(exit::input(format!(
-            "{e}; if the robot's limits are only nominal, give --nominal-limits to use these rows"
-        ))),
-    }
 }
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {

@@ -1,6 +1,7 @@
 //! Helpers shared by the subcommands.
 
 use anyhow::Context;
+use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::CalibrationResult;
 use robocal_core::{load_robot, Robot};
 use std::path::Path;
@@ -111,4 +112,26 @@ pub fn indent(text: &str) -> String {
         .map(|l| format!("    {l}"))
         .collect::<Vec<_>>()
         .join("\n")
+}
+
+/// Refuses rows outside the joint limits (exit code 3), or with `--nominal-limits` warns about
+/// them and keeps them in `outside` for the result.
+pub fn check_limits(
+    o: OutsideLimits,
+    nominal_limits: bool,
+    outside: &mut Vec<OutsideLimits>,
+) -> anyhow::Result<()> {
+    if nominal_limits {
+        if let Some(w) = o.to_warning() {
+            eprintln!("warning: {w} (used anyway: --nominal-limits)");
+            outside.push(o);
+        }
+        return Ok(());
+    }
+    match o.to_error() {
+        None => Ok(()),
+        Some(e) => Err(crate::exit::input(format!(
+            "{e}; if the robot's limits are only nominal, give --nominal-limits to use these rows"
+        ))),
+    }
 }

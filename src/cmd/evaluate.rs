@@ -124,7 +124,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     }
     let n_outside = outside.count();
     // Refused before anything is written (the per-point writer is dropped).
-    super::calibrate::check_limits(outside, a.nominal_limits, &mut Vec::new())?;
+    super::common::check_limits(outside, a.nominal_limits, &mut Vec::new())?;
     if let Some(w) = per_point {
         w.commit()?;
     }
