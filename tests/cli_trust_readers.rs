@@ -56,23 +56,7 @@ fn args(run: Run, f: &str, d: &Path, fx: &Fixture) -> Vec<String> {
         ReportData => "report RESULT --robot KUKA --data F --out REPORT",
         SimTruth => "simulate --robot KUKA --truth F --poses 5 --out OUT.csv",
     };
-    let out = |name: &str| p(&d.join(name)).to_owned();
-    template
-        .split(' ')
-        .map(|w| match w {
-            "F" => f.to_owned(),
-            "KUKA" => KUKA.to_owned(),
-            "TRUTH" => TRUTH.to_owned(),
-            "DATA" => p(&fx.data).to_owned(),
-            "RESULT" => p(&fx.result).to_owned(),
-            "JOINTS" => p(&fx.joints).to_owned(),
-            "OUT.json" => out("out.json"),
-            "OUT.csv" => out("out.csv"),
-            "PP.csv" => out("per_point.csv"),
-            "REPORT" => out("report"),
-            w => w.to_owned(),
-        })
-        .collect()
+    expand(template, f, d, fx)
 }
 
 /// One bad input file: its name, content, the commands that read it, the exit code and what

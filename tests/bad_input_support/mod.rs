@@ -248,3 +248,26 @@ pub fn expect_failure(label: &str, dir: &Path, args: &[String], code: i32, wants
         );
     }
 }
+
+/// A command line from a template: the words `F` (the bad file), `KUKA`, `TRUTH`, `DATA`,
+/// `RESULT`, `JOINTS` (the fixture's good files) and `OUT.json`, `OUT.csv`, `PP.csv`, `REPORT`
+/// (outputs in the case directory `d`) are replaced; other words are kept.
+pub fn expand(template: &str, f: &str, d: &Path, fx: &Fixture) -> Vec<String> {
+    let out = |name: &str| p(&d.join(name)).to_owned();
+    template
+        .split(' ')
+        .map(|w| match w {
+            "F" => f.to_owned(),
+            "KUKA" => KUKA.to_owned(),
+            "TRUTH" => TRUTH.to_owned(),
+            "DATA" => p(&fx.data).to_owned(),
+            "RESULT" => p(&fx.result).to_owned(),
+            "JOINTS" => p(&fx.joints).to_owned(),
+            "OUT.json" => out("out.json"),
+            "OUT.csv" => out("out.csv"),
+            "PP.csv" => out("per_point.csv"),
+            "REPORT" => out("report"),
+            w => w.to_owned(),
+        })
+        .collect()
+}
