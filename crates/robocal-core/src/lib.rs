@@ -25,6 +25,7 @@ pub mod ranges;
 pub mod registration;
 pub mod simulation;
 pub mod stats;
+pub mod unit;
 
 pub use compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
 pub use error::{Error, Result};

@@ -7,7 +7,7 @@
 //! (squares, sums, sines) keeps its precision; the reason is given beside each.
 
 use crate::error::{Error, Result};
-use crate::model::Unit;
+use crate::unit::Unit;
 
 /// A closed interval of accepted values, with the unit and the kind of quantity for messages.
 #[derive(Debug, Clone, Copy, PartialEq)]

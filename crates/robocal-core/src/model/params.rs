@@ -1,41 +1,6 @@
 //! Parameter identities, names and units.
 
-/// The unit a parameter is shown in at the interfaces.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum Unit {
-    /// Millimetres (stored as millimetres).
-    #[serde(rename = "mm")]
-    Mm,
-    /// Degrees (stored as radians).
-    #[serde(rename = "deg")]
-    Deg,
-}
-
-impl Unit {
-    /// Converts an internal value (mm or rad) to this unit.
-    pub fn from_internal(self, v: f64) -> f64 {
-        match self {
-            Unit::Mm => v,
-            Unit::Deg => v.to_degrees(),
-        }
-    }
-
-    /// Converts a value in this unit to internal units (mm or rad).
-    pub fn to_internal(self, v: f64) -> f64 {
-        match self {
-            Unit::Mm => v,
-            Unit::Deg => v.to_radians(),
-        }
-    }
-
-    /// `"mm"` or `"deg"`.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Unit::Mm => "mm",
-            Unit::Deg => "deg",
-        }
-    }
-}
+pub use crate::unit::Unit;
 
 /// One model parameter. Joint indices are 0-based here and 1-based in names (`Param::D(0)` is
 /// `d1`). Frame-vector components are indexed 0..6 as `x, y, z, a, b, c`.
