@@ -1,5 +1,6 @@
 //! Text tables in the layout of the paper's tables.
 
+use robocal_core::model::family::{self, FamilyId};
 use robocal_core::{Controller, Param, Robot};
 
 /// A number with `decimals` decimals, without a minus sign on zero; `-` when not finite.
@@ -25,62 +26,75 @@ pub fn parameter_table(robot: &Robot, decimals: usize) -> String {
     layout(robot, &|p| num(robot.get_display(p), decimals))
 }
 
-/// The layout of the paper's Table III (rows per joint: alpha, d, a, phi and beta where enabled;
-/// columns B and T with x, y, z in mm and A, B, C in degrees), each cell given by `cell`. A robot
-/// with a prismatic joint gets a column with each joint's type.
+/// The layout of the paper's Table III, built from the parameter families (each cell given by
+/// `cell`): one row per joint with a column per template of every family whose parameters belong
+/// to joints (alpha, d, a, phi, then beta where enabled, then any further family), and a column per
+/// family of frame-vector parameters (B for the base, T for the tool correction) with x, y, z in mm
+/// then A, B, C in degrees. A column shows when some joint has its parameter; a cell is blank
+/// where the robot lacks it. A robot with a prismatic joint gets a column with each joint's type.
 pub fn layout(robot: &Robot, cell: &dyn Fn(Param) -> String) -> String {
     use std::fmt::Write;
     let n = robot.dof();
-    let any_beta = (0..n).any(|i| robot.beta_enabled(i));
+    let all = robot.param_list();
+    // Per-joint columns: (family, template) with a `{j}` template that some joint has.
+    let mut joint_cols: Vec<(FamilyId, u8, String)> = Vec::new();
+    let mut frame_cols: Vec<(FamilyId, u8, &'static str)> = Vec::new();
+    for (id, span) in robot.family_spans() {
+        let fam = family::get(*id);
+        for (t, tpl) in fam.templates().iter().enumerate() {
+            let present = all[span.clone()].iter().find(|p| p.template() == t);
+            let Some(first) = present else { continue };
+            if tpl.contains("{j}") {
+                let title = format!("{} ({})", tpl.replace("{j}", ""), first.unit().as_str());
+                joint_cols.push((*id, t as u8, title));
+            } else {
+                frame_cols.push((*id, t as u8, fam.symbol()));
+            }
+        }
+    }
     let types = robot.joint_space().any_prismatic();
     let mut s = String::new();
     let _ = write!(s, "{:>3}", "i");
     if types {
         let _ = write!(s, " {:>9}", "joint");
     }
-    let _ = write!(
-        s,
-        " {:>13} {:>13} {:>13} {:>13}",
-        "alpha (deg)", "d (mm)", "a (mm)", "phi (deg)"
-    );
-    if any_beta {
-        let _ = write!(s, " {:>13}", "beta (deg)");
+    for (_, _, title) in &joint_cols {
+        let _ = write!(s, " {title:>13}");
     }
-    let _ = writeln!(s, " {:>13} {:>13}", "B", "T");
-    let units = ["mm", "mm", "mm", "deg", "deg", "deg"];
-    for i in 0..n.max(6) {
+    for (_, _, symbol) in &frame_cols {
+        let _ = write!(s, " {symbol:>13}");
+    }
+    s.push('\n');
+    let rows = if frame_cols.is_empty() { n } else { n.max(6) };
+    for i in 0..rows {
         if i < n {
             let _ = write!(s, "{:>3}", i + 1);
             if types {
                 let _ = write!(s, " {:>9}", robot.joint_type(i).as_str());
             }
-            for p in [Param::Alpha(i), Param::D(i), Param::A(i), Param::Phi(i)] {
-                let _ = write!(s, " {:>13}", cell(p));
-            }
-            if any_beta {
-                let b = if robot.beta_enabled(i) {
-                    cell(Param::Beta(i))
+            for (id, t, _) in &joint_cols {
+                let p = Param::new(*id, *t, i as u16);
+                let c = if robot.has_param(p) {
+                    cell(p)
                 } else {
                     String::new()
                 };
-                let _ = write!(s, " {b:>13}");
+                let _ = write!(s, " {c:>13}");
             }
         } else {
             let _ = write!(
                 s,
                 "{:>3}{}",
                 "",
-                " ".repeat(14 * if any_beta { 5 } else { 4 } + if types { 10 } else { 0 })
+                " ".repeat(14 * joint_cols.len() + if types { 10 } else { 0 })
             );
         }
-        if i < 6 {
-            let _ = write!(
-                s,
-                " {:>13} {:>13}  ({})",
-                cell(Param::Base(i)),
-                cell(Param::Tool(i)),
-                units[i]
-            );
+        if i < 6 && !frame_cols.is_empty() {
+            for (id, t, _) in &frame_cols {
+                let _ = write!(s, " {:>13}", cell(Param::new(*id, *t, i as u16)));
+            }
+            let unit = Param::new(frame_cols[0].0, frame_cols[0].1, i as u16).unit();
+            let _ = write!(s, "  ({})", unit.as_str());
         }
         s.push('\n');
     }

@@ -186,7 +186,7 @@ fn exact_data_recover_the_equivalent_truth() {
         assert!((a - b).abs() < 1e-6, "{}: {a} vs {b}", p.name());
     }
     // Fixed parameters keep their nominal value; their true error went elsewhere (d1 -> base_z).
-    let d1 = crate::Param::D(0);
+    let d1 = crate::Param::d(0);
     assert_eq!(tc.equivalent.get(d1), e.config.nominal.get(d1));
     assert!((e.config.truth.get(d1) - e.config.nominal.get(d1)).abs() > 0.5);
     // Verification of exact data: the compensated poses land on the desired positions.

@@ -3,9 +3,9 @@
 //! For the objective `f = sum l(|e_i|)` the estimate is an M-estimator; its covariance is the
 //! sandwich `H^-1 B H^-1` with `H` the objective's Hessian (Gauss–Newton part,
 //! `sum J^T (w (I - u u^T) + l'' u u^T) J`) and `B` the covariance of the gradient. Assuming
-//! isotropic measurement errors, `B = (sum |l'(r_i)|^2 / 3N) sum J^T J`, and a factor
-//! `3N / (3N - k)` corrects for the k fitted parameters. For least squares this is the textbook
-//! `sigma^2 (J^T J)^-1` with `sigma^2 = sum r^2 / (3N - k)`; for the sum of norms and the robust
+//! isotropic measurement errors, `B = (sum |l'(r_i)|^2 / m) sum J^T J` over the m residual rows
+//! (3N for N points), and a factor `m / (m - k)` corrects for the k fitted parameters. For least
+//! squares this is the textbook `sigma^2 (J^T J)^-1` with `sigma^2 = sum r^2 / (m - k)`; for the sum of norms and the robust
 //! losses it accounts for their weights (the plain `(J^T W J)^-1` formula would understate the
 //! spread of a sum-of-norms estimate by about a third).
 
@@ -42,10 +42,11 @@ pub struct Correlation {
 }
 
 impl Covariance {
-    /// The covariance from a full accumulation pass at the solution with `n_points` points.
-    pub fn from_accumulated(params: &[Param], acc: &Accumulated, n_points: usize) -> Covariance {
+    /// The covariance from a full accumulation pass at the solution (its residual rows counted
+    /// in [`Accumulated::rows`]).
+    pub fn from_accumulated(params: &[Param], acc: &Accumulated) -> Covariance {
         let k = params.len();
-        let m = 3 * n_points;
+        let m = acc.rows;
         let dof_factor = if m > k {
             m as f64 / (m - k) as f64
         } else {

@@ -17,6 +17,7 @@
 //! `--free d3` keeps d3 and fixes d2); parameters in `--fix` are left out.
 
 use crate::error::{Error, Result};
+use crate::identification::kinds::ToolState;
 use crate::identification::Observations;
 use crate::model::{Param, Robot};
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -79,8 +80,14 @@ impl Default for IdentifiabilityOptions {
 pub enum FixReason {
     /// Named in `--fix`.
     User,
-    /// Its column is zero: it does not move the tool point (e.g. the tool orientation).
+    /// Its column is zero: it does not move the tool.
     NoEffect,
+    /// It moves only what the measurement kind does not see (the tool orientation, for points).
+    Unseen {
+        /// What it moves and why the measurements miss it, e.g. `tool orientation; points carry
+        /// no orientation`.
+        what: String,
+    },
     /// Its column is (numerically) a combination of identified parameters' columns.
     Duplicate {
         /// The dominant parameters and their coefficients in internal units: a change `dx` of the
@@ -105,13 +112,8 @@ impl FixedParam {
     pub fn describe(&self) -> String {
         match &self.reason {
             FixReason::User => "fixed by --fix".to_string(),
-            FixReason::NoEffect => match self.param {
-                Param::Tool(k) if k >= 3 => {
-                    "no effect on the tool point (tool orientation; points carry no orientation)"
-                        .to_string()
-                }
-                _ => "no effect on the tool point".to_string(),
-            },
+            FixReason::NoEffect => "no effect on the tool point".to_string(),
+            FixReason::Unseen { what } => format!("no effect on the tool point ({what})"),
             FixReason::Duplicate { of, .. } => {
                 let names: Vec<String> = of.iter().map(|(p, _)| p.name()).collect();
                 match names.len() {
@@ -168,68 +170,86 @@ impl Identifiability {
     }
 }
 
-/// The default priority of a robot's parameters (see the module docs); `free` first.
+/// The default priority of a robot's parameters (see the module docs and
+/// [`crate::model::family::priority`]); `free` first.
 pub fn priority_order(robot: &Robot, free: &[Param]) -> Vec<Param> {
     let mut out: Vec<Param> = free.to_vec();
-    let mut push = |p: Param| {
-        if robot.has_param(p) && !out.contains(&p) {
-            out.push(p);
-        }
-    };
-    for k in 0..6 {
-        push(Param::Base(k));
-    }
-    for k in 0..3 {
-        push(Param::Tool(k));
-    }
-    for i in 0..robot.dof() {
-        for p in [
-            Param::Alpha(i),
-            Param::A(i),
-            Param::Beta(i),
-            Param::Phi(i),
-            Param::D(i),
-        ] {
-            push(p);
-        }
-    }
-    for k in 3..6 {
-        push(Param::Tool(k));
-    }
+    let mut rest: Vec<(u32, Param)> = robot
+        .param_list()
+        .iter()
+        .filter(|p| !free.contains(p))
+        .map(|p| (p.family().priority(robot, *p), *p))
+        .collect();
+    rest.sort();
+    out.extend(rest.into_iter().map(|(_, p)| p));
     out
 }
 
-/// The R factor (n x n, n = all parameters) of the stacked identification Jacobian over the poses
-/// of `obs`, computed blockwise (and in parallel for large sets).
-pub fn jacobian_r(robot: &Robot, obs: &Observations) -> DMatrix<f64> {
+/// The stacked identification Jacobian over the poses of `obs`, reduced: its R factor (n x n,
+/// n = all parameters), and each parameter's angular column norm (`sqrt(sum |dw|^2)` over the
+/// poses: how much it turns the tool frame, seen by the measurements or not).
+pub struct Reduced {
+    /// The R factor, `R^T R = J^T J`.
+    pub r: DMatrix<f64>,
+    /// Per parameter, the root sum of squares of its angular columns over the poses.
+    pub angular: Vec<f64>,
+}
+
+/// The R factor (n x n, n = all parameters) of the stacked identification Jacobian over the
+/// observations of `obs` (the rows their measurement kind gives), computed blockwise (and in
+/// parallel for large sets); see [`Reduced`].
+pub fn jacobian_r(robot: &Robot, obs: &Observations) -> Reduced {
     let n = robot.param_count();
+    let kind = obs.kind();
+    let rows = kind.rows();
+    let sees_w = kind.measurability().orientation;
+    let cols: Vec<usize> = (0..n).collect();
     let idx: Vec<usize> = (0..obs.len()).collect();
-    let r_of = |points: &[usize]| -> DMatrix<f64> {
+    let r_of = |points: &[usize]| -> (DMatrix<f64>, Vec<f64>) {
         let mut r = DMatrix::<f64>::zeros(0, n);
+        let mut ang = vec![0.0; n];
         let mut jp = vec![Vector3::zeros(); n];
+        let mut jw = vec![Vector3::zeros(); n];
+        let mut jr = vec![0.0; rows * n];
         for block in points.chunks(BLOCK_POINTS) {
-            let rows = r.nrows() + 3 * block.len();
-            let mut m = DMatrix::<f64>::zeros(rows, n);
-            m.view_mut((0, 0), (r.nrows(), n)).copy_from(&r);
+            let top = r.nrows();
+            let mut m = DMatrix::<f64>::zeros(top + rows * block.len(), n);
+            m.view_mut((0, 0), (top, n)).copy_from(&r);
             for (b, &i) in block.iter().enumerate() {
-                robot.tool_position_jacobians(obs.q(i), None, Some(&mut jp));
-                for (c, v) in jp.iter().enumerate() {
-                    for a in 0..3 {
-                        m[(r.nrows() + 3 * b + a, c)] = v[a];
+                let q = obs.q(i);
+                let point = robot.tool_screw_jacobians(q, None, Some(&mut jp), Some(&mut jw));
+                let tool = ToolState {
+                    point,
+                    rotation: sees_w.then(|| *robot.tool_pose(q).rotation.matrix()),
+                };
+                kind.jacobian_rows(&tool, &jp, sees_w.then_some(&jw[..]), &cols, &mut jr);
+                for a in 0..rows {
+                    for c in 0..n {
+                        m[(top + rows * b + a, c)] = jr[a * n + c];
                     }
+                }
+                for (s, w) in ang.iter_mut().zip(&jw) {
+                    *s += w.norm_squared();
                 }
             }
             r = upper(m);
         }
-        r
+        (r, ang)
     };
-    let parts: Vec<DMatrix<f64>> = if obs.len() > TASK_POINTS {
+    let parts: Vec<(DMatrix<f64>, Vec<f64>)> = if obs.len() > TASK_POINTS {
         idx.par_chunks(TASK_POINTS).map(r_of).collect()
     } else {
         vec![r_of(&idx)]
     };
+    let mut angular = vec![0.0; n];
+    for (_, a) in &parts {
+        for (s, v) in angular.iter_mut().zip(a) {
+            *s += v;
+        }
+    }
     let mut r = parts
         .into_iter()
+        .map(|(r, _)| r)
         .reduce(|a, b| {
             let mut m = DMatrix::zeros(a.nrows() + b.nrows(), n);
             m.view_mut((0, 0), (a.nrows(), n)).copy_from(&a);
@@ -243,7 +263,10 @@ pub fn jacobian_r(robot: &Robot, obs: &Observations) -> DMatrix<f64> {
         p.view_mut((0, 0), (r.nrows(), n)).copy_from(&r);
         r = p;
     }
-    r
+    Reduced {
+        r,
+        angular: angular.into_iter().map(f64::sqrt).collect(),
+    }
 }
 
 /// The upper-triangular factor of a QR decomposition (min(rows, cols) x cols).
@@ -260,13 +283,14 @@ pub fn analyze(
     obs: &Observations,
     opts: &IdentifiabilityOptions,
 ) -> Result<Identifiability> {
-    let all = robot.params();
+    let all = robot.param_list();
     let n = all.len();
-    let r = jacobian_r(robot, obs);
+    let Reduced { r, angular } = jacobian_r(robot, obs);
+    let blind = obs.kind().blind_to_orientation();
     let npts = obs.len().max(1) as f64;
     let norms: Vec<f64> = (0..n).map(|j| r.column(j).norm()).collect();
     let max_norm = norms.iter().cloned().fold(0.0, f64::max);
-    let col = |p: Param| all.iter().position(|q| *q == p).expect("robot parameter");
+    let col = |p: Param| robot.param_position(p).expect("robot parameter");
     let unit = |j: usize| -> DVector<f64> {
         if norms[j] > 0.0 {
             r.column(j) / norms[j]
@@ -292,10 +316,14 @@ pub fn analyze(
         }
         let j = col(p);
         if norms[j] <= 1e-12 * max_norm || norms[j] == 0.0 {
-            fixed.push(FixedParam {
-                param: p,
-                reason: FixReason::NoEffect,
-            });
+            let reason = match blind {
+                // It turns the tool frame, which the measurements do not see.
+                Some(why) if angular[j] > 1e-12 * max_norm => FixReason::Unseen {
+                    what: format!("{} orientation; {why}", p.family().key()),
+                },
+                _ => FixReason::NoEffect,
+            };
+            fixed.push(FixedParam { param: p, reason });
             continue;
         }
         let mut v = unit(j);
@@ -391,9 +419,9 @@ pub fn analyze(
     } else {
         f64::INFINITY
     };
-    let order = |p: &Param| all.iter().position(|q| q == p).unwrap_or(usize::MAX);
-    kept.sort_by_key(|(p, _)| order(p));
-    fixed.sort_by_key(|f| order(&f.param));
+    // Model order is `Param` order.
+    kept.sort_by_key(|(p, _)| *p);
+    fixed.sort_by_key(|f| f.param);
     Ok(Identifiability {
         identified: kept.iter().map(|(p, _)| *p).collect(),
         independence: kept.iter().map(|(_, r)| *r).collect(),

@@ -4,6 +4,7 @@
 //! - [`observations`]: the measured points and their CSV lines;
 //! - [`objective`]: sum of norms (eq. 4), least squares and robust losses;
 //! - [`identifiability`]: which parameters are identifiable, and why the others are fixed;
+//! - [`kinds`]: measurement kinds, the rows each observation contributes;
 //! - [`system`]: the per-point accumulation of the normal equations (the hot loop);
 //! - [`solver`]: Levenberg–Marquardt with reweighting and a termination report;
 //! - [`covariance`]: standard deviations and correlations of the estimates;
@@ -14,6 +15,7 @@
 
 pub mod covariance;
 pub mod identifiability;
+pub mod kinds;
 pub mod objective;
 pub mod observations;
 pub mod pipeline;

@@ -41,6 +41,11 @@ impl Observations {
         }
     }
 
+    /// The measurement kind of these observations (one reflector's point).
+    pub fn kind(&self) -> &'static dyn crate::identification::kinds::MeasurementKind {
+        &crate::identification::kinds::Point
+    }
+
     /// Adds a point: joint values (rad), measured position (mm, tracker frame), CSV line (0 when
     /// the point does not come from a file). Rejects a wrong joint count and non-finite values.
     pub fn push(&mut self, q: &[f64], m: Vector3<f64>, line: usize) -> Result<()> {

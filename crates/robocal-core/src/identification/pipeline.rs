@@ -329,7 +329,7 @@ pub fn calibrate(
 
     progress("uncertainty", 0, 1);
     let acc = problem.accumulate(&robot, &final_loss, Level::Full);
-    let mut covariance = Covariance::from_accumulated(&ident.identified, &acc, cal.len());
+    let mut covariance = Covariance::from_accumulated(&ident.identified, &acc);
     if let Some(why) = ill_conditioned {
         covariance.mark_unavailable(why);
     }

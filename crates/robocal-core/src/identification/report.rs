@@ -105,7 +105,9 @@ impl Calibration {
                 let mut o = json!({"name": f.param.name(), "reason": f.describe()});
                 match &f.reason {
                     FixReason::User => o["kind"] = json!("user"),
-                    FixReason::NoEffect => o["kind"] = json!("no_effect"),
+                    FixReason::NoEffect | FixReason::Unseen { .. } => {
+                        o["kind"] = json!("no_effect")
+                    }
                     FixReason::Duplicate { of, independence } => {
                         o["kind"] = json!("duplicate");
                         o["independence"] = json!(independence);

@@ -1,36 +1,51 @@
 //! The identification problem's hot loop: residuals, IRLS normal equations and the curvature
-//! terms the covariance needs, accumulated point by point.
+//! terms the covariance needs, accumulated observation by observation.
 //!
-//! For point i, `e_i = pose(F) m_i - p(q_i; theta)` (eq. 3 with the measured point mapped into the
-//! ACS). With `J_i = d p(q_i) / d theta` restricted to the identified parameters and the loss
-//! weight `w_i` (see [`Loss`]), the solver needs `A = sum w_i J_i^T J_i` and
-//! `b = sum w_i J_i^T e_i`. They are accumulated per point (k x k and k numbers; the 3N x k
-//! Jacobian is never formed) with per-thread buffers allocated once per pass, so the per-point work
-//! allocates nothing. Large point sets are split across threads with rayon.
+//! For observation i the measurement kind ([`kinds`]) gives its residual rows `e_i` (for a point,
+//! `e_i = pose(F) m_i - p(q_i; theta)`, eq. 3 with the measured point mapped into the ACS) and,
+//! from the parameter families' screws at the tool, the Jacobian rows `J_i` of the model with
+//! respect to the identified parameters. With the loss weight `w_i` of `|e_i|` (see [`Loss`]),
+//! the solver needs `A = sum w_i J_i^T J_i` and `b = sum w_i J_i^T e_i`. They are accumulated
+//! per observation (k x k and k numbers; the stacked Jacobian is never formed) with per-thread
+//! buffers allocated once per pass, so the per-observation work allocates nothing. Large sets are
+//! split across threads with rayon.
 
 use crate::frame::Frame;
+use crate::identification::kinds::{self, MeasurementKind, ToolState};
 use crate::identification::objective::Loss;
 use crate::identification::Observations;
 use crate::model::{Param, Robot, MAX_JOINTS};
-use nalgebra::{DMatrix, DVector, Point3, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 use rayon::prelude::*;
 
 /// Largest number of model parameters (all of `alpha, d, a, phi, beta` for [`MAX_JOINTS`] joints
 /// plus base and tool).
 pub const MAX_PARAMS: usize = 5 * MAX_JOINTS + 12;
 
-/// Below this many points the passes run on one thread.
+/// Below this many observations the passes run on one thread.
 const PARALLEL_MIN_POINTS: usize = 2048;
 
-/// The identification problem: which parameters are unknown and the measured points in the ACS.
-#[derive(Debug, Clone)]
+/// The identification problem: which parameters are unknown, the measurement kind and the
+/// observations' measured values in the ACS.
+#[derive(Clone)]
 pub struct Problem<'a> {
     params: Vec<Param>,
     /// Position of each identified parameter in `robot.params()`.
     index: Vec<usize>,
     obs: &'a Observations,
-    /// `pose(F) m_i`.
-    targets: Vec<Vector3<f64>>,
+    kind: &'static dyn MeasurementKind,
+    /// The kind's targets, `target_len` numbers per observation (for points, `pose(F) m_i`).
+    targets: Vec<f64>,
+}
+
+impl std::fmt::Debug for Problem<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Problem")
+            .field("params", &self.params)
+            .field("kind", &self.kind.key())
+            .field("observations", &self.obs.len())
+            .finish()
+    }
 }
 
 /// How much a pass accumulates.
@@ -62,6 +77,8 @@ pub struct Accumulated {
     pub h: Option<DMatrix<f64>>,
     /// [`Level::Full`] only: `sum (l'(|e_i|))^2`.
     pub psi_sq: f64,
+    /// The number of residual rows summed over (rows per observation times observations).
+    pub rows: usize,
 }
 
 /// Per-thread state of a pass.
@@ -76,15 +93,16 @@ struct Acc {
     b: Vec<f64>,
     s: Vec<f64>,
     h: Vec<f64>,
+    /// Parameter screws at the tool: linear and (when the kind sees orientation) angular parts.
     jp: Vec<Vector3<f64>>,
-    jx: Vec<f64>,
-    jy: Vec<f64>,
-    jz: Vec<f64>,
+    jw: Vec<Vector3<f64>>,
+    /// The observation's Jacobian rows, row-major (rows x k).
+    jr: Vec<f64>,
     u: Vec<f64>,
 }
 
 impl Acc {
-    fn new(k: usize, n_params: usize, level: Level) -> Acc {
+    fn new(k: usize, rows: usize, n_params: usize, angular: bool, level: Level) -> Acc {
         let full = level == Level::Full;
         let newton = level >= Level::Newton;
         Acc {
@@ -99,9 +117,8 @@ impl Acc {
             s: vec![0.0; if full { k * k } else { 0 }],
             h: vec![0.0; if newton { k * k } else { 0 }],
             jp: vec![Vector3::zeros(); n_params],
-            jx: vec![0.0; k],
-            jy: vec![0.0; k],
-            jz: vec![0.0; k],
+            jw: vec![Vector3::zeros(); if angular { n_params } else { 0 }],
+            jr: vec![0.0; rows * k],
             u: vec![0.0; if newton { k } else { 0 }],
         }
     }
@@ -125,58 +142,105 @@ impl Acc {
         self
     }
 
-    /// Adds `c * v v^T` (upper triangle) for v given by the three rows `jx, jy, jz` weighted per
-    /// axis: `sum_axes c_axis * row_axis row_axis^T`.
+    /// Adds observation `i`: its residual rows and Jacobian rows from the kind, then
+    /// `w J^T J`, `w J^T e` (upper triangles) and what the level adds.
     #[inline]
-    fn add_point(&mut self, p: &Problem, robot: &Robot, loss: &Loss, i: usize) {
-        let pos = robot.tool_position_jacobians(p.obs.q(i), None, Some(&mut self.jp));
-        let k = self.k;
-        for (c, &j) in p.index.iter().enumerate() {
-            let v = self.jp[j];
-            self.jx[c] = v.x;
-            self.jy[c] = v.y;
-            self.jz[c] = v.z;
+    fn add_observation(&mut self, p: &Problem, robot: &Robot, loss: &Loss, i: usize) {
+        let rows = p.kind.rows();
+        let angular = !self.jw.is_empty();
+        let point = robot.tool_screw_jacobians(
+            p.obs.q(i),
+            None,
+            Some(&mut self.jp),
+            angular.then_some(&mut self.jw[..]),
+        );
+        let tool = p.tool_state(robot, i, point);
+        let mut e = [0.0; kinds::MAX_ROWS];
+        p.kind.residual(p.target(i), &tool, &mut e[..rows]);
+        p.kind.jacobian_rows(
+            &tool,
+            &self.jp,
+            angular.then_some(&self.jw[..]),
+            &p.index,
+            &mut self.jr,
+        );
+        // Point measurements (3 rows) take a copy of the loop the compiler unrolls.
+        if rows == 3 {
+            self.accumulate(3, &e[..3], loss);
+        } else {
+            self.accumulate(rows, &e[..rows], loss);
         }
-        let e = p.targets[i] - pos;
-        let r = e.norm();
+    }
+
+    /// The accumulation of one observation's rows (`self.jr`, `rows x k`) and residual `e`.
+    #[inline(always)]
+    fn accumulate(&mut self, rows: usize, e: &[f64], loss: &Loss) {
+        let k = self.k;
+        let jr = &self.jr[..rows * k];
+        let mut r2 = 0.0;
+        for v in e {
+            r2 += v * v;
+        }
+        let r = r2.sqrt();
         let w = loss.weight(r);
         self.objective += loss.value(r);
         self.weighted_sq += w * r * r;
-        let (ex, ey, ez) = (w * e.x, w * e.y, w * e.z);
+        let mut we = [0.0; kinds::MAX_ROWS];
+        for (x, v) in we.iter_mut().zip(e) {
+            *x = w * v;
+        }
+        let mut wa = [0.0; kinds::MAX_ROWS];
         for a in 0..k {
-            let (xa, ya, za) = (self.jx[a], self.jy[a], self.jz[a]);
-            self.b[a] += xa * ex + ya * ey + za * ez;
-            let (wx, wy, wz) = (w * xa, w * ya, w * za);
+            let mut s = 0.0;
+            for rr in 0..rows {
+                s += jr[rr * k + a] * we[rr];
+            }
+            self.b[a] += s;
+            for rr in 0..rows {
+                wa[rr] = w * jr[rr * k + a];
+            }
             let row = &mut self.a[a * k..(a + 1) * k];
             for b in a..k {
-                row[b] += wx * self.jx[b] + wy * self.jy[b] + wz * self.jz[b];
+                let mut s = 0.0;
+                for rr in 0..rows {
+                    s += wa[rr] * jr[rr * k + b];
+                }
+                row[b] += s;
             }
         }
         if self.full {
             let psi = w * r;
             self.psi_sq += psi * psi;
             for a in 0..k {
-                let (xa, ya, za) = (self.jx[a], self.jy[a], self.jz[a]);
                 let row = &mut self.s[a * k..(a + 1) * k];
                 for b in a..k {
-                    row[b] += xa * self.jx[b] + ya * self.jy[b] + za * self.jz[b];
+                    let mut s = 0.0;
+                    for rr in 0..rows {
+                        s += jr[rr * k + a] * jr[rr * k + b];
+                    }
+                    row[b] += s;
                 }
             }
         }
-        if self.newton {
-            // Radial correction of the Hessian: (l'' - w) (J^T u)(J^T u)^T.
-            if r > 0.0 {
-                let c = loss.radial_curvature(r) - w;
-                let (ux, uy, uz) = (e.x / r, e.y / r, e.z / r);
-                for a in 0..k {
-                    self.u[a] = self.jx[a] * ux + self.jy[a] * uy + self.jz[a] * uz;
+        // Radial correction of the Hessian: (l'' - w) (J^T u)(J^T u)^T.
+        if self.newton && r > 0.0 {
+            let c = loss.radial_curvature(r) - w;
+            let mut ue = [0.0; kinds::MAX_ROWS];
+            for (x, v) in ue.iter_mut().zip(e) {
+                *x = v / r;
+            }
+            for a in 0..k {
+                let mut s = 0.0;
+                for rr in 0..rows {
+                    s += jr[rr * k + a] * ue[rr];
                 }
-                for a in 0..k {
-                    let ca = c * self.u[a];
-                    let row = &mut self.h[a * k..(a + 1) * k];
-                    for b in a..k {
-                        row[b] += ca * self.u[b];
-                    }
+                self.u[a] = s;
+            }
+            for a in 0..k {
+                let ca = c * self.u[a];
+                let row = &mut self.h[a * k..(a + 1) * k];
+                for b in a..k {
+                    row[b] += ca * self.u[b];
                 }
             }
         }
@@ -195,28 +259,26 @@ fn symmetric(k: usize, upper: &[f64]) -> DMatrix<f64> {
 }
 
 impl<'a> Problem<'a> {
-    /// The problem of identifying `params` of `robot` from `obs`, whose points map into the ACS
-    /// by the tracker frame `frame`. Panics if a parameter is not one of the robot's (the callers
-    /// take them from `robot.params()`).
+    /// The problem of identifying `params` of `robot` from `obs` (of the observations' own
+    /// measurement kind), whose measured values map into the ACS by the tracker frame `frame`.
+    /// Panics if a parameter is not one of the robot's (the callers take them from
+    /// `robot.params()`).
     pub fn new(robot: &Robot, params: &[Param], obs: &'a Observations, frame: &Frame) -> Self {
-        let all = robot.params();
+        let kind = obs.kind();
         let index = params
             .iter()
-            .map(|p| {
-                all.iter()
-                    .position(|q| q == p)
-                    .expect("parameter of the robot")
-            })
+            .map(|p| robot.param_position(*p).expect("parameter of the robot"))
             .collect();
-        let targets = obs
-            .measured()
-            .iter()
-            .map(|m| (frame * Point3::from(*m)).coords)
-            .collect();
+        let tl = kind.target_len();
+        let mut targets = vec![0.0; tl * obs.len()];
+        for (i, t) in targets.chunks_exact_mut(tl.max(1)).enumerate() {
+            kind.target(obs, i, frame, t);
+        }
         Problem {
             params: params.to_vec(),
             index,
             obs,
+            kind,
             targets,
         }
     }
@@ -226,14 +288,53 @@ impl<'a> Problem<'a> {
         &self.params
     }
 
-    /// Number of points.
-    pub fn len(&self) -> usize {
-        self.targets.len()
+    /// The measurement kind.
+    pub fn kind(&self) -> &'static dyn MeasurementKind {
+        self.kind
     }
 
-    /// Whether there are no points.
+    /// Number of observations.
+    pub fn len(&self) -> usize {
+        self.obs.len()
+    }
+
+    /// Whether there are no observations.
     pub fn is_empty(&self) -> bool {
-        self.targets.is_empty()
+        self.obs.is_empty()
+    }
+
+    /// Number of residual rows (rows per observation times observations).
+    pub fn rows(&self) -> usize {
+        self.kind.rows() * self.len()
+    }
+
+    fn target(&self, i: usize) -> &[f64] {
+        let tl = self.kind.target_len();
+        &self.targets[i * tl..(i + 1) * tl]
+    }
+
+    /// The model's tool at observation i, given its tool point.
+    fn tool_state(&self, robot: &Robot, i: usize, point: Vector3<f64>) -> ToolState {
+        let rotation = self
+            .kind
+            .measurability()
+            .orientation
+            .then(|| *robot.tool_pose(self.obs.q(i)).rotation.matrix());
+        ToolState { point, rotation }
+    }
+
+    /// Observation i's residual norm `|e_i|` (mm; forward kinematics only).
+    fn error_norm(&self, robot: &Robot, i: usize) -> f64 {
+        let rows = self.kind.rows();
+        let point = robot.tool_position(self.obs.q(i));
+        let tool = self.tool_state(robot, i, point);
+        let mut e = [0.0; kinds::MAX_ROWS];
+        self.kind.residual(self.target(i), &tool, &mut e[..rows]);
+        let mut r2 = 0.0;
+        for v in &e[..rows] {
+            r2 += v * v;
+        }
+        r2.sqrt()
     }
 
     /// The identified parameters' current values (internal units).
@@ -248,22 +349,14 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// The error vectors `e_i = pose(F) m_i - p(q_i)` (mm).
-    pub fn errors(&self, robot: &Robot) -> Vec<Vector3<f64>> {
-        (0..self.len())
-            .map(|i| self.targets[i] - robot.tool_position(self.obs.q(i)))
-            .collect()
-    }
-
-    /// The error norms `|e_i|` (mm).
+    /// The residual norms `|e_i|` (mm), one per observation.
     pub fn error_norms(&self, robot: &Robot) -> Vec<f64> {
-        self.errors(robot).iter().map(|e| e.norm()).collect()
+        (0..self.len()).map(|i| self.error_norm(robot, i)).collect()
     }
 
     /// The objective `sum l(|e_i|)` (forward kinematics only).
     pub fn objective(&self, robot: &Robot, loss: &Loss) -> f64 {
-        let f =
-            |i: usize| loss.value((self.targets[i] - robot.tool_position(self.obs.q(i))).norm());
+        let f = |i: usize| loss.value(self.error_norm(robot, i));
         if self.len() >= PARALLEL_MIN_POINTS {
             (0..self.len())
                 .into_par_iter()
@@ -275,26 +368,27 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// One pass over the points: objective and IRLS normal equations, and what `level` adds.
+    /// One pass over the observations: objective and IRLS normal equations, and what `level`
+    /// adds.
     pub fn accumulate(&self, robot: &Robot, loss: &Loss, level: Level) -> Accumulated {
         let k = self.params.len();
         let np = robot.param_count();
+        let rows = self.kind.rows();
+        let angular = self.kind.measurability().orientation;
+        let new = || Acc::new(k, rows, np, angular, level);
         let acc = if self.len() >= PARALLEL_MIN_POINTS {
             (0..self.len())
                 .into_par_iter()
                 .with_min_len(512)
-                .fold(
-                    || Acc::new(k, np, level),
-                    |mut acc, i| {
-                        acc.add_point(self, robot, loss, i);
-                        acc
-                    },
-                )
-                .reduce(|| Acc::new(k, np, level), Acc::merge)
+                .fold(new, |mut acc, i| {
+                    acc.add_observation(self, robot, loss, i);
+                    acc
+                })
+                .reduce(new, Acc::merge)
         } else {
-            let mut acc = Acc::new(k, np, level);
+            let mut acc = new();
             for i in 0..self.len() {
-                acc.add_point(self, robot, loss, i);
+                acc.add_observation(self, robot, loss, i);
             }
             acc
         };
@@ -309,6 +403,7 @@ impl<'a> Problem<'a> {
             s,
             h,
             psi_sq: acc.psi_sq,
+            rows: self.rows(),
         }
     }
 }

@@ -88,7 +88,7 @@ fn settings(objective: Objective) -> CalibrationSettings {
 fn random_truth(rng: &mut ChaCha8Rng) -> Robot {
     let mut r = nominal();
     for p in r.params() {
-        if p == Param::D(2) {
+        if p == Param::d(2) {
             continue;
         }
         let (len, ang) = (1.0, 0.05f64.to_radians());
@@ -139,7 +139,7 @@ fn kuka_with_75_random_poses_identifies_26_parameters_and_explains_the_rest() {
     assert_eq!(id.fixed.len(), 10);
     assert!(id.condition_number.is_finite() && id.condition_number > 1.0);
     // The coefficient of an exact duplicate is exact: d1 moves the tool like base_z, one to one.
-    match &id.fixed_reason(Param::D(0)).unwrap().reason {
+    match &id.fixed_reason(Param::d(0)).unwrap().reason {
         FixReason::Duplicate { of, independence } => {
             assert!((of[0].1 - 1.0).abs() < 1e-9, "{of:?}");
             assert!(*independence < 1e-9);
@@ -154,25 +154,25 @@ fn fix_and_free_override_the_choice() {
     let mut rng = ChaCha8Rng::seed_from_u64(2);
     let obs = measure(&nom, &tracker(0.0, 0.0), 75, &mut rng);
     let opts = IdentifiabilityOptions {
-        free: vec![Param::D(2)],
-        fix: vec![Param::A(4)],
+        free: vec![Param::d(2)],
+        fix: vec![Param::a(4)],
         ..Default::default()
     };
     let id = analyze(&nom, &obs, &opts).unwrap();
-    assert!(id.identified.contains(&Param::D(2)));
-    assert!(!id.identified.contains(&Param::D(1)));
+    assert!(id.identified.contains(&Param::d(2)));
+    assert!(!id.identified.contains(&Param::d(1)));
     assert_eq!(
-        id.fixed_reason(Param::D(1)).unwrap().describe(),
+        id.fixed_reason(Param::d(1)).unwrap().describe(),
         "same effect as d3"
     );
     assert_eq!(
-        id.fixed_reason(Param::A(4)).unwrap().describe(),
+        id.fixed_reason(Param::a(4)).unwrap().describe(),
         "fixed by --fix"
     );
     assert_eq!(id.identified.len(), 25);
     // Freeing a parameter that cannot be identified is an error naming it and why.
     let bad = IdentifiabilityOptions {
-        free: vec![Param::D(1), Param::D(2)],
+        free: vec![Param::d(1), Param::d(2)],
         ..Default::default()
     };
     let e = analyze(&nom, &obs, &bad).unwrap_err().to_string();
@@ -181,7 +181,7 @@ fn fix_and_free_override_the_choice() {
         "{e}"
     );
     let bad = IdentifiabilityOptions {
-        free: vec![Param::Tool(4)],
+        free: vec![Param::tool(4)],
         ..Default::default()
     };
     let e = analyze(&nom, &obs, &bad).unwrap_err().to_string();
@@ -361,7 +361,7 @@ fn hayati_beta_captures_the_tilt_between_parallel_axes() {
     // Truth: Table III plus a tilt of axis 3 about y (the 27th parameter MDH lacks).
     let mut truth = table3();
     truth.enable_beta(2).unwrap();
-    truth.set_display(Param::Beta(2), 0.02);
+    truth.set_display(Param::beta(2), 0.02);
     let tr = tracker(0.0, 0.0);
     let mut rng = ChaCha8Rng::seed_from_u64(51);
     let cal = measure(&truth, &tr, 75, &mut rng);
@@ -383,14 +383,14 @@ fn hayati_beta_captures_the_tilt_between_parallel_axes() {
     let beta = run(&nb, &cal, Some(&val), &CalibrationSettings::default());
     let id = &beta.identifiability;
     assert_eq!(id.identified.len(), 27);
-    assert!(id.identified.contains(&Param::Beta(2)));
+    assert!(id.identified.contains(&Param::beta(2)));
     assert_eq!(
-        id.fixed_reason(Param::D(2)).unwrap().describe(),
+        id.fixed_reason(Param::d(2)).unwrap().describe(),
         "same effect as d2"
     );
     assert!(beta.calibration.after_stats().rms_mm < 1e-6);
     assert!(beta.validation.unwrap().after_stats().rms_mm < 1e-6);
-    let b3 = beta.calibrated.get_display(Param::Beta(2));
+    let b3 = beta.calibrated.get_display(Param::beta(2));
     assert!((b3 - 0.02).abs() < 1e-6, "beta3 = {b3}");
 }
 
@@ -423,9 +423,12 @@ fn standard_deviations_match_the_monte_carlo_spread() {
             est.push(
                 params
                     .iter()
-                    .map(|p| match p {
-                        Param::Base(k) => b[*k],
-                        _ => c.calibrated.get(*p),
+                    .map(|p| {
+                        if p.family_id() == crate::model::family::base::ID {
+                            b[p.index()]
+                        } else {
+                            c.calibrated.get(*p)
+                        }
                     })
                     .collect(),
             );
@@ -532,8 +535,8 @@ fn bad_input_is_rejected_with_reasons() {
     );
     let both = CalibrationSettings {
         identifiability: IdentifiabilityOptions {
-            fix: vec![Param::D(1)],
-            free: vec![Param::D(1)],
+            fix: vec![Param::d(1)],
+            free: vec![Param::d(1)],
             ..Default::default()
         },
         ..Default::default()
@@ -651,7 +654,7 @@ fn noise_free_tracked_robot_with_random_errors_is_reproduced_exactly() {
     for _ in 0..2 {
         let mut truth = nom.clone();
         for p in truth.params() {
-            if p == Param::D(3) {
+            if p == Param::d(3) {
                 continue;
             }
             let dv = match p.unit() {
@@ -675,12 +678,12 @@ fn noise_free_tracked_robot_with_random_errors_is_reproduced_exactly() {
         // 26.
         let id = &c.identifiability;
         assert_eq!(id.identified.len(), 28, "{:?}", names(&id.identified));
-        for p in [Param::Alpha(0), Param::D(0), Param::A(0), Param::Phi(0)] {
+        for p in [Param::alpha(0), Param::d(0), Param::a(0), Param::phi(0)] {
             assert!(id.fixed_reason(p).is_some(), "{p} identified");
         }
-        assert!(id.identified.contains(&Param::Alpha(1)));
+        assert!(id.identified.contains(&Param::alpha(1)));
         assert_eq!(
-            id.fixed_reason(Param::D(0)).unwrap().describe(),
+            id.fixed_reason(Param::d(0)).unwrap().describe(),
             "same effect as base_x"
         );
     }

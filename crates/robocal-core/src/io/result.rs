@@ -339,10 +339,8 @@ impl CalibrationResult {
             .check_joint_types(nominal, path, "the result's robot")?;
         let mut r = nominal.clone();
         for name in self.parameters.keys() {
-            if let Some(Param::Beta(i)) = Param::parse(name) {
-                if i < r.dof() {
-                    r.enable_beta(i)?;
-                }
+            if let Some(p) = Param::parse(name) {
+                r.enable_param(p)?;
             }
         }
         for p in r.params() {

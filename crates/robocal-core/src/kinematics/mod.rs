@@ -13,25 +13,16 @@
 
 pub mod poe;
 
-use crate::frame::{euler_axes, Frame};
+use crate::frame::Frame;
+use crate::model::family::{self, PoseFrames};
 use crate::model::{mul_rot_z, Convention, JointType, Link, Robot, MAX_JOINTS};
 use nalgebra::{Matrix3, Point3, Vector3};
-
-/// The frames of one forward pass: for each joint i, the frame whose z axis is joint i's axis
-/// (origin on the axis) and the link frame the next joint builds on.
-struct Chain {
-    /// `axis[i]`: joint i's axis frame (MDH: `F_{i-1} Rx Tx Ry`; DH: `F_{i-1}`).
-    axis: [Frame; MAX_JOINTS],
-    /// `link[i]`: the frame from which link i's constant part is applied (MDH: `F_{i-1}`;
-    /// DH: `F_{i-1} Rz Tz`).
-    link: [Frame; MAX_JOINTS],
-    /// The flange frame `F_n`.
-    flange: Frame,
-}
 
 impl Robot {
     /// The flange frame `pose(B) * T1(q1) * ... * Tn(qn)` (direct DH product).
     pub fn flange_pose(&self, q: &[f64]) -> Frame {
+        let mut buf = [0.0; MAX_JOINTS];
+        let q = self.deflected(q, &mut buf);
         // All-revolute chains (the common case) run a loop without the per-joint type test.
         if self.joint_space().any_prismatic() {
             self.flange_pose_with::<true>(q)
@@ -75,21 +66,50 @@ impl Robot {
         f.rotation * self.tool_frame().translation.vector + f.translation.vector
     }
 
-    fn chain(&self, q: &[f64]) -> Chain {
-        if self.joint_space().any_prismatic() {
+    /// The joint values forward kinematics evaluates: `q` itself, or `q + dq` when a family
+    /// deflects the joints (see [`family::ParameterFamily::add_joint_deflection`]), written to
+    /// `buf`.
+    #[inline]
+    pub fn deflected<'a>(&self, q: &'a [f64], buf: &'a mut [f64; MAX_JOINTS]) -> &'a [f64] {
+        if !self.deflects_joints() {
+            return q;
+        }
+        assert_eq!(q.len(), self.dof(), "joint vector length");
+        let mut dq = [0.0; MAX_JOINTS];
+        for fam in family::all() {
+            if fam.deflects_joints(self) {
+                fam.add_joint_deflection(self, q, &mut dq[..q.len()]);
+            }
+        }
+        for (i, v) in q.iter().enumerate() {
+            buf[i] = v + dq[i];
+        }
+        &buf[..q.len()]
+    }
+
+    /// The frames of one forward pass at joint values `q` (deflected, see
+    /// [`Robot::deflected`]), with the tool point.
+    pub fn pose_frames(&self, q: &[f64]) -> PoseFrames {
+        let mut buf = [0.0; MAX_JOINTS];
+        let q = self.deflected(q, &mut buf);
+        let mut ch = if self.joint_space().any_prismatic() {
             self.chain_with::<true>(q)
         } else {
             self.chain_with::<false>(q)
-        }
+        };
+        let f = &ch.flange;
+        ch.point = f.rotation * self.tool_frame().translation.vector + f.translation.vector;
+        ch
     }
 
     #[inline(always)]
-    fn chain_with<const MIXED: bool>(&self, q: &[f64]) -> Chain {
+    fn chain_with<const MIXED: bool>(&self, q: &[f64]) -> PoseFrames {
         assert_eq!(q.len(), self.dof(), "joint vector length");
-        let mut ch = Chain {
+        let mut ch = PoseFrames {
             axis: [Frame::identity(); MAX_JOINTS],
             link: [Frame::identity(); MAX_JOINTS],
             flange: *self.base_frame(),
+            point: Vector3::zeros(),
         };
         let mut f = *self.base_frame();
         let types = self.joint_types();
@@ -126,107 +146,58 @@ impl Robot {
     ///
     /// Panics if `q`, `jq` or `jp` have the wrong length (programming errors: validate user joint
     /// vectors with [`Robot::check_joints`] first).
+    #[inline]
     pub fn tool_position_jacobians(
         &self,
         q: &[f64],
         jq: Option<&mut [Vector3<f64>]>,
         jp: Option<&mut [Vector3<f64>]>,
     ) -> Vector3<f64> {
+        self.tool_screw_jacobians(q, jq, jp, None)
+    }
+
+    /// [`Robot::tool_position_jacobians`] with, in `jw`, each parameter's angular column: the
+    /// tool frame's angular velocity (rad per internal unit, ACS) under a unit change of the
+    /// parameter. `(jp[k], jw[k])` is parameter k's screw at the tool; every parameter family
+    /// contributes its own (see [`family`]). Joint columns are taken at the deflected joint values
+    /// and treat the deflection as independent of `q`.
+    pub fn tool_screw_jacobians(
+        &self,
+        q: &[f64],
+        jq: Option<&mut [Vector3<f64>]>,
+        jp: Option<&mut [Vector3<f64>]>,
+        mut jw: Option<&mut [Vector3<f64>]>,
+    ) -> Vector3<f64> {
         let n = self.dof();
-        let ch = self.chain(q);
-        let rn = ch.flange.rotation.matrix();
-        let t = self.tool_frame().translation.vector;
-        let p = rn * t + ch.flange.translation.vector;
-        let col = |f: &Frame, k: usize| -> Vector3<f64> { f.rotation.matrix().column(k).into() };
-        let org = |f: &Frame| -> Vector3<f64> { f.translation.vector };
+        let pose = self.pose_frames(q);
+        let p = pose.point;
         if let Some(jq) = jq {
             assert_eq!(jq.len(), n, "joint Jacobian length");
-            for (j, f) in jq.iter_mut().zip(&ch.axis[..n]) {
-                *j = col(f, 2).cross(&(p - org(f)));
+            for (j, f) in jq.iter_mut().zip(&pose.axis[..n]) {
+                let z: Vector3<f64> = f.rotation.matrix().column(2).into();
+                *j = z.cross(&(p - f.translation.vector));
             }
             if self.joint_space().any_prismatic() {
-                for ((j, f), t) in jq.iter_mut().zip(&ch.axis[..n]).zip(self.joint_types()) {
+                for ((j, f), t) in jq.iter_mut().zip(&pose.axis[..n]).zip(self.joint_types()) {
                     if *t == JointType::Prismatic {
-                        *j = col(f, 2);
+                        *j = f.rotation.matrix().column(2).into();
                     }
                 }
             }
         }
         let Some(jp) = jp else { return p };
         assert_eq!(jp.len(), self.param_count(), "parameter Jacobian length");
-        let mut k = 0;
-        // alpha_i: rotation about the x axis of the link frame the constant part starts from,
-        // through its origin (MDH: Rx comes first) or that origin moved by a (DH: Tx(a) Rx).
-        for i in 0..n {
-            let f = &ch.link[i];
-            let o = match self.convention() {
-                Convention::Mdh => org(f),
-                Convention::Dh => org(f) + col(f, 0) * self.links()[i].a,
-            };
-            jp[k] = col(f, 0).cross(&(p - o));
-            k += 1;
+        if let Some(jw) = jw.as_deref() {
+            assert_eq!(jw.len(), jp.len(), "angular Jacobian length");
         }
-        // d_i: translation along the joint axis.
-        for i in 0..n {
-            jp[k] = col(&ch.axis[i], 2);
-            k += 1;
+        for (id, span) in self.family_spans() {
+            family::get(*id).columns(
+                self,
+                &pose,
+                &mut jp[span.clone()],
+                jw.as_deref_mut().map(|w| &mut w[span.clone()]),
+            );
         }
-        // a_i: translation along the x axis of the link frame.
-        for i in 0..n {
-            jp[k] = col(&ch.link[i], 0);
-            k += 1;
-        }
-        // phi_i: rotation about the joint axis (the joint value's column for a revolute joint).
-        for i in 0..n {
-            jp[k] = col(&ch.axis[i], 2).cross(&(p - org(&ch.axis[i])));
-            k += 1;
-        }
-        // beta_i (enabled only): rotation about the y axis after Rx(alpha) Tx(a).
-        for i in 0..n {
-            if !self.beta_enabled(i) {
-                continue;
-            }
-            let (y, o) = match self.convention() {
-                // M_i = F_{i-1} Rx Tx Ry: its y axis is unchanged by Ry; its origin is the pivot.
-                Convention::Mdh => (col(&ch.axis[i], 1), org(&ch.axis[i])),
-                // F_i = N Tx Rx Ry: y unchanged by Ry; origin of F_i is the pivot.
-                // F_i = N Tx Rx Ry: y unchanged by Ry; origin of F_i is the pivot. F_i is the
-                // axis frame of joint i+1, or the flange for the last joint.
-                Convention::Dh => {
-                    let fi = if i + 1 < n {
-                        &ch.axis[i + 1]
-                    } else {
-                        &ch.flange
-                    };
-                    (col(fi, 1), org(fi))
-                }
-            };
-            jp[k] = y.cross(&(p - o));
-            k += 1;
-        }
-        // base: translations along the ACS axes, rotations about the Euler axes through b.
-        let b = self.base();
-        let bo = Vector3::new(b[0], b[1], b[2]);
-        for e in 0..3 {
-            let mut v = Vector3::zeros();
-            v[e] = 1.0;
-            jp[k] = v;
-            k += 1;
-        }
-        for ax in euler_axes(b[3], b[4]) {
-            jp[k] = ax.cross(&(p - bo));
-            k += 1;
-        }
-        // tool: translations along the flange axes; orientation does not move the point.
-        for e in 0..3 {
-            jp[k] = rn.column(e).into();
-            k += 1;
-        }
-        for _ in 0..3 {
-            jp[k] = Vector3::zeros();
-            k += 1;
-        }
-        debug_assert_eq!(k, jp.len());
         p
     }
 
@@ -234,7 +205,7 @@ impl Robot {
     /// origin of its axis frame (a point on the axis; for a prismatic joint, where its motion
     /// starts: the frame before the joint's translation).
     pub fn joint_axes(&self, q: &[f64]) -> Vec<(Vector3<f64>, Vector3<f64>)> {
-        let ch = self.chain(q);
+        let ch = self.pose_frames(q);
         ch.axis[..self.dof()]
             .iter()
             .map(|f| (f.rotation.matrix().column(2).into(), f.translation.vector))
@@ -244,7 +215,7 @@ impl Robot {
     /// Joint `i`'s axis (0-based) at joint values `q`: as one entry of [`Robot::joint_axes`],
     /// without allocating.
     pub(crate) fn joint_axis(&self, q: &[f64], i: usize) -> (Vector3<f64>, Vector3<f64>) {
-        let f = &self.chain(q).axis[i];
+        let f = &self.pose_frames(q).axis[i];
         (f.rotation.matrix().column(2).into(), f.translation.vector)
     }
 

@@ -45,7 +45,7 @@ fn random_robot(rng: &mut ChaCha8Rng, conv: Convention, n: usize, betas: bool) -
     }
     for k in 0..6 {
         r.set(
-            Param::Tool(k),
+            Param::tool(k),
             rng.gen_range(-2.0..2.0) * if k < 3 { 1.0 } else { 0.01 },
         );
     }
@@ -83,9 +83,9 @@ fn kuka_has_36_parameters_with_paper_names() {
     assert_eq!(names[24], "base_x");
     assert_eq!(names[35], "tool_c");
     let t3 = preset("kuka-kr480-r3330-table3").unwrap();
-    assert!((t3.get_display(Param::D(0)) - 1044.237).abs() < 1e-12);
-    assert!((t3.get_display(Param::Base(3)) + 0.0497).abs() < 1e-12);
-    assert!((t3.get_display(Param::Tool(1)) + 0.4149).abs() < 1e-12);
+    assert!((t3.get_display(Param::d(0)) - 1044.237).abs() < 1e-12);
+    assert!((t3.get_display(Param::base(3)) + 0.0497).abs() < 1e-12);
+    assert!((t3.get_display(Param::tool(1)) + 0.4149).abs() < 1e-12);
 }
 
 #[test]
@@ -261,7 +261,7 @@ fn prismatic_joint_adds_to_d_and_leaves_phi_constant() {
         let q = random_q_for(&mut rng, &r);
         // The same chain with the joint value moved into d2 and joint 2 held at 0.
         let mut moved = r.clone();
-        moved.set(Param::D(1), r.get(Param::D(1)) + q[1]);
+        moved.set(Param::d(1), r.get(Param::d(1)) + q[1]);
         let mut q0 = q.clone();
         q0[1] = 0.0;
         let d = (r.tool_position(&q) - moved.tool_position(&q0)).norm();
@@ -358,7 +358,7 @@ fn jacobians_match_finite_differences_with_prismatic_joints() {
                 if r.joint_type(i) == JointType::Prismatic {
                     // A prismatic column is the unit axis: the d column of the same row.
                     assert!((jq[i].norm() - 1.0).abs() < 1e-12);
-                    let k = params.iter().position(|x| *x == Param::D(i)).unwrap();
+                    let k = params.iter().position(|x| *x == Param::d(i)).unwrap();
                     assert!((jq[i] - jp[k]).norm() < 1e-12);
                 }
             }

@@ -10,12 +10,14 @@
 //! `sin_cos` per joint; every mutation goes through [`Robot::set`] which keeps the cache valid.
 
 pub mod controller;
+pub mod family;
 mod joints;
 mod params;
 pub mod presets;
 pub mod robot_file;
 
 pub use controller::{Controller, Coupling};
+pub use family::{FamilyId, ParameterFamily, PoseFrames};
 pub use joints::{JointSpace, JointType};
 pub use params::{Param, Unit};
 
@@ -101,10 +103,18 @@ pub struct Robot {
     base: [f64; 6],
     tool0: [f64; 6],
     tool: [f64; 6],
+    /// Values of the parameter families that are not part of the link table, by family key.
+    family_store: std::collections::BTreeMap<String, Vec<f64>>,
     // Caches derived from the above (kept valid by every mutator).
     link_const: Vec<Frame>,
     base_frame: Frame,
     tool_frame: Frame,
+    /// Every parameter, in model order (ascending `Param` order).
+    param_list: Vec<Param>,
+    /// Per family with parameters on this robot: its id and its range in `param_list`.
+    family_spans: Vec<(FamilyId, std::ops::Range<usize>)>,
+    /// Whether some family deflects the joints.
+    deflects: bool,
 }
 
 impl Robot {
@@ -165,9 +175,13 @@ impl Robot {
             base,
             tool0,
             tool: [0.0; 6],
+            family_store: Default::default(),
             link_const: Vec::new(),
             base_frame: Frame::identity(),
             tool_frame: Frame::identity(),
+            param_list: Vec::new(),
+            family_spans: Vec::new(),
+            deflects: false,
         };
         r.refresh();
         Ok(r)
@@ -176,6 +190,17 @@ impl Robot {
     fn refresh(&mut self) {
         self.link_const = self.links.iter().map(link_constant).collect();
         self.base_frame = frame::pose(&self.base);
+        self.refresh_tool();
+        self.refresh_params();
+    }
+
+    /// Recomputes link `i`'s constant part after one of its parameters changed.
+    fn refresh_link(&mut self, i: usize) {
+        self.link_const[i] = link_constant(&self.links[i]);
+    }
+
+    /// Recomputes the tool frame after T changed.
+    fn refresh_tool(&mut self) {
         let mut t = self.tool0;
         for (k, v) in t.iter_mut().enumerate() {
             *v += self.tool[k];
@@ -183,6 +208,25 @@ impl Robot {
         self.tool_frame = frame::pose(&t);
     }
 
+    /// Rebuilds the parameter list after the set of parameters changed (a tilt enabled, a
+    /// family's values stored).
+    fn refresh_params(&mut self) {
+        let mut list = Vec::with_capacity(5 * self.dof() + 12);
+        let mut spans = Vec::new();
+        let mut deflects = false;
+        for (k, fam) in family::all().iter().enumerate() {
+            let start = list.len();
+            fam.params(self, &mut list);
+            if list.len() > start {
+                spans.push((FamilyId::new(k), start..list.len()));
+            }
+            deflects |= fam.deflects_joints(self);
+        }
+        debug_assert!(list.windows(2).all(|w| w[0] < w[1]), "model order");
+        self.param_list = list;
+        self.family_spans = spans;
+        self.deflects = deflects;
+    }
     /// The robot's name (preset name or the `name` of its file).
     pub fn name(&self) -> &str {
         &self.name
@@ -340,6 +384,7 @@ impl Robot {
             ));
         }
         self.beta_enabled[i] = true;
+        self.refresh_params();
         Ok(())
     }
 
@@ -364,28 +409,74 @@ impl Robot {
                 }
             }
         }
+        self.refresh_params();
         out
     }
 
     /// Every parameter of the model, in the DESIGN.md order: `alpha1..n, d1..n, a1..n, phi1..n`,
     /// then enabled `beta`s, then `base_x..base_c`, `tool_x..tool_c` (36 for six joints without
-    /// beta, as in the paper).
+    /// beta, as in the paper), then the parameters of any further family (see [`family`]).
     pub fn params(&self) -> Vec<Param> {
-        let n = self.dof();
-        let mut v = Vec::with_capacity(4 * n + 12);
-        v.extend((0..n).map(Param::Alpha));
-        v.extend((0..n).map(Param::D));
-        v.extend((0..n).map(Param::A));
-        v.extend((0..n).map(Param::Phi));
-        v.extend((0..n).filter(|&i| self.beta_enabled[i]).map(Param::Beta));
-        v.extend((0..6).map(Param::Base));
-        v.extend((0..6).map(Param::Tool));
-        v
+        self.param_list.clone()
+    }
+
+    /// The parameters as a slice (see [`Robot::params`]).
+    pub fn param_list(&self) -> &[Param] {
+        &self.param_list
     }
 
     /// Number of parameters ([`Robot::params`]`.len()`).
     pub fn param_count(&self) -> usize {
-        4 * self.dof() + self.beta_enabled.iter().filter(|b| **b).count() + 12
+        self.param_list.len()
+    }
+
+    /// The position of `p` in [`Robot::params`] (a binary search: the list is in `Param`
+    /// order), or `None` when this model lacks it.
+    pub fn param_position(&self, p: Param) -> Option<usize> {
+        self.param_list.binary_search(&p).ok()
+    }
+
+    /// The families with parameters on this robot and each one's range in [`Robot::params`].
+    pub fn family_spans(&self) -> &[(FamilyId, std::ops::Range<usize>)] {
+        &self.family_spans
+    }
+
+    /// Whether some family deflects the joints (forward kinematics then evaluates `q + dq`).
+    pub fn deflects_joints(&self) -> bool {
+        self.deflects
+    }
+
+    /// The values a family keeps in the robot's family store (families beyond the link table
+    /// and the frames), if it has any.
+    pub fn family_values(&self, key: &str) -> Option<&[f64]> {
+        self.family_store.get(key).map(Vec::as_slice)
+    }
+
+    /// Stores (or, with `None`, removes) a family's values (internal units); the family then
+    /// derives its parameters from them. Checks that the values are finite.
+    pub fn set_family_values(&mut self, key: &str, values: Option<Vec<f64>>) -> Result<()> {
+        match values {
+            Some(v) => {
+                if let Some(k) = v.iter().position(|x| !x.is_finite()) {
+                    return Err(Error::invalid(
+                        format!("{key} value {}", k + 1),
+                        "not a finite number",
+                    ));
+                }
+                self.family_store.insert(key.to_owned(), v);
+            }
+            None => {
+                self.family_store.remove(key);
+            }
+        }
+        self.refresh_params();
+        Ok(())
+    }
+
+    /// A mutable view of a family's stored values, for the family's own `set`. The number of
+    /// values must not change (the parameter list is derived from it).
+    pub fn family_values_mut(&mut self, key: &str) -> Option<&mut [f64]> {
+        self.family_store.get_mut(key).map(Vec::as_mut_slice)
     }
 
     /// Looks a parameter up by its name (`alpha1`, `d2`, `beta3`, `base_x`, `tool_c`, ...).
@@ -395,7 +486,7 @@ impl Robot {
             _ => Err(Error::UnknownParameter {
                 name: name.to_owned(),
                 known: self
-                    .params()
+                    .param_list
                     .iter()
                     .map(|p| p.name())
                     .collect::<Vec<_>>()
@@ -404,54 +495,29 @@ impl Robot {
         }
     }
 
+    /// Makes `p` a parameter of this model if its family allows (a Hayati tilt of an existing
+    /// joint; see [`ParameterFamily::enable`]); else does nothing.
+    pub fn enable_param(&mut self, p: Param) -> Result<()> {
+        p.family().enable(self, p)
+    }
+
     /// Whether the parameter exists in this model.
     pub fn has_param(&self, p: Param) -> bool {
-        match p {
-            Param::Alpha(i) | Param::D(i) | Param::A(i) | Param::Phi(i) => i < self.dof(),
-            Param::Beta(i) => i < self.dof() && self.beta_enabled[i],
-            Param::Base(k) | Param::Tool(k) => k < 6,
-        }
+        self.param_position(p).is_some()
     }
 
     /// A parameter's value in internal units (mm or radians). For `tool_*` this is the correction
-    /// T, not T0 + T.
+    /// T, not T0 + T. (A Hayati tilt that is not enabled reads as its value in the link table,
+    /// zero unless set.)
     pub fn get(&self, p: Param) -> f64 {
-        match p {
-            Param::Alpha(i) => self.links[i].alpha,
-            Param::D(i) => self.links[i].d,
-            Param::A(i) => self.links[i].a,
-            Param::Phi(i) => self.links[i].phi,
-            Param::Beta(i) => self.links[i].beta,
-            Param::Base(k) => self.base[k],
-            Param::Tool(k) => self.tool[k],
-        }
+        p.family().get(self, p)
     }
 
     /// Sets a parameter in internal units (mm or radians). Panics if `p` is not a parameter of
     /// this robot (a programming error; names from users go through [`Robot::param_by_name`]).
     pub fn set(&mut self, p: Param, value: f64) {
-        match p {
-            Param::Alpha(i) => self.links[i].alpha = value,
-            Param::D(i) => self.links[i].d = value,
-            Param::A(i) => self.links[i].a = value,
-            Param::Phi(i) => self.links[i].phi = value,
-            Param::Beta(i) => self.links[i].beta = value,
-            Param::Base(k) => self.base[k] = value,
-            Param::Tool(k) => self.tool[k] = value,
-        }
-        match p {
-            Param::Alpha(i) | Param::D(i) | Param::A(i) | Param::Phi(i) | Param::Beta(i) => {
-                self.link_const[i] = link_constant(&self.links[i])
-            }
-            Param::Base(_) => self.base_frame = frame::pose(&self.base),
-            Param::Tool(_) => {
-                let mut t = self.tool0;
-                for (k, v) in t.iter_mut().enumerate() {
-                    *v += self.tool[k];
-                }
-                self.tool_frame = frame::pose(&t);
-            }
-        }
+        debug_assert!(self.has_param(p), "{p} is not a parameter of this robot");
+        p.family().set(self, p, value)
     }
 
     /// A parameter's value in display units (mm or degrees).
@@ -477,7 +543,7 @@ impl Robot {
 
     /// All parameter values in internal units, in [`Robot::params`] order.
     pub fn values(&self) -> Vec<f64> {
-        self.params().into_iter().map(|p| self.get(p)).collect()
+        self.param_list.iter().map(|p| self.get(*p)).collect()
     }
 
     /// Sets all parameters from `values` (internal units, [`Robot::params`] order).
@@ -490,7 +556,7 @@ impl Robot {
             ));
         }
         for (p, v) in ps.into_iter().zip(values) {
-            self.set(p, *v);
+            p.family().set(self, p, *v);
         }
         Ok(())
     }

@@ -96,8 +96,8 @@ pub fn preset(name: &str) -> Result<Robot> {
         "kuka-kr480-r3330-table3" => {
             let mut r = kr480(name, &KR480_TABLE3);
             for k in 0..6 {
-                r.set_display(Param::Base(k), KR480_TABLE3_B[k]);
-                r.set_display(Param::Tool(k), KR480_TABLE3_T[k]);
+                r.set_display(Param::base(k), KR480_TABLE3_B[k]);
+                r.set_display(Param::tool(k), KR480_TABLE3_T[k]);
             }
             Ok(r)
         }

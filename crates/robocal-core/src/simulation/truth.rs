@@ -213,7 +213,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         let t = e.apply(&nominal, &mut rng).unwrap();
         assert!(t.beta_enabled(2), "axes 2 and 3 are parallel");
-        assert_ne!(t.get(Param::Beta(2)), 0.0);
+        assert_ne!(t.get(Param::beta(2)), 0.0);
         assert_eq!(t.param_count(), 37);
         check_truth_matches(&nominal, &t).unwrap();
     }

@@ -164,10 +164,8 @@ impl TruthFile {
         let mut r = nominal.clone();
         r.set_name(self.robot.name.clone());
         for name in self.parameters.keys() {
-            if let Some(Param::Beta(i)) = Param::parse(name) {
-                if i < r.dof() {
-                    r.enable_beta(i)?;
-                }
+            if let Some(p) = Param::parse(name) {
+                r.enable_param(p)?;
             }
         }
         for (name, e) in &self.parameters {
@@ -228,7 +226,7 @@ mod tests {
         let p = Path::new("t.truth.json");
         let tf = table3_file();
         let r = tf.truth_robot(&nominal, p).unwrap();
-        assert_eq!(r.get_display(Param::D(3)), 1525.997);
+        assert_eq!(r.get_display(Param::d(3)), 1525.997);
         assert_eq!(r.name(), "kuka-kr480-r3330-table3");
 
         let mut missing = tf.clone();

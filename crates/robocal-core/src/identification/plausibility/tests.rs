@@ -311,7 +311,7 @@ fn parameter_move_checks_catch_lengths_and_angles_beyond_calibration() {
         })
     };
     let mut moved = c.calibrated.clone();
-    moved.set(Param::A(2), moved.get(Param::A(2)) + 300.0);
+    moved.set(Param::a(2), moved.get(Param::a(2)) + 300.0);
     let p = assess_with(&moved);
     let k = p
         .checks
@@ -322,8 +322,8 @@ fn parameter_move_checks_catch_lengths_and_angles_beyond_calibration() {
     assert!(k.cause.as_deref().unwrap().contains("hardly determine"));
     let mut turned = c.calibrated.clone();
     turned.set(
-        Param::Phi(1),
-        turned.get(Param::Phi(1)) + 20f64.to_radians(),
+        Param::phi(1),
+        turned.get(Param::phi(1)) + 20f64.to_radians(),
     );
     let p = assess_with(&turned);
     let k = p
@@ -336,8 +336,8 @@ fn parameter_move_checks_catch_lengths_and_angles_beyond_calibration() {
     // A full turn is no move.
     let mut wrapped = c.calibrated.clone();
     wrapped.set(
-        Param::Phi(1),
-        wrapped.get(Param::Phi(1)) + std::f64::consts::TAU,
+        Param::phi(1),
+        wrapped.get(Param::phi(1)) + std::f64::consts::TAU,
     );
     assert!(assess_with(&wrapped).passed());
 }
