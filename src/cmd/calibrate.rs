@@ -555,7 +555,8 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
         println!("  {:<8} fixed: {}", f.param.name(), f.describe());
     }
     println!();
-    let fixed = |p: Param| !c.covariance.identifies(p);
+    let pv = c.param_vector();
+    let entry = |p: Param| pv.get(p).expect("a parameter of the calibrated robot");
     println!(
         "Table III. Calibrated parameters of the robot (* fixed at its nominal value){partial}"
     );
@@ -563,7 +564,7 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
         "{}",
         layout(&c.calibrated, &|p| {
             let v = num(c.calibrated.get_display(p), 4);
-            if fixed(p) {
+            if !entry(p).identified() {
                 format!("{v}*")
             } else {
                 format!("{v} ")
@@ -573,10 +574,13 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
     println!("Standard deviations (same layout; - fixed, n/a unavailable)");
     print!(
         "{}",
-        layout(&c.calibrated, &|p| match c.covariance.std_of(p) {
-            Some(sd) => format!("{:.4} ", p.unit().from_internal(sd)),
-            None if c.covariance.identifies(p) => "n/a ".to_string(),
-            None => "- ".to_string(),
+        layout(&c.calibrated, &|p| {
+            let e = entry(p);
+            match e.std {
+                Some(sd) => format!("{:.4} ", e.display(sd)),
+                None if e.identified() => "n/a ".to_string(),
+                None => "- ".to_string(),
+            }
         })
     );
     let corr = c.covariance.most_correlated(5);

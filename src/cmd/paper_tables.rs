@@ -79,13 +79,11 @@ pub fn parameter_table(exp: &Experiment) -> String {
         "{:<13}{:>11}{:>13}{:>13}{:>14}{:>10}{:>12}",
         "", "(Table I)", "Table III", "same params", "", "", "- true"
     );
+    let pv = cal.param_vector();
     for p in cfg.nominal.params() {
         let d = 4;
-        let unit = match p.unit() {
-            Unit::Mm => "mm",
-            Unit::Deg => "deg",
-        };
-        let sd = cal.covariance.std_of(p).map(|v| p.unit().from_internal(v));
+        let unit = p.unit().as_str();
+        let sd = pv.get(p).and_then(|e| e.std.map(|v| e.display(v)));
         let c = exp.calibrated.get_display(p);
         let t = eq.get_display(p);
         let mut err = c - t;

@@ -317,9 +317,9 @@ pub fn analyze(
         let j = col(p);
         if norms[j] <= 1e-12 * max_norm || norms[j] == 0.0 {
             let reason = match blind {
-                // It turns the tool frame, which the measurements do not see.
+                // It only turns the tool frame, which the measurements do not see.
                 Some(why) if angular[j] > 1e-12 * max_norm => FixReason::Unseen {
-                    what: format!("{} orientation; {why}", p.family().key()),
+                    what: format!("tool orientation; {why}"),
                 },
                 _ => FixReason::NoEffect,
             };

@@ -7,6 +7,7 @@
 //! - [`kinds`]: measurement kinds, the rows each observation contributes;
 //! - [`system`]: the per-point accumulation of the normal equations (the hot loop);
 //! - [`solver`]: Levenberg–Marquardt with reweighting and a termination report;
+//! - [`param_vector`]: every parameter with its name, unit, family, values and verdicts;
 //! - [`covariance`]: standard deviations and correlations of the estimates;
 //! - [`pipeline`]: registration + all of the above ([`calibrate`]);
 //! - [`plausibility`]: the gate run after every fit (units, handedness, nominal error, parameter
@@ -18,6 +19,7 @@ pub mod identifiability;
 pub mod kinds;
 pub mod objective;
 pub mod observations;
+pub mod param_vector;
 pub mod pipeline;
 pub mod plausibility;
 pub mod report;
@@ -36,6 +38,7 @@ pub use identifiability::{
 };
 pub use objective::{Loss, Objective, RobustLoss};
 pub use observations::{split_measurements, Observations, SplitData};
+pub use param_vector::{ParamEntry, ParamVector};
 pub use pipeline::{
     calibrate, Calibration, CalibrationData, CalibrationSettings, DownWeighted, SetErrors, Stage,
 };

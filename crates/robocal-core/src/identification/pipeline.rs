@@ -17,6 +17,7 @@ use crate::identification::identifiability::{
 use crate::identification::objective::{
     Loss, Objective, RobustLoss, CHI3_MEDIAN, ROBUST_SCALE_SIGMAS, SUM_OF_NORMS_SMOOTHING_MM,
 };
+use crate::identification::param_vector::ParamVector;
 use crate::identification::plausibility::{self, Plausibility};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
@@ -153,6 +154,16 @@ impl Calibration {
     /// The last solver run.
     pub fn solver(&self) -> &SolverReport {
         &self.stages.last().expect("at least one stage").report
+    }
+
+    /// Every parameter with its values and verdicts (see [`ParamVector`]).
+    pub fn param_vector(&self) -> ParamVector {
+        ParamVector::of_calibration(
+            &self.nominal,
+            &self.calibrated,
+            &self.identifiability,
+            &self.covariance,
+        )
     }
 }
 

@@ -105,7 +105,10 @@ fn the_registry_positions_are_the_families_ids() {
             assert_eq!(Param::parse(&p.name()), Some(p));
         }
     }
-    assert_eq!(super::by_key("link").map(|(id, _)| id), Some(super::link::ID));
+    assert_eq!(
+        super::by_key("link").map(|(id, _)| id),
+        Some(super::link::ID)
+    );
 }
 
 #[test]
@@ -142,7 +145,11 @@ fn joint_offsets_move_the_chain_like_phi() {
 /// skew-symmetric part (accurate for tiny angles, unlike the angle's arc cosine).
 fn rotvec(a: &Frame, b: &Frame) -> Vector3<f64> {
     let m = a.rotation.matrix() * b.rotation.matrix().transpose();
-    Vector3::new(m[(2, 1)] - m[(1, 2)], m[(0, 2)] - m[(2, 0)], m[(1, 0)] - m[(0, 1)]) * 0.5
+    Vector3::new(
+        m[(2, 1)] - m[(1, 2)],
+        m[(0, 2)] - m[(2, 0)],
+        m[(1, 0)] - m[(0, 1)],
+    ) * 0.5
 }
 
 /// Every column of every family, linear and angular, against central differences of the tool
@@ -153,8 +160,12 @@ fn every_screw_column_matches_central_differences() {
     let mut kuka = offsets(&preset("kuka-kr480-r3330-table3").unwrap(), &[0.1; 6]);
     kuka.enable_beta(2).unwrap();
     kuka.set_family_values(KEY, Some(vec![0.002; 6])).unwrap();
-    let track_file = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/kr480-track.toml");
-    let track = crate::model::robot_file::load_robot_file(std::path::Path::new(track_file)).unwrap();
+    let track_file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../examples/kr480-track.toml"
+    );
+    let track =
+        crate::model::robot_file::load_robot_file(std::path::Path::new(track_file)).unwrap();
     assert_eq!(track.joint_type(0), JointType::Prismatic);
     let track = offsets(&track, &[0.1; 7]);
     for robot in [kuka, track] {
@@ -218,14 +229,28 @@ fn calibration_identifies_a_family_it_does_not_know() {
     let qoffset = |i: usize| nominal.param_by_name(&format!("qoffset{i}")).unwrap();
     for i in [1, 6] {
         let why = cal.identifiability.fixed_reason(qoffset(i)).expect("fixed");
-        assert!(why.describe().starts_with("same effect as"), "{}", why.describe());
+        assert!(
+            why.describe().starts_with("same effect as"),
+            "{}",
+            why.describe()
+        );
     }
     for i in 2..=5 {
         let p = qoffset(i);
-        assert!(cal.identifiability.identified.contains(&p), "{p} identified");
+        assert!(
+            cal.identifiability.identified.contains(&p),
+            "{p} identified"
+        );
         let got = cal.calibrated.get_display(p);
-        assert!((got - deg[i - 1]).abs() < 1e-6, "{p}: {got} vs {}", deg[i - 1]);
-        assert!(cal.covariance.std_of(p).is_some(), "{p} has a standard deviation");
+        assert!(
+            (got - deg[i - 1]).abs() < 1e-6,
+            "{p}: {got} vs {}",
+            deg[i - 1]
+        );
+        assert!(
+            cal.covariance.std_of(p).is_some(),
+            "{p} has a standard deviation"
+        );
     }
     let worst = cal.calibration.after.iter().cloned().fold(0.0, f64::max);
     assert!(worst < 1e-6, "largest error after {worst} mm");

@@ -78,7 +78,10 @@ impl ParameterFamily for Tool {
         if dw.is_some() {
             let t0 = robot.tool0();
             let t = robot.tool_correction();
-            for (e, ax) in euler_axes(t0[3] + t[3], t0[4] + t[4]).into_iter().enumerate() {
+            for (e, ax) in euler_axes(t0[3] + t[3], t0[4] + t[4])
+                .into_iter()
+                .enumerate()
+            {
                 put(&mut dw, 3 + e, rn * ax);
             }
         }
