@@ -1,32 +1,7 @@
 //! `robocal demo` (the paper's experiment in one command) and `robocal report`.
 
+use crate::util::*;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn robocal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .output()
-        .expect("run robocal")
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-fn ok(o: &Output) -> String {
-    assert!(
-        o.status.success(),
-        "{}\n{}",
-        text(&o.stdout),
-        text(&o.stderr)
-    );
-    text(&o.stdout)
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
 
 /// The numbers of the first line starting with `label` after the line containing `table`.
 fn row(out: &str, table: &str, label: &str) -> Vec<f64> {
@@ -112,10 +87,10 @@ const FILES: [&str; 7] = [
 /// printed commands, which give the same files again when run by hand.
 #[test]
 fn demo_prints_the_papers_tables_and_its_commands_reproduce_the_files() {
-    let tmp = tempfile::tempdir().unwrap();
-    let dir = tmp.path().join("demo");
+    let tmp = Dir::new();
+    let dir = tmp.join("demo");
     assert!(!p(&dir).contains(' '), "the test splits commands on spaces");
-    let out = ok(&robocal(&["demo", "--seed", "1", "--out", p(&dir)]));
+    let out = ok(&["demo", "--seed", "1", "--out", p(&dir)]).stdout();
 
     // Table II: ours, paper, ours, paper (calibration, validation points).
     let before = row(&out, "Table II.", "Mean (mm)");
@@ -206,9 +181,9 @@ fn demo_prints_the_papers_tables_and_its_commands_reproduce_the_files() {
     for c in &cmds {
         let args: Vec<&str> = c.iter().map(String::as_str).collect();
         let o = robocal(&args);
-        assert!(o.status.success(), "{c:?}: {}", text(&o.stderr));
+        o.assert_ok();
         if c[0] == "evaluate" {
-            let m = row(&text(&o.stdout), "verification", "Mean (mm)");
+            let m = row(&o.stdout(), "verification", "Mean (mm)");
             assert!((m[0] - ver[0]).abs() <= 0.0005 + 1e-9, "{m:?} vs {ver:?}");
         }
     }
@@ -225,12 +200,11 @@ fn demo_prints_the_papers_tables_and_its_commands_reproduce_the_files() {
 
 #[test]
 fn demo_into_a_file_is_an_io_error_and_writes_nothing() {
-    let tmp = tempfile::tempdir().unwrap();
-    let f = tmp.path().join("x");
-    std::fs::write(&f, "keep").unwrap();
+    let tmp = Dir::new();
+    let f = tmp.write("x", "keep");
     let o = robocal(&["demo", "--out", p(&f)]);
-    assert_eq!(o.status.code(), Some(4), "{}", text(&o.stderr));
-    assert!(text(&o.stderr).contains("not a directory"));
+    o.assert_code(4);
+    assert!(o.stderr().contains("not a directory"));
     assert_eq!(std::fs::read_to_string(&f).unwrap(), "keep");
     assert_eq!(std::fs::read_dir(tmp.path()).unwrap().count(), 1);
 }
@@ -239,10 +213,10 @@ fn demo_into_a_file_is_an_io_error_and_writes_nothing() {
 /// robot and the data files come from the result; without the data the reach plot is left out.
 #[test]
 fn report_of_a_calibrate_result() {
-    let tmp = tempfile::tempdir().unwrap();
+    let tmp = Dir::new();
     let d = tmp.path();
     let (cell, val, res) = (d.join("cell.csv"), d.join("val.csv"), d.join("r.json"));
-    ok(&robocal(&[
+    ok(&[
         "simulate",
         "--robot",
         "kuka-kr480-r3330",
@@ -258,8 +232,8 @@ fn report_of_a_calibrate_result() {
         p(&cell),
         "--validation-out",
         p(&val),
-    ]));
-    ok(&robocal(&[
+    ]);
+    ok(&[
         "calibrate",
         "--robot",
         "kuka-kr480-r3330",
@@ -269,9 +243,9 @@ fn report_of_a_calibrate_result() {
         p(&val),
         "--out",
         p(&res),
-    ]));
+    ]);
     let out_dir = d.join("rep");
-    let out = ok(&robocal(&["report", p(&res), "--out", p(&out_dir)]));
+    let out = ok(&["report", p(&res), "--out", p(&out_dir)]).stdout();
     assert!(
         out.contains("Before calibration (Table II): calibration points mean"),
         "{out}"
@@ -294,26 +268,22 @@ fn report_of_a_calibrate_result() {
     std::fs::rename(&cell, d.join("moved.csv")).unwrap();
     std::fs::remove_file(&val).unwrap();
     let o = robocal(&["report", p(&res), "--paper", "--out", p(&d.join("rep2"))]);
-    ok(&o);
-    assert!(text(&o.stderr).contains("--data"), "{}", text(&o.stderr));
-    assert!(
-        text(&o.stderr).contains("--validate"),
-        "{}",
-        text(&o.stderr)
-    );
+    o.assert_ok();
+    assert!(o.stderr().contains("--data"), "{}", o.stderr());
+    assert!(o.stderr().contains("--validate"), "{}", o.stderr());
     let html = well_formed_html(&d.join("rep2/report.html"));
     assert_eq!(html.matches("<svg").count(), 1);
     assert!(html.contains("Paper: Samak et al. 2019, Table II"));
     // ... unless given again.
     let html2 = {
-        ok(&robocal(&[
+        ok(&[
             "report",
             p(&res),
             "--data",
             p(&d.join("moved.csv")),
             "--out",
             p(&d.join("rep3")),
-        ]));
+        ]);
         well_formed_html(&d.join("rep3/report.html"))
     };
     assert_eq!(html2.matches("<svg").count(), 2);
@@ -327,9 +297,9 @@ fn report_of_a_calibrate_result() {
         "--out",
         p(&d.join("x")),
     ]);
-    assert_eq!(o.status.code(), Some(3), "{}", text(&o.stderr));
+    o.assert_code(3);
     let o = robocal(&["report", p(&d.join("nope.json")), "--out", p(&d.join("x"))]);
-    assert_eq!(o.status.code(), Some(4), "{}", text(&o.stderr));
+    o.assert_code(4);
     std::fs::write(d.join("bad.csv"), "q1,q2\n1,2\n").unwrap();
     let o = robocal(&[
         "report",
@@ -339,31 +309,27 @@ fn report_of_a_calibrate_result() {
         "--out",
         p(&d.join("x")),
     ]);
-    assert_eq!(o.status.code(), Some(3), "{}", text(&o.stderr));
-    assert!(text(&o.stderr).contains("bad.csv"), "{}", text(&o.stderr));
+    o.assert_code(3);
+    assert!(o.stderr().contains("bad.csv"), "{}", o.stderr());
     assert!(!d.join("x").exists(), "nothing written on errors");
 }
 
 /// A result that does not record its robot needs --robot.
 #[test]
 fn report_needs_a_robot() {
-    let tmp = tempfile::tempdir().unwrap();
+    let tmp = Dir::new();
     let d = tmp.path();
     let demo = d.join("demo");
-    ok(&robocal(&["demo", "--seed", "2", "--out", p(&demo)]));
+    ok(&["demo", "--seed", "2", "--out", p(&demo)]);
     let mut r: serde_json::Value =
         serde_json::from_slice(&std::fs::read(demo.join("result.json")).unwrap()).unwrap();
     r["settings"].as_object_mut().unwrap().remove("robot_arg");
     let res: PathBuf = d.join("r.json");
     std::fs::write(&res, serde_json::to_string(&r).unwrap()).unwrap();
     let o = robocal(&["report", p(&res), "--out", p(&d.join("x"))]);
-    assert_eq!(o.status.code(), Some(2), "{}", text(&o.stderr));
-    assert!(
-        text(&o.stderr).contains("give --robot"),
-        "{}",
-        text(&o.stderr)
-    );
-    ok(&robocal(&[
+    o.assert_code(2);
+    assert!(o.stderr().contains("give --robot"), "{}", o.stderr());
+    ok(&[
         "report",
         p(&res),
         "--robot",
@@ -372,7 +338,7 @@ fn report_needs_a_robot() {
         p(&demo.join("verify.csv")),
         "--out",
         p(&d.join("x")),
-    ]));
+    ]);
     let html = well_formed_html(&d.join("x/report.html"));
     assert!(html.contains("Verification, measured after compensation (Table V)"));
 }

@@ -3,6 +3,7 @@
 //! the page's text and both figures (pixels of the "before" and "after" colours). Skips, saying
 //! why, where Chromium is not installed (`.ci/run` installs it).
 
+use crate::util::Dir;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -109,10 +110,10 @@ fn render_and_check(data: &robocal_report::ReportData) {
         );
         return;
     };
-    let tmp = tempfile::tempdir().unwrap();
-    let profile = tempfile::tempdir().unwrap();
-    let files = robocal_report::write_report(&tmp.path().join("report"), data).unwrap();
-    let png_path = tmp.path().join("report.png");
+    let tmp = Dir::new();
+    let profile = Dir::new();
+    let files = robocal_report::write_report(&tmp.join("report"), data).unwrap();
+    let png_path = tmp.join("report.png");
     screenshot(
         &chromium,
         &files.html,

@@ -1,6 +1,7 @@
 //! `robocal calibrate` end to end: simulated data written as CSV, the result JSON contract, the
 //! printed tables, `fk --params` on the result, bad input, and the real UR5/WAM data sets.
 
+use crate::util::*;
 use rand::SeedableRng;
 use robocal_core::frame::pose;
 use robocal_core::io::CalibrationResult;
@@ -9,22 +10,6 @@ use robocal_core::{preset, Robot};
 use serde_json::Value;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn robocal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .output()
-        .expect("run robocal")
-}
-
-fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
 
 fn tracker(noise: bool) -> Tracker {
     let (s, p) = if noise { (0.010, 0.005) } else { (0.0, 0.0) };
@@ -91,33 +76,25 @@ fn paper_files(dir: &Path, noise: bool) -> (PathBuf, PathBuf) {
     (cal, val)
 }
 
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
-
-fn read_json(p: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
-}
-
 #[test]
 fn calibrate_prints_the_tables_and_writes_the_contract() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = Dir::new();
     let (cal, val) = paper_files(dir.path(), true);
-    let out = dir.path().join("result.json");
+    let out = dir.join("result.json");
     let o = robocal(&[
         "calibrate",
         "--robot",
         "kuka-kr480-r3330",
         "--data",
-        s(&cal),
+        p(&cal),
         "--validate",
-        s(&val),
+        p(&val),
         "--affine",
         "--out",
-        s(&out),
+        p(&out),
     ]);
-    let t = text(&o);
-    assert!(o.status.success(), "{t}");
+    let t = o.text();
+    o.assert_ok();
     for want in [
         "3 plane point(s)",
         "initial measurement frame from 3 plane points",
@@ -208,13 +185,13 @@ fn fk_json(robot: &str, params: &Path, q: &[f64]) -> [f64; 3] {
         "--robot",
         robot,
         "--params",
-        s(params),
+        p(params),
         "--joints",
         &joints,
         "--json",
     ]);
-    assert!(o.status.success(), "{}", text(&o));
-    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
+    o.assert_ok();
+    let v: Value = serde_json::from_str(&o.stdout()).unwrap();
     [
         v["x"].as_f64().unwrap(),
         v["y"].as_f64().unwrap(),
@@ -224,23 +201,23 @@ fn fk_json(robot: &str, params: &Path, q: &[f64]) -> [f64; 3] {
 
 #[test]
 fn fk_with_the_result_uses_the_calibrated_model() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = Dir::new();
     let (cal, _) = paper_files(dir.path(), false);
-    let out = dir.path().join("r.json");
+    let out = dir.join("r.json");
     let o = robocal(&[
         "calibrate",
         "--robot",
         "kuka-kr480-r3330",
         "--data",
-        s(&cal),
+        p(&cal),
         "--beta",
         "parallel",
         "--objective",
         "least-squares",
         "--out",
-        s(&out),
+        p(&out),
     ]);
-    assert!(o.status.success(), "{}", text(&o));
+    o.assert_ok();
     let res = CalibrationResult::read(&out).unwrap();
     assert!(res.parameters.contains_key("beta3"));
     let nominal = preset("kuka-kr480-r3330").unwrap();
@@ -267,8 +244,8 @@ fn fk_with_the_result_uses_the_calibrated_model() {
 
 fn expect_failure(args: &[&str], out: &Path, code: i32, wants: &[&str]) {
     let o = robocal(args);
-    let t = text(&o);
-    assert_eq!(o.status.code(), Some(code), "{args:?}: {t}");
+    let t = o.text();
+    o.assert_code(code);
     for w in wants {
         assert!(t.contains(w), "{args:?}: missing `{w}` in {t}");
     }
@@ -277,23 +254,23 @@ fn expect_failure(args: &[&str], out: &Path, code: i32, wants: &[&str]) {
 
 #[test]
 fn bad_input_is_rejected_and_nothing_is_written() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = dir.path().join("never.json");
-    let o = s(&out).to_owned();
+    let dir = Dir::new();
+    let out = dir.join("never.json");
+    let o = p(&out).to_owned();
     let run = |data: &Path, extra: &[&str], code: i32, wants: &[&str]| {
         let mut args = vec![
             "calibrate",
             "--robot",
             "kuka-kr480-r3330",
             "--data",
-            s(data),
+            p(data),
         ];
         args.extend_from_slice(extra);
         args.extend_from_slice(&["--out", &o]);
         expect_failure(&args, &out, code, wants);
     };
     // Fewer points than identifiable parameters.
-    let few = dir.path().join("few.csv");
+    let few = dir.join("few.csv");
     write_csv(&few, &simulate(20, 3, true), &|_| "");
     run(
         &few,
@@ -304,11 +281,11 @@ fn bad_input_is_rejected_and_nothing_is_written() {
     // A duplicated pose.
     let mut rows = simulate(40, 4, true);
     rows.push(rows[5].clone());
-    let dup = dir.path().join("dup.csv");
+    let dup = dir.join("dup.csv");
     write_csv(&dup, &rows, &|_| "");
     run(&dup, &[], 3, &["dup.csv:42", "duplicated pose", "line 7"]);
     // NaN.
-    let nan = dir.path().join("nan.csv");
+    let nan = dir.join("nan.csv");
     let text = std::fs::read_to_string(&dup).unwrap();
     let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
     let mut cells: Vec<String> = lines[3].split(',').map(str::to_owned).collect();
@@ -324,8 +301,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
     // An absurd reading (a unit mistake or a corrupt file).
     cells[8] = "1e300".into();
     lines[3] = cells.join(",");
-    let huge = dir.path().join("huge.csv");
-    std::fs::write(&huge, lines.join("\n")).unwrap();
+    let huge = dir.write("huge.csv", lines.join("\n"));
     run(
         &huge,
         &[],
@@ -333,7 +309,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
         &["huge.csv:4", "not a plausible tracker reading"],
     );
     // A joint count that differs from the robot's.
-    let seven = dir.path().join("seven.csv");
+    let seven = dir.join("seven.csv");
     std::fs::write(
         &seven,
         "q1,q2,q3,q4,q5,q6,q7,x,y,z\n1,2,3,4,5,6,7,100,200,300\n",
@@ -341,7 +317,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
     .unwrap();
     run(&seven, &[], 3, &["seven.csv:1", "q7", "6 joints"]);
     // Unknown --fix / --free names, all named at once.
-    let ok = dir.path().join("ok.csv");
+    let ok = dir.join("ok.csv");
     write_csv(&ok, &simulate(40, 6, true), &|_| "");
     run(
         &ok,
@@ -359,7 +335,7 @@ fn bad_input_is_rejected_and_nothing_is_written() {
     );
     run(&ok, &["--beta", "9"], 2, &["--beta", "joint 9"]);
     // Two plane points: the initial frame needs three.
-    let two = dir.path().join("two-plane.csv");
+    let two = dir.join("two-plane.csv");
     write_csv(&two, &simulate(40, 7, true), &|i| {
         if i < 2 {
             "plane"
@@ -369,16 +345,16 @@ fn bad_input_is_rejected_and_nothing_is_written() {
     });
     run(&two, &[], 3, &["plane points", "2 row(s) with set = plane"]);
     // An output directory that does not exist.
-    let missing = dir.path().join("nope").join("r.json");
+    let missing = dir.join("nope").join("r.json");
     expect_failure(
         &[
             "calibrate",
             "--robot",
             "kuka-kr480-r3330",
             "--data",
-            s(&ok),
+            p(&ok),
             "--out",
-            s(&missing),
+            p(&missing),
         ],
         &missing,
         4,
@@ -388,28 +364,28 @@ fn bad_input_is_rejected_and_nothing_is_written() {
 
 #[test]
 fn robust_objective_names_the_downweighted_lines() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = Dir::new();
     let mut rows = simulate(75, 8, true);
     for i in [9usize, 30, 61] {
         rows[i].1[0] += 4.0;
         rows[i].1[2] -= 3.0;
     }
-    let cal = dir.path().join("cal.csv");
+    let cal = dir.join("cal.csv");
     write_csv(&cal, &rows, &|_| "");
-    let out = dir.path().join("r.json");
+    let out = dir.join("r.json");
     let o = robocal(&[
         "calibrate",
         "--robot",
         "kuka-kr480-r3330",
         "--data",
-        s(&cal),
+        p(&cal),
         "--objective",
         "robust",
         "--out",
-        s(&out),
+        p(&out),
     ]);
-    let t = text(&o);
-    assert!(o.status.success(), "{t}");
+    let t = o.text();
+    o.assert_ok();
     assert!(t.contains("3 point(s) down-weighted"), "{t}");
     let j = read_json(&out);
     let mut lines: Vec<u64> = j["downweighted_points"]
@@ -423,52 +399,10 @@ fn robust_objective_names_the_downweighted_lines() {
     assert_eq!(lines, vec![11, 32, 63]);
 }
 
-/// The real data sets of ../shared/data (see its README); `None` (and a printed reason) when the
-/// folder is absent.
-fn real_data() -> Option<PathBuf> {
-    let d = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
-    if d.join("jacobi_ur5_grid.csv").is_file() {
-        Some(d)
-    } else {
-        eprintln!(
-            "skipped: real data not found at {} (see DESIGN.md; the folder is optional)",
-            d.display()
-        );
-        None
-    }
-}
-
-fn real(robot: &str, grid: &Path, random: &Path, dir: &Path) -> Value {
-    let out = dir.join(format!(
-        "{}.json",
-        grid.file_stem().unwrap().to_string_lossy()
-    ));
-    let o = robocal(&[
-        "calibrate",
-        "--robot",
-        robot,
-        "--data",
-        s(grid),
-        "--validate",
-        s(random),
-        "--out",
-        s(&out),
-    ]);
-    assert!(o.status.success(), "{}", text(&o));
-    read_json(&out)
-}
-
 #[test]
 fn real_ur5_grid_calibration_predicts_the_random_poses() {
     let Some(d) = real_data() else { return };
-    let dir = tempfile::tempdir().unwrap();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let j = real(
-        s(&root.join("examples/ur5.toml")),
-        &d.join("jacobi_ur5_grid.csv"),
-        &d.join("jacobi_ur5_random.csv"),
-        dir.path(),
-    );
+    let j = &fixtures::real_fit(&d, "ur5").result;
     let v = &j["errors"]["validation"];
     let after = v["after"]["mean_mm"].as_f64().unwrap();
     let before = v["before"]["mean_mm"].as_f64().unwrap();
@@ -484,14 +418,7 @@ fn real_ur5_grid_calibration_predicts_the_random_poses() {
 #[test]
 fn real_wam_grid_calibration_improves_the_random_poses() {
     let Some(d) = real_data() else { return };
-    let dir = tempfile::tempdir().unwrap();
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let j = real(
-        s(&root.join("examples/wam.toml")),
-        &d.join("jacobi_wam_grid.csv"),
-        &d.join("jacobi_wam_random.csv"),
-        dir.path(),
-    );
+    let j = &fixtures::real_fit(&d, "wam").result;
     // The WAM sags under gravity: a geometric model removes about a third of its error on
     // unseen poses (figures in README.md).
     let v = &j["errors"]["validation"];

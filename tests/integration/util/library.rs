@@ -1,35 +1,13 @@
-//! Helpers shared by the compensation and evaluation CLI tests: result files, data files and a
-//! virtual measurement (what `robocal simulate` and a real tracker provide).
-#![allow(dead_code)]
+//! Files made through the library for the compensation and evaluation tests: result files, joint
+//! files and a virtual measurement (what `robocal simulate` and a real tracker provide).
 
+use super::{KUKA, TRUTH};
 use rand::SeedableRng;
 use robocal_core::io::result::{BeforeAfter, ErrorTables, FrameVec, RobotInfo};
 use robocal_core::io::{write_measurements, CalibrationResult, Measurement, MeasurementSet};
 use robocal_core::simulation::{random_poses, PoseSampler, Tracker};
 use robocal_core::{pose, preset, ErrorStats, Frame, Robot};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-pub const NOMINAL: &str = "kuka-kr480-r3330";
-
-pub fn robocal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .output()
-        .expect("run robocal")
-}
-
-pub fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-pub fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-pub fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
 
 /// The tracker of the virtual cell: about 4 m from the base, turned about its vertical axis.
 pub fn tracker(noise: bool) -> Tracker {
@@ -69,8 +47,8 @@ pub fn result_for(nominal: &Robot, calibrated: &Robot, frame: &Frame) -> Calibra
 
 /// Writes the standard result: nominal Table I, "calibrated" = Table III (the simulation's truth).
 pub fn write_result(dir: &Path, frame: &Frame) -> PathBuf {
-    let nom = preset(NOMINAL).unwrap();
-    let cal = preset("kuka-kr480-r3330-table3").unwrap();
+    let nom = preset(KUKA).unwrap();
+    let cal = preset(TRUTH).unwrap();
     let path = dir.join("result.json");
     result_for(&nom, &cal, frame).write(&path).unwrap();
     path
@@ -78,7 +56,7 @@ pub fn write_result(dir: &Path, frame: &Frame) -> PathBuf {
 
 /// `n` random poses (rad) of the nominal robot.
 pub fn poses(n: usize, seed: u64) -> Vec<Vec<f64>> {
-    let nom = preset(NOMINAL).unwrap();
+    let nom = preset(KUKA).unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     random_poses(&nom, n, &PoseSampler::default(), &mut rng).unwrap()
 }
@@ -99,7 +77,7 @@ pub fn write_joints(path: &Path, qs: &[Vec<f64>]) {
 /// Measures the truth (Table III) at the joints of `set` with `tracker`, keeping every other
 /// column: what `robocal simulate --joints` does.
 pub fn measure_set(set: &MeasurementSet, tracker: &Tracker, seed: u64) -> MeasurementSet {
-    let truth = preset("kuka-kr480-r3330-table3").unwrap();
+    let truth = preset(TRUTH).unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let mut out = set.clone();
     out.rows = set
@@ -115,7 +93,7 @@ pub fn measure_set(set: &MeasurementSet, tracker: &Tracker, seed: u64) -> Measur
 
 /// Reads a joint file, measures it (see [`measure_set`]) and writes the measurement file.
 pub fn simulate(joints: &Path, out: &Path, tracker: &Tracker, seed: u64) {
-    let kuka = robocal_core::preset(NOMINAL).unwrap();
+    let kuka = robocal_core::preset(KUKA).unwrap();
     let set = robocal_core::io::read_measurements(
         joints,
         kuka.joint_space(),
@@ -123,22 +101,4 @@ pub fn simulate(joints: &Path, out: &Path, tracker: &Tracker, seed: u64) {
     )
     .unwrap();
     write_measurements(out, &measure_set(&set, tracker, seed)).unwrap();
-}
-
-/// Parses a CSV into a header and rows of strings.
-pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(String::from).collect())
-        .collect();
-    (header, rows)
-}
-
-pub fn col(header: &[String], name: &str) -> usize {
-    header
-        .iter()
-        .position(|h| h == name)
-        .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
 }

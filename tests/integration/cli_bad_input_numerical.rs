@@ -3,41 +3,16 @@
 //! with a reason, not invented), and a solver that does not converge (a failure, and a partial
 //! result only on request, marked as such and refused by `compensate`).
 
-mod bad_input_support;
-
-use bad_input_support::*;
+use crate::util::fixtures::cell;
+use crate::util::*;
 use serde_json::Value;
-use std::path::Path;
-
-fn read_json(path: &Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
-
-fn csv_rows(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(str::to_owned)
-        .collect();
-    let rows = lines
-        .map(|l| l.split(',').map(str::to_owned).collect())
-        .collect();
-    (header, rows)
-}
-
-fn col(header: &[String], name: &str) -> usize {
-    header.iter().position(|h| h == name).unwrap()
-}
 
 const STATUSES: [&str; 4] = ["converged", "joint_limit", "unreachable", "not_converged"];
 
 #[test]
 fn singular_and_unreachable_poses_are_reported_per_row_never_dropped() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     // Desired joints: q = 0 is the arm stretched out horizontally with the wrist singular
     // (q5 = 0); then stretched upwards, a wrist singularity alone, and both joints 2 and 3 at
@@ -61,8 +36,8 @@ fn singular_and_unreachable_poses_are_reported_per_row_never_dropped() {
         "--out",
         p(&out),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let (h, rows) = csv_rows(&out);
+    o.assert_ok();
+    let (h, rows) = read_csv(&out);
     let ids: Vec<&str> = rows.iter().map(|r| r[col(&h, "id")].as_str()).collect();
     assert_eq!(ids, ["stretched", "stretched-up", "wrist", "limits"]);
     for r in &rows {
@@ -98,9 +73,9 @@ fn singular_and_unreachable_poses_are_reported_per_row_never_dropped() {
         a.into_iter().map(str::to_owned).collect::<Vec<_>>()
     };
     let o = robocal(&args(false));
-    let err = stderr(&o);
-    assert!(o.status.success(), "{err}");
-    let (h, rows) = csv_rows(&out);
+    let err = o.stderr();
+    o.assert_ok();
+    let (h, rows) = read_csv(&out);
     assert_eq!(rows.len(), 4, "no row dropped");
     let status: Vec<&str> = rows.iter().map(|r| r[col(&h, "status")].as_str()).collect();
     assert_eq!(
@@ -124,16 +99,16 @@ fn singular_and_unreachable_poses_are_reported_per_row_never_dropped() {
         );
     }
     assert!(
-        stdout(&o).contains("unreachable           2"),
+        o.stdout().contains("unreachable           2"),
         "{}",
-        stdout(&o)
+        o.stdout()
     );
 
     // --strict: the same file fails, names the rows and writes nothing.
     std::fs::write(&out, "earlier output\n").unwrap();
     let o = robocal(&args(true));
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(5), "{err}");
+    let err = o.stderr();
+    o.assert_code(5);
     assert!(err.contains("--strict: 2 of 4 row(s)"), "{err}");
     assert!(err.contains("line 2: unreachable") && err.contains("line 5: unreachable"));
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "earlier output\n");
@@ -141,8 +116,8 @@ fn singular_and_unreachable_poses_are_reported_per_row_never_dropped() {
 
 #[test]
 fn parameters_the_data_do_not_excite_are_fixed_with_a_reason() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     // The fixture's poses with joint 6 held at 12.5 degrees, measured in the same cell.
     let text = std::fs::read_to_string(&fx.data).unwrap();
@@ -167,7 +142,7 @@ fn parameters_the_data_do_not_excite_are_fixed_with_a_reason() {
         "--out",
         p(&data),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    o.assert_ok();
     let out = d.join("result.json");
     let o = robocal(&[
         "calibrate",
@@ -178,8 +153,8 @@ fn parameters_the_data_do_not_excite_are_fixed_with_a_reason() {
         "--out",
         p(&out),
     ]);
-    let text = stdout(&o);
-    assert!(o.status.success(), "{}\n{text}", stderr(&o));
+    let text = o.stdout();
+    o.assert_ok();
     let j = read_json(&out);
     let normal = read_json(&fx.result);
     // With joint 6 still, the tool point is a fixed point of link 5: alpha6 and a6 (identified
@@ -214,8 +189,8 @@ fn parameters_the_data_do_not_excite_are_fixed_with_a_reason() {
 
 #[test]
 fn a_solver_that_does_not_converge_fails_and_its_partial_result_is_marked() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     let out = d.join("result.json");
     std::fs::copy(&fx.result, &out).unwrap();
@@ -228,14 +203,14 @@ fn a_solver_that_does_not_converge_fails_and_its_partial_result_is_marked() {
     };
     // Default: exit 5, the earlier result untouched, the tables labelled as partial.
     let o = robocal(&base(&[]));
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(5), "{err}");
+    let err = o.stderr();
+    o.assert_code(5);
     assert!(
         err.contains("the solver stopped at the iteration limit after 1 iteration(s)"),
         "{err}"
     );
     assert!(err.contains("partial result, not a calibration; nothing written"));
-    assert!(stdout(&o).contains(
+    assert!(o.stdout().contains(
         "Table III. Calibrated parameters of the robot (* fixed at its nominal value) -- PARTIAL"
     ));
     assert_eq!(std::fs::read(&out).unwrap(), earlier);
@@ -243,8 +218,8 @@ fn a_solver_that_does_not_converge_fails_and_its_partial_result_is_marked() {
 
     // --keep-partial: written, marked, still exit 5.
     let o = robocal(&base(&["--keep-partial"]));
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(5), "{err}");
+    let err = o.stderr();
+    o.assert_code(5);
     assert!(err.contains("marked \"status\": \"partial\""), "{err}");
     let j = read_json(&out);
     assert_eq!(j["status"], "partial");
@@ -269,8 +244,8 @@ fn a_solver_that_does_not_converge_fails_and_its_partial_result_is_marked() {
         "--out",
         p(&cout),
     ]);
-    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
-    assert!(stderr(&o).contains("a partial result, not a calibration"));
+    o.assert_code(3);
+    assert!(o.stderr().contains("a partial result, not a calibration"));
     assert!(!cout.exists());
     for args in [
         vec![
@@ -294,15 +269,16 @@ fn a_solver_that_does_not_converge_fails_and_its_partial_result_is_marked() {
         vec!["robot", "show", KUKA, "--params", p(&out)],
     ] {
         let o = robocal(&args);
-        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+        o.assert_ok();
         assert!(
-            stderr(&o).contains("is a PARTIAL result, not a calibration (the solver stopped"),
+            o.stderr()
+                .contains("is a PARTIAL result, not a calibration (the solver stopped"),
             "{args:?}: {}",
-            stderr(&o)
+            o.stderr()
         );
     }
     let o = robocal(&["robot", "show", KUKA, "--params", p(&out)]);
-    assert!(stdout(&o).contains("PARTIAL parameters"), "{}", stdout(&o));
+    assert!(o.stdout().contains("PARTIAL parameters"), "{}", o.stdout());
 }
 
 #[test]
@@ -311,9 +287,9 @@ fn few_points_still_converge() {
     // its minimum; these data sets ran into the old 200-iteration limit, still moving by less
     // than a micrometre, before the solver had an objective-change test (seed 10 needs 349
     // iterations to a relative change of 1e-9).
-    let dir = tempfile::tempdir().unwrap();
+    let dir = Dir::new();
     for seed in ["10", "12"] {
-        let data = dir.path().join(format!("few{seed}.csv"));
+        let data = dir.join(format!("few{seed}.csv"));
         let o = robocal(&[
             "simulate",
             "--robot",
@@ -327,8 +303,8 @@ fn few_points_still_converge() {
             "--out",
             p(&data),
         ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        let out = dir.path().join(format!("few{seed}.json"));
+        o.assert_ok();
+        let out = dir.join(format!("few{seed}.json"));
         let o = robocal(&[
             "calibrate",
             "--robot",
@@ -338,7 +314,7 @@ fn few_points_still_converge() {
             "--out",
             p(&out),
         ]);
-        assert!(o.status.success(), "seed {seed}: {}", stderr(&o));
+        o.assert_ok();
         let j = read_json(&out);
         assert_eq!(j["solver"]["converged"], true);
         assert_eq!(j["status"], "calibrated");

@@ -5,41 +5,10 @@
 //! its exit code, its message (flag and files), no panic, and a directory exactly as before.
 #![cfg(unix)]
 
-mod bad_input_support;
-
-use bad_input_support::{fixture, p, robocal, stderr, stdout, KUKA, TRUTH};
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-
-/// What a directory entry is, for comparing a directory before and after a run.
-#[derive(Debug, PartialEq)]
-enum Entry {
-    File(Vec<u8>),
-    Link(PathBuf),
-    Dir,
-    Special,
-}
-
-/// Every entry of `dir` (hidden ones included: temporaries), without reading FIFOs or devices.
-fn snapshot(dir: &Path) -> BTreeMap<String, Entry> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            let t = e.file_type().unwrap();
-            let entry = if t.is_symlink() {
-                Entry::Link(std::fs::read_link(e.path()).unwrap())
-            } else if t.is_file() {
-                Entry::File(std::fs::read(e.path()).unwrap())
-            } else if t.is_dir() {
-                Entry::Dir
-            } else {
-                Entry::Special
-            };
-            (e.file_name().to_string_lossy().into_owned(), entry)
-        })
-        .collect()
-}
+use crate::util::bad_input::expect_refused;
+use crate::util::fixtures::{cell, many_poses};
+use crate::util::*;
+use std::path::Path;
 
 /// Names of the temporary files (`.NAME.PID.tmp`) in `dir`.
 fn temporaries(dir: &Path) -> Vec<String> {
@@ -52,9 +21,9 @@ fn temporaries(dir: &Path) -> Vec<String> {
 /// A directory with copies of the fixture's inputs: `data.csv`, `t.truth.json`, `res.json`
 /// (recording `data.csv` as its calibration data), `j.csv` (joints), `targets.csv`,
 /// `robot.toml`.
-fn inputs() -> tempfile::TempDir {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+fn inputs() -> Dir {
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     std::fs::copy(&fx.data, d.join("data.csv")).unwrap();
     std::fs::copy(&fx.truth, d.join("t.truth.json")).unwrap();
@@ -68,22 +37,12 @@ fn inputs() -> tempfile::TempDir {
 }
 
 /// Runs `args` (with `{d}` standing for the directory) and checks: exit `code`, stderr has every
-/// string of `wants`, no panic, and `d` exactly as before (inputs byte-identical, nothing added,
-/// no temporary file).
+/// string of `wants` (`{d}` replaced too), no panic, and `d` exactly as before (inputs
+/// byte-identical, nothing added, no temporary file).
 fn refused(d: &Path, args: &[&str], code: i32, wants: &[&str]) {
     let args: Vec<String> = args.iter().map(|a| a.replace("{d}", p(d))).collect();
-    let label = args.join(" ");
-    let before = snapshot(d);
-    let o = robocal(&args);
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(code), "{label}\nstderr: {err}");
-    assert!(!err.contains("panicked"), "{label}: panic: {err}");
-    assert!(err.contains("error: "), "{label}: {err}");
-    for w in wants {
-        let w = w.replace("{d}", p(d));
-        assert!(err.contains(&w), "{label}: stderr lacks `{w}`:\n{err}");
-    }
-    assert_eq!(snapshot(d), before, "{label}: the directory changed");
+    let wants: Vec<String> = wants.iter().map(|w| w.replace("{d}", p(d))).collect();
+    expect_refused(&args.join(" "), d, &args, code, &wants);
 }
 
 #[test]
@@ -497,7 +456,7 @@ fn a_link_to_a_regular_file_is_written_through() {
         "--out",
         p(&d.join("link.csv")),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    o.assert_ok();
     let link = std::fs::symlink_metadata(d.join("link.csv")).unwrap();
     assert!(link.file_type().is_symlink(), "the link was replaced");
     let text = std::fs::read_to_string(d.join("real.csv")).unwrap();
@@ -524,14 +483,14 @@ fn dash_is_standard_output_where_it_makes_sense() {
         "--out",
         "-",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let csv = stdout(&o);
+    o.assert_ok();
+    let csv = o.stdout();
     assert!(
         csv.starts_with("q1,q2,q3,q4,q5,q6,axis1,axis2,axis3,axis4,axis5,axis6,status"),
         "{csv}"
     );
     assert_eq!(csv.lines().count(), 6, "{csv}");
-    let err = stderr(&o);
+    let err = o.stderr();
     assert!(err.contains("converged             5"), "{err}");
     assert!(err.contains("wrote standard output (5 rows)"), "{err}");
     let o = robocal(&[
@@ -545,11 +504,11 @@ fn dash_is_standard_output_where_it_makes_sense() {
         "--per-point",
         "-",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let csv = stdout(&o);
+    o.assert_ok();
+    let csv = o.stdout();
     assert!(csv.starts_with("line,q1,"), "{csv}");
     assert_eq!(csv.lines().count(), 34, "{csv}");
-    assert!(stderr(&o).contains("Mean (mm)"), "{}", stderr(&o));
+    assert!(o.stderr().contains("Mean (mm)"), "{}", o.stderr());
     assert_eq!(snapshot(d), before, "no file named `-` or anything else");
 
     // Where standard output cannot be the output.
@@ -727,26 +686,9 @@ fn absurd_counts_and_sizes_are_usage_errors_not_panics() {
     refused(d, &a, 2, &["--poses"]);
 }
 
-/// A joint file of `n` poses and the command that compensates it into `out`: a run long enough
-/// to be interrupted while its temporary file is open.
-fn long_compensation(d: &Path, n: usize, out: &Path) -> Vec<String> {
-    let joints = d.join("many.csv");
-    if !joints.exists() {
-        let o = robocal(&[
-            "simulate",
-            "--robot",
-            KUKA,
-            "--truth",
-            TRUTH,
-            "--poses",
-            &n.to_string(),
-            "--no-plane",
-            "--out",
-            p(&joints),
-        ]);
-        assert!(o.status.success(), "{}", stderr(&o));
-        std::fs::remove_file(d.join("many.truth.json")).unwrap();
-    }
+/// The command that compensates the 200,000 poses of [`many_poses`] into `out`: a run long
+/// enough to be interrupted while its temporary file is open.
+fn long_compensation(d: &Path, out: &Path) -> Vec<String> {
     [
         "compensate",
         "--robot",
@@ -754,7 +696,7 @@ fn long_compensation(d: &Path, n: usize, out: &Path) -> Vec<String> {
         "--params",
         p(&d.join("res.json")),
         "--joints",
-        p(&joints),
+        p(many_poses()),
         "--out",
         p(out),
     ]
@@ -767,7 +709,7 @@ fn long_compensation(d: &Path, n: usize, out: &Path) -> Vec<String> {
 /// exit status and stderr.
 fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i32>, String) {
     use std::os::unix::process::ExitStatusExt;
-    let child = std::process::Command::new(env!("CARGO_BIN_EXE_robocal"))
+    let child = command()
         .args(args)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
@@ -791,7 +733,8 @@ fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i
     let r = unsafe { libc::kill(child.id() as i32, signal) };
     assert_eq!(r, 0);
     let o = child.wait_with_output().unwrap();
-    (o.status.code(), o.status.signal(), stderr(&o))
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    (o.status.code(), o.status.signal(), err)
 }
 
 #[test]
@@ -800,7 +743,7 @@ fn sigint_and_sigterm_remove_the_temporary_and_keep_the_old_output() {
     let d = dir.path();
     let out = d.join("out.csv");
     std::fs::write(&out, "old output\n").unwrap();
-    let args = long_compensation(d, 200_000, &out);
+    let args = long_compensation(d, &out);
     for (signal, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
         let (code, _, err) = interrupt(&args, &out, signal);
         assert_eq!(code, Some(130), "{name}: {err}");
@@ -823,7 +766,7 @@ fn temporaries_of_killed_runs_are_removed_at_the_next_write() {
     let out = d.join("out.csv");
     std::fs::write(&out, "old output\n").unwrap();
     // SIGKILL cannot be caught: its temporary stays until the next write of the same output.
-    let args = long_compensation(d, 200_000, &out);
+    let args = long_compensation(d, &out);
     let (_, signal, _) = interrupt(&args, &out, libc::SIGKILL);
     assert_eq!(signal, Some(libc::SIGKILL));
     assert_eq!(temporaries(d).len(), 1);
@@ -843,7 +786,7 @@ fn temporaries_of_killed_runs_are_removed_at_the_next_write() {
         "--out",
         p(&out),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    o.assert_ok();
     assert_eq!(temporaries(d), Vec::<String>::new());
     // Another output's temporaries are not touched.
     std::fs::write(d.join(".other.csv.999999999.tmp"), "x").unwrap();
@@ -858,6 +801,6 @@ fn temporaries_of_killed_runs_are_removed_at_the_next_write() {
         "--out",
         p(&out),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    o.assert_ok();
     assert_eq!(temporaries(d), [".other.csv.999999999.tmp"]);
 }

@@ -1,14 +1,14 @@
 //! Bad output paths and command-line values, for every command that writes or takes them:
 //! each fails with its exit code and message before any work, and leaves the directory as it was.
 
-mod bad_input_support;
-
-use bad_input_support::*;
+use crate::util::bad_input::expect_failure;
+use crate::util::fixtures::cell;
+use crate::util::*;
 
 #[test]
 fn output_paths_that_cannot_be_written_fail_before_any_work() {
-    let fx = fixture();
-    let root = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let root = Dir::new();
     let d = root.path();
     let nodir = d.join("no-such-dir");
     let (data, res, joints) = (p(&fx.data), p(&fx.result), p(&fx.joints));
@@ -183,8 +183,8 @@ fn output_paths_that_cannot_be_written_fail_before_any_work() {
 
 #[test]
 fn bad_command_line_values_are_usage_errors() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     let res = p(&fx.result);
     let v = |a: &[&str]| a.iter().map(|s| s.to_string()).collect::<Vec<_>>();

@@ -1,34 +1,28 @@
 //! `robocal compensate`: commanded joints from a result file (eq. 12-14), per-row statuses, and
 //! clear errors for bad input with nothing written.
 
-mod comp_support;
-
-use comp_support::*;
+use crate::util::library::*;
+use crate::util::*;
 use robocal_core::{preset, Frame, Robot};
 use std::path::Path;
 
-fn setup() -> (tempfile::TempDir, std::path::PathBuf) {
-    let dir = tempfile::tempdir().unwrap();
+fn setup() -> (Dir, std::path::PathBuf) {
+    let dir = Dir::new();
     let res = write_result(dir.path(), &Frame::identity());
     (dir, res)
-}
-
-fn num(s: &str) -> f64 {
-    s.parse()
-        .unwrap_or_else(|_| panic!("`{s}` is not a number"))
 }
 
 #[test]
 fn joints_mode_writes_converged_commanded_joints() {
     let (dir, res) = setup();
     let desired = poses(75, 1);
-    let input = dir.path().join("desired.csv");
+    let input = dir.join("desired.csv");
     write_joints(&input, &desired);
-    let out = dir.path().join("commanded.csv");
+    let out = dir.join("commanded.csv");
     let o = robocal(&[
         "compensate",
         "--robot",
-        NOMINAL,
+        KUKA,
         "--params",
         p(&res),
         "--joints",
@@ -36,8 +30,8 @@ fn joints_mode_writes_converged_commanded_joints() {
         "--out",
         p(&out),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = stdout(&o);
+    o.assert_ok();
+    let text = o.stdout();
     assert!(text.contains("converged            75"), "{text}");
     assert!(text.contains("wrote"), "{text}");
 
@@ -49,8 +43,8 @@ fn joints_mode_writes_converged_commanded_joints() {
          q1_desired,q2_desired,q3_desired,q4_desired,q5_desired,q6_desired,id"
     );
     assert_eq!(rows.len(), 75);
-    let nom = preset(NOMINAL).unwrap();
-    let cal = preset("kuka-kr480-r3330-table3").unwrap();
+    let nom = preset(KUKA).unwrap();
+    let cal = preset(TRUTH).unwrap();
     for (k, r) in rows.iter().enumerate() {
         assert_eq!(r[col(&h, "status")], "converged");
         assert_eq!(r[col(&h, "id")], format!("p{k}"));
@@ -86,9 +80,9 @@ fn joints_mode_writes_converged_commanded_joints() {
 #[test]
 fn targets_mode_reports_every_row_and_strict_fails_without_writing() {
     let (dir, res) = setup();
-    let cal = preset("kuka-kr480-r3330-table3").unwrap();
+    let cal = preset(TRUTH).unwrap();
     let reachable = cal.tool_position(&[0.3, -0.8, 0.6, 0.1, 0.5, -0.2]);
-    let input = dir.path().join("targets.csv");
+    let input = dir.join("targets.csv");
     std::fs::write(
         &input,
         format!(
@@ -97,12 +91,12 @@ fn targets_mode_reports_every_row_and_strict_fails_without_writing() {
         ),
     )
     .unwrap();
-    let out = dir.path().join("commanded.csv");
+    let out = dir.join("commanded.csv");
     let args = |strict: bool| {
         let mut a = vec![
             "compensate",
             "--robot",
-            NOMINAL,
+            KUKA,
             "--params",
             p(&res),
             "--targets",
@@ -117,16 +111,16 @@ fn targets_mode_reports_every_row_and_strict_fails_without_writing() {
     };
     // --strict first: exit 5, listed rows, nothing written.
     let o = robocal(&args(true).iter().map(|s| s.as_str()).collect::<Vec<_>>());
-    assert_eq!(o.status.code(), Some(5), "{}", stderr(&o));
-    assert!(stderr(&o).contains("line 3: unreachable"), "{}", stderr(&o));
+    o.assert_code(5);
+    assert!(o.stderr().contains("line 3: unreachable"), "{}", o.stderr());
     assert!(!out.exists());
     // Default: exit 0, both rows written with their status, a warning names the line.
     let o = robocal(&args(false).iter().map(|s| s.as_str()).collect::<Vec<_>>());
-    assert!(o.status.success(), "{}", stderr(&o));
+    o.assert_ok();
     assert!(
-        stderr(&o).contains("targets.csv: line 3: unreachable"),
+        o.stderr().contains("targets.csv: line 3: unreachable"),
         "{}",
-        stderr(&o)
+        o.stderr()
     );
     let (h, rows) = read_csv(&out);
     assert_eq!(rows.len(), 2);
@@ -143,12 +137,12 @@ fn targets_mode_reports_every_row_and_strict_fails_without_writing() {
 /// and that nothing was written.
 fn fails(dir: &Path, args: &[&str], code: i32, needles: &[&str]) {
     let out = dir.join("never.csv");
-    let mut a = vec!["compensate", "--robot", NOMINAL];
+    let mut a = vec!["compensate", "--robot", KUKA];
     a.extend_from_slice(args);
     a.extend_from_slice(&["--out", p(&out)]);
     let o = robocal(&a);
-    let e = stderr(&o);
-    assert_eq!(o.status.code(), Some(code), "{a:?}: {e}");
+    let e = o.stderr();
+    o.assert_code(code);
     for n in needles {
         assert!(e.contains(n), "`{e}` lacks `{n}`");
     }
@@ -201,7 +195,7 @@ fn bad_results_and_inputs_are_clear_errors_and_write_nothing() {
         &["wam.json", "robot.dof", "7-joint"],
     );
     // Same shape, another nominal model (Table III as nominal).
-    let t3: Robot = preset("kuka-kr480-r3330-table3").unwrap();
+    let t3: Robot = preset(TRUTH).unwrap();
     let r = d.join("t3.json");
     result_for(&t3, &t3, &Frame::identity()).write(&r).unwrap();
     fails(
@@ -297,13 +291,13 @@ fn bad_results_and_inputs_are_clear_errors_and_write_nothing() {
 #[test]
 fn output_into_a_missing_directory_is_an_io_error() {
     let (dir, res) = setup();
-    let input = dir.path().join("desired.csv");
+    let input = dir.join("desired.csv");
     write_joints(&input, &poses(3, 3));
-    let out = dir.path().join("no/such/dir/c.csv");
+    let out = dir.join("no/such/dir/c.csv");
     let o = robocal(&[
         "compensate",
         "--robot",
-        NOMINAL,
+        KUKA,
         "--params",
         p(&res),
         "--joints",
@@ -311,6 +305,6 @@ fn output_into_a_missing_directory_is_an_io_error() {
         "--out",
         p(&out),
     ]);
-    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
-    assert!(stderr(&o).contains("does not exist"), "{}", stderr(&o));
+    o.assert_code(4);
+    assert!(o.stderr().contains("does not exist"), "{}", o.stderr());
 }

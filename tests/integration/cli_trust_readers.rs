@@ -5,9 +5,9 @@
 //! directory as it was (inputs byte-identical, earlier outputs untouched, nothing new) and not
 //! panic (`expect_failure`).
 
-mod bad_input_support;
-
-use bad_input_support::*;
+use crate::util::bad_input::*;
+use crate::util::fixtures::{cell, Cell};
+use crate::util::{ok, p, Dir, KUKA, TRUTH};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -38,7 +38,7 @@ const MEASURED: &[Run] = &[Cal, CalVal, Eval];
 const RESULT: &[Run] = &[FkParams, ShowParams, EvalParams, CompParams, ReportParams];
 
 /// The command line of `run` with the bad file `f`, outputs in the case directory `d`.
-fn args(run: Run, f: &str, d: &Path, fx: &Fixture) -> Vec<String> {
+fn args(run: Run, f: &str, d: &Path, fx: &Cell) -> Vec<String> {
     let template = match run {
         Cal => "calibrate --robot KUKA --data F --out OUT.json",
         CalVal => "calibrate --robot KUKA --data DATA --validate F --out OUT.json",
@@ -63,7 +63,7 @@ fn args(run: Run, f: &str, d: &Path, fx: &Fixture) -> Vec<String> {
 /// stderr must contain (`{F}` is the file's path).
 struct Case {
     file: &'static str,
-    make: fn(&Fixture) -> (Vec<u8>, Vec<String>),
+    make: fn(&Cell) -> (Vec<u8>, Vec<String>),
     runs: &'static [Run],
     code: i32,
 }
@@ -102,7 +102,7 @@ fn json_case(text: String, needle: &str, field: &str, msg: &str) -> (Vec<u8>, Ve
 }
 
 /// `data` with the q2 of `lines` moved by `by` degrees.
-fn shifted_q2(fx: &Fixture, lines: &[usize], by: f64) -> String {
+fn shifted_q2(fx: &Cell, lines: &[usize], by: f64) -> String {
     let mut t = fx.text(&fx.data);
     for &l in lines {
         let q2: f64 = t
@@ -236,8 +236,8 @@ fn case_dir(root: &Path, k: usize, run: Run) -> std::path::PathBuf {
 
 #[test]
 fn every_untrusted_input_fails_naming_file_line_and_field_and_writes_nothing() {
-    let fx = fixture();
-    let root = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let root = Dir::new();
     let mut runs = 0;
     for (k, c) in CASES.iter().enumerate() {
         let (bytes, wants) = (c.make)(fx);
@@ -260,8 +260,8 @@ fn every_untrusted_input_fails_naming_file_line_and_field_and_writes_nothing() {
 
 #[test]
 fn validate_must_be_another_file_than_data() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     let data = d.join("data.csv");
     std::fs::copy(&fx.data, &data).unwrap();
@@ -295,7 +295,7 @@ fn validate_must_be_another_file_than_data() {
 
 #[test]
 fn simulate_refuses_absurd_numbers_and_readings_no_reader_would_accept() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = Dir::new();
     let d = dir.path();
     let cases: &[(&str, &str)] = &[
         ("--tracker 1e308,0,0,0,0,0", "--tracker: x: 1e308 mm is out of range (a length must be within ±1e6 mm, 1 km)"),
@@ -353,17 +353,10 @@ fn simulate_refuses_absurd_numbers_and_readings_no_reader_would_accept() {
     );
 }
 
-fn ok(args: &[&str]) -> std::process::Output {
-    let o = robocal(args);
-    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
-    assert!(!stderr(&o).contains("panicked"));
-    o
-}
-
 #[test]
 fn accepted_set_labels_and_statuses() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     // Any case, surrounding spaces, `val`, and an empty cell (a calibration point).
     let t = with_cell(&fx.data_with_cell(2, "set", "PLANE"), 6, "set", "");
@@ -381,9 +374,10 @@ fn accepted_set_labels_and_statuses() {
         p(&out),
     ]);
     assert!(
-        stdout(&o).contains("28 calibration point(s), 3 plane point(s), 2 validation point(s)"),
+        o.stdout()
+            .contains("28 calibration point(s), 3 plane point(s), 2 validation point(s)"),
         "{}",
-        stdout(&o)
+        o.stdout()
     );
     assert_eq!(std::fs::read_to_string(&data).unwrap(), t);
     // Every status robocal writes reads.
@@ -404,8 +398,8 @@ fn accepted_set_labels_and_statuses() {
 
 #[test]
 fn nominal_limits_turn_the_error_into_a_warning_recorded_in_the_result() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     let data = d.join("limits.csv");
     let text = shifted_q2(fx, &[7, 9], 360.0);
@@ -421,7 +415,7 @@ fn nominal_limits_turn_the_error_into_a_warning_recorded_in_the_result() {
         p(&out),
         "--nominal-limits",
     ]);
-    let err = stderr(&o);
+    let err = o.stderr();
     let want = format!(
         "warning: {}: 2 row(s) with joint values outside the limits of robot `{KUKA}`: line 7 (q2 = ",
         p(&data)
@@ -453,8 +447,8 @@ fn nominal_limits_turn_the_error_into_a_warning_recorded_in_the_result() {
         "--json",
         "--nominal-limits",
     ]);
-    assert!(stderr(&o).contains(&want), "{}", stderr(&o));
-    let j: Value = serde_json::from_str(&stdout(&o)).unwrap();
+    assert!(o.stderr().contains(&want), "{}", o.stderr());
+    let j: Value = serde_json::from_str(&o.stdout()).unwrap();
     assert_eq!(j["rows_outside_limits"], json!(2));
 
     // compensate and simulate measure such rows and name each with its file and line.
@@ -472,7 +466,7 @@ fn nominal_limits_turn_the_error_into_a_warning_recorded_in_the_result() {
         "--out",
         p(&d.join("c.csv")),
     ]);
-    let err = stderr(&o);
+    let err = o.stderr();
     assert!(
         err.contains(&format!(
             "{}: 2 desired pose(s) outside the joint limits",
@@ -491,7 +485,7 @@ fn nominal_limits_turn_the_error_into_a_warning_recorded_in_the_result() {
         "--out",
         p(&d.join("s.csv")),
     ]);
-    let err = stderr(&o);
+    let err = o.stderr();
     for l in [7, 9] {
         assert!(
             err.contains(&format!("{}:{l}: q2 outside the joint limits", p(&joints))),

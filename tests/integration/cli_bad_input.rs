@@ -3,9 +3,9 @@
 //! line, field). Every failing run must leave its directory as it was: earlier outputs unchanged,
 //! no new or temporary files.
 
-mod bad_input_support;
-
-use bad_input_support::*;
+use crate::util::bad_input::*;
+use crate::util::fixtures::{cell, Cell};
+use crate::util::{p, Dir};
 use serde_json::{json, Value};
 use std::path::Path;
 
@@ -71,7 +71,7 @@ const EVERY: [Run; 16] = [
 /// The command line of `run` with the bad file `f`: a template whose words `F` (the bad file),
 /// `DATA`, `RESULT`, `JOINTS` (the fixture's good files), `OUT.json`, `OUT.csv` and `PP.csv`
 /// (outputs in the case directory `d`) are replaced.
-fn args(run: Run, f: &str, d: &Path, fx: &Fixture) -> Vec<String> {
+fn args(run: Run, f: &str, d: &Path, fx: &Cell) -> Vec<String> {
     let template = match run {
         Cal => "calibrate --robot KUKA --data F --out OUT.json",
         CalVal => "calibrate --robot KUKA --data DATA --validate F --out OUT.json",
@@ -98,7 +98,7 @@ struct Case {
     /// Its name (the extension matters for `--robot` and `--truth`).
     file: &'static str,
     /// Its content.
-    make: fn(&Fixture) -> Vec<u8>,
+    make: fn(&Cell) -> Vec<u8>,
     /// The commands that read it.
     runs: &'static [Run],
     /// The exit code.
@@ -292,8 +292,8 @@ fn case_dir(root: &Path, k: usize, run: Run) -> std::path::PathBuf {
 
 #[test]
 fn every_bad_input_fails_with_its_message_and_code_and_writes_nothing() {
-    let fx = fixture();
-    let root = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let root = Dir::new();
     let mut runs = 0;
     for (k, c) in CASES.iter().enumerate() {
         for &run in c.runs {
@@ -313,8 +313,8 @@ fn every_bad_input_fails_with_its_message_and_code_and_writes_nothing() {
 
 #[test]
 fn missing_files_and_directories_fail_with_exit_code_4_for_every_reader() {
-    let fx = fixture();
-    let root = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let root = Dir::new();
     for (k, run) in EVERY.iter().enumerate() {
         // A path that does not exist. `.toml` / `.json` so that --robot / --truth take it as a file.
         let d = case_dir(root.path(), k, *run);
@@ -339,9 +339,9 @@ fn missing_files_and_directories_fail_with_exit_code_4_for_every_reader() {
 #[test]
 fn unreadable_file_fails_with_exit_code_4() {
     use std::os::unix::fs::PermissionsExt;
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
-    let f = dir.path().join("locked.csv");
+    let fx = cell();
+    let dir = Dir::new();
+    let f = dir.join("locked.csv");
     std::fs::copy(&fx.data, &f).unwrap();
     std::fs::set_permissions(&f, std::fs::Permissions::from_mode(0o000)).unwrap();
     if std::fs::read(&f).is_ok() {

@@ -1,32 +1,29 @@
 //! `robocal simulate`: reproducibility, the exact rigid case, the noise model, joint files,
 //! truth files, non-geometric errors and bad input (clear errors, nothing written).
 
+use crate::util::*;
 use nalgebra::{Point3, Vector3};
 use robocal_core::io::measurements::{read_measurements, MeasurementSet, Positions};
 use robocal_core::io::result::FrameVec;
 use robocal_core::preset;
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 /// Runs `robocal simulate` with `spec` (whitespace-separated arguments without paths) followed
 /// by `paths` (option, path) pairs, which may contain any character.
-fn sim(spec: &str, paths: &[(&str, &Path)]) -> Output {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_robocal"));
-    c.arg("simulate").args(spec.split_whitespace());
+fn sim(spec: &str, paths: &[(&str, &Path)]) -> Outcome {
+    let mut args: Vec<OsString> = vec!["simulate".into()];
+    args.extend(spec.split_whitespace().map(OsString::from));
     for (opt, p) in paths {
-        c.arg(opt).arg(p);
+        args.push(opt.into());
+        args.push(p.into());
     }
-    c.output().expect("run robocal")
+    robocal(&args)
 }
 
 /// [`sim`] with the nominal KR 480, expecting success.
 fn sim_ok(spec: &str, paths: &[(&str, &Path)]) {
-    let o = sim(&format!("--robot kuka-kr480-r3330 {spec}"), paths);
-    assert!(o.status.success(), "{spec}: {}", stderr(&o));
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
+    sim(&format!("--robot kuka-kr480-r3330 {spec}"), paths).assert_ok();
 }
 
 fn read(p: &Path) -> MeasurementSet {
@@ -48,21 +45,12 @@ fn tracker_frame(v: &serde_json::Value) -> robocal_core::Frame {
     f.to_frame()
 }
 
-fn files_in(dir: &Path) -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
-}
-
 #[test]
 fn same_seed_identical_bytes_other_seed_other_data() {
     // Three cells written under the same file name in three directories: the same arguments
     // (and seed) twice, then another seed.
-    let dirs: Vec<_> = (0..3).map(|_| tempfile::tempdir().unwrap()).collect();
-    let out: Vec<PathBuf> = dirs.iter().map(|d| d.path().join("cell.csv")).collect();
+    let dirs: Vec<_> = (0..3).map(|_| Dir::new()).collect();
+    let out: Vec<PathBuf> = dirs.iter().map(|d| d.join("cell.csv")).collect();
     for (o, seed) in out.iter().zip(["5", "5", "6"]) {
         sim_ok(
             &format!(
@@ -95,8 +83,8 @@ fn same_seed_identical_bytes_other_seed_other_data() {
 /// rigidly into the tracker frame given by --tracker.
 #[test]
 fn nominal_truth_without_noise_is_the_rigidly_moved_nominal() {
-    let d = tempfile::tempdir().unwrap();
-    let out = d.path().join("exact.csv");
+    let d = Dir::new();
+    let out = d.join("exact.csv");
     sim_ok(
         "--truth kuka-kr480-r3330 --poses 60 --seed 3 --noise-mm 0 --noise-per-m 0 \
          --tracker -2500,3100,900,-60,0.5,-0.3",
@@ -127,8 +115,8 @@ fn nominal_truth_without_noise_is_the_rigidly_moved_nominal() {
 /// Over 10,000 points the spread of readings minus exact positions matches sigma within 5%.
 #[test]
 fn noise_spread_matches_sigma_over_10000_points() {
-    let d = tempfile::tempdir().unwrap();
-    let out = d.path().join("noise.csv");
+    let d = Dir::new();
+    let out = d.join("noise.csv");
     sim_ok(
         "--truth kuka-kr480-r3330 --poses 10000 --no-plane --noise-mm 0.02 --noise-per-m 0.01",
         &[("--out", &out)],
@@ -154,8 +142,8 @@ fn noise_spread_matches_sigma_over_10000_points() {
 
 #[test]
 fn sets_ids_and_a_separate_validation_file() {
-    let d = tempfile::tempdir().unwrap();
-    let (out, val) = (d.path().join("cell.csv"), d.path().join("cell-val.csv"));
+    let d = Dir::new();
+    let (out, val) = (d.join("cell.csv"), d.join("cell-val.csv"));
     sim_ok(
         "--truth kuka-kr480-r3330-table3 --poses 75 --validation 73 --seed 9",
         &[("--out", &out), ("--validation-out", &val)],
@@ -193,8 +181,8 @@ fn sets_ids_and_a_separate_validation_file() {
 /// truth file), keeping the rows' order and extra columns.
 #[test]
 fn joints_file_is_measured_in_the_same_cell() {
-    let d = tempfile::tempdir().unwrap();
-    let first = d.path().join("first.csv");
+    let d = Dir::new();
+    let first = d.join("first.csv");
     let exact = "--noise-mm 0 --noise-per-m 0";
     sim_ok(
         &format!("--truth random --tilt-parallel-axes --poses 12 --seed 21 {exact}"),
@@ -211,8 +199,7 @@ fn joints_file_is_measured_in_the_same_cell() {
                 .collect();
         text.push_str(&format!("pt{i},{},0,0,0\n", q.join(",")));
     }
-    let joints = d.path().join("joints.csv");
-    std::fs::write(&joints, text).unwrap();
+    let joints = d.write("joints.csv", text);
     let truth_json = first.with_extension("truth.json");
     let by_seed = format!("--truth random --seed 21 --tilt-parallel-axes {exact}");
     let runs: [(&str, Vec<(&str, &Path)>); 2] = [
@@ -220,7 +207,7 @@ fn joints_file_is_measured_in_the_same_cell() {
         (exact, vec![("--truth", truth_json.as_path())]),
     ];
     for (i, (spec, extra)) in runs.iter().enumerate() {
-        let out = d.path().join(format!("again{i}.csv"));
+        let out = d.join(format!("again{i}.csv"));
         let mut paths = extra.clone();
         paths.extend([("--joints", joints.as_path()), ("--out", out.as_path())]);
         sim_ok(spec, &paths);
@@ -244,23 +231,23 @@ fn joints_file_is_measured_in_the_same_cell() {
 
 #[test]
 fn joint_values_outside_the_limits_are_measured_with_a_warning() {
-    let d = tempfile::tempdir().unwrap();
-    let joints = d.path().join("j.csv");
+    let d = Dir::new();
+    let joints = d.join("j.csv");
     std::fs::write(
         &joints,
         "q1,q2,q3,q4,q5,q6\n0,-40,30,0,20,0\n0,-40,30,0,150,0\n",
     )
     .unwrap();
-    let out = d.path().join("m.csv");
+    let out = d.join("m.csv");
     let o = sim(
         "--robot kuka-kr480-r3330 --truth kuka-kr480-r3330-table3",
         &[("--joints", &joints), ("--out", &out)],
     );
-    assert!(o.status.success(), "{}", stderr(&o));
+    o.assert_ok();
     assert!(
-        stderr(&o).contains("j.csv:3: q5 outside the joint limits"),
+        o.stderr().contains("j.csv:3: q5 outside the joint limits"),
         "{}",
-        stderr(&o)
+        o.stderr()
     );
     assert_eq!(read(&out).rows.len(), 2);
     let w = truth_of(&out)["warnings"].to_string();
@@ -269,12 +256,8 @@ fn joint_values_outside_the_limits_are_measured_with_a_warning() {
 
 #[test]
 fn outliers_and_gravity_are_recorded() {
-    let d = tempfile::tempdir().unwrap();
-    let (plain, bad, grav) = (
-        d.path().join("plain.csv"),
-        d.path().join("bad.csv"),
-        d.path().join("g.csv"),
-    );
+    let d = Dir::new();
+    let (plain, bad, grav) = (d.join("plain.csv"), d.join("bad.csv"), d.join("g.csv"));
     let common = "--truth kuka-kr480-r3330-table3 --poses 50 --no-plane --seed 4 --noise-mm 0 \
                   --noise-per-m 0";
     sim_ok(common, &[("--out", &plain)]);
@@ -324,8 +307,8 @@ type Case<'a> = (String, Vec<(&'a str, &'a Path)>, i32, &'a str);
 /// Every bad input: non-zero exit with a clear message, and no file written.
 #[test]
 fn bad_input_is_rejected_and_nothing_is_written() {
-    let d = tempfile::tempdir().unwrap();
-    let below = d.path().join("below.toml");
+    let d = Dir::new();
+    let below = d.join("below.toml");
     std::fs::write(
         &below,
         "convention = \"mdh\"\nbase = [0, 0, -500, 0, 0, 0]\n\
@@ -333,12 +316,13 @@ fn bad_input_is_rejected_and_nothing_is_written() {
          [[joints]]\nalpha = 0\nd = 0\na = 100\nlimits = [-10, 10]\n",
     )
     .unwrap();
-    let joints = d.path().join("joints.csv");
-    std::fs::write(&joints, "q1,q2,q3,q4,q5,q6\n1,2,3,4,5,6\n1,2,x,4,5,6\n").unwrap();
-    let bad_truth = d.path().join("bad.truth.json");
-    std::fs::write(&bad_truth, "{\n  \"robot\": 3,\n}\n").unwrap();
-    let wam = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/wam.toml");
-    let out = d.path().join("out.csv");
+    let joints = d.write(
+        "joints.csv",
+        "q1,q2,q3,q4,q5,q6\n1,2,3,4,5,6\n1,2,x,4,5,6\n",
+    );
+    let bad_truth = d.write("bad.truth.json", "{\n  \"robot\": 3,\n}\n");
+    let wam = root().join("examples/wam.toml");
+    let out = d.join("out.csv");
     let kr = "--robot kuka-kr480-r3330 --truth kuka-kr480-r3330-table3";
     let cases: Vec<Case> = vec![
         (
@@ -447,8 +431,8 @@ fn bad_input_is_rejected_and_nothing_is_written() {
     for (spec, mut paths, code, msg) in cases {
         paths.push(("--out", &out));
         let o = sim(&spec, &paths);
-        let err = stderr(&o);
-        assert_eq!(o.status.code(), Some(code), "{spec}: {err}");
+        let err = o.stderr();
+        o.assert_code(code);
         assert!(err.contains(msg), "{spec}: `{msg}` not in {err}");
         assert_eq!(
             files_in(d.path()),
@@ -461,13 +445,13 @@ fn bad_input_is_rejected_and_nothing_is_written() {
         &format!("{kr} --poses 5"),
         &[("--out", Path::new("/nonexistent-robocal-dir/x.csv"))],
     );
-    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
+    o.assert_code(4);
 }
 
 #[test]
 fn an_existing_result_is_not_touched_by_a_failed_run() {
-    let d = tempfile::tempdir().unwrap();
-    let out = d.path().join("cell.csv");
+    let d = Dir::new();
+    let out = d.join("cell.csv");
     let truth = out.with_extension("truth.json");
     sim_ok(
         "--truth kuka-kr480-r3330-table3 --poses 5",
@@ -479,7 +463,7 @@ fn an_existing_result_is_not_touched_by_a_failed_run() {
          --floor-mm 99999",
         &[("--out", &out)],
     );
-    assert_eq!(o.status.code(), Some(3));
+    o.assert_code(3);
     assert!(std::fs::read(&out).unwrap() == before.0);
     assert!(std::fs::read(&truth).unwrap() == before.1);
     assert_eq!(files_in(d.path()), ["cell.csv", "cell.truth.json"]);

@@ -1,15 +1,14 @@
 //! `robocal evaluate`: validation statistics under both models, per-point errors, and the
 //! verification workflow of the README (compensate, measure the commanded joints, evaluate).
 
-mod comp_support;
-
-use comp_support::*;
+use crate::util::library::*;
+use crate::util::*;
 use robocal_core::io::{write_measurements, Measurement, MeasurementSet};
 use std::path::{Path, PathBuf};
 
-fn json(o: &std::process::Output) -> serde_json::Value {
-    assert!(o.status.success(), "{}", stderr(o));
-    serde_json::from_str(&stdout(o)).unwrap_or_else(|e| panic!("{e}: {}", stdout(o)))
+fn json(o: &Outcome) -> serde_json::Value {
+    o.assert_ok();
+    serde_json::from_str(&o.stdout()).unwrap_or_else(|e| panic!("{e}: {}", o.stdout()))
 }
 
 /// A measurement file of the truth at `n` random poses, with an `id` column.
@@ -23,7 +22,7 @@ fn measured(dir: &Path, name: &str, n: usize, seed: u64, noise: bool) -> PathBuf
 
 #[test]
 fn validation_statistics_and_per_point_file() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = Dir::new();
     let d = dir.path();
     let t = tracker(false);
     let res = write_result(d, &t.frame);
@@ -32,7 +31,7 @@ fn validation_statistics_and_per_point_file() {
     let o = robocal(&[
         "evaluate",
         "--robot",
-        NOMINAL,
+        KUKA,
         "--params",
         p(&res),
         "--data",
@@ -68,14 +67,14 @@ fn validation_statistics_and_per_point_file() {
     let o = robocal(&[
         "evaluate",
         "--robot",
-        NOMINAL,
+        KUKA,
         "--params",
         p(&res),
         "--data",
         p(&data),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = stdout(&o);
+    o.assert_ok();
+    let text = o.stdout();
     assert!(text.contains("Mean (mm)") && text.contains("nominal") && text.contains("reduced by"));
 }
 
@@ -88,7 +87,7 @@ fn validation_statistics_and_per_point_file() {
 /// simulation predicts verification).
 #[test]
 fn verification_workflow_gives_table_v() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = Dir::new();
     let d = dir.path();
     let t = tracker(true);
     let cal = measured(d, "cal", 75, 2, true);
@@ -96,17 +95,17 @@ fn verification_workflow_gives_table_v() {
     let o = robocal(&[
         "calibrate",
         "--robot",
-        NOMINAL,
+        KUKA,
         "--data",
         p(&cal),
         "--out",
         p(&res),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    o.assert_ok();
     let before = json(&robocal(&[
         "evaluate",
         "--robot",
-        NOMINAL,
+        KUKA,
         "--params",
         p(&res),
         "--data",
@@ -119,7 +118,7 @@ fn verification_workflow_gives_table_v() {
     let o = robocal(&[
         "compensate",
         "--robot",
-        NOMINAL,
+        KUKA,
         "--params",
         p(&res),
         "--joints",
@@ -127,14 +126,14 @@ fn verification_workflow_gives_table_v() {
         "--out",
         p(&commanded),
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stderr(&o).contains("x,y,z columns"), "{}", stderr(&o));
+    o.assert_ok();
+    assert!(o.stderr().contains("x,y,z columns"), "{}", o.stderr());
     let verify = d.join("verify.csv");
     simulate(&commanded, &verify, &t, 7);
     let after = json(&robocal(&[
         "evaluate",
         "--robot",
-        NOMINAL,
+        KUKA,
         "--params",
         p(&res),
         "--data",
@@ -166,7 +165,7 @@ fn verification_workflow_gives_table_v() {
     let m = json(&robocal(&[
         "evaluate",
         "--robot",
-        NOMINAL,
+        KUKA,
         "--params",
         p(&res),
         "--data",
@@ -180,13 +179,13 @@ fn verification_workflow_gives_table_v() {
 
 #[test]
 fn bad_inputs_are_clear_errors() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = Dir::new();
     let d = dir.path();
     let t = tracker(false);
     let res = write_result(d, &t.frame);
     let data = measured(d, "val", 5, 3, false);
     let run = |args: &[&str]| {
-        let mut a = vec!["evaluate", "--robot", NOMINAL];
+        let mut a = vec!["evaluate", "--robot", KUKA];
         a.extend_from_slice(args);
         robocal(&a)
     };
@@ -199,20 +198,20 @@ fn bad_inputs_are_clear_errors() {
         "--against",
         "desired",
     ]);
-    assert_eq!(o.status.code(), Some(3));
+    o.assert_code(3);
     assert!(
-        stderr(&o).contains("val.csv:1: field `x_desired`"),
+        o.stderr().contains("val.csv:1: field `x_desired`"),
         "{}",
-        stderr(&o)
+        o.stderr()
     );
     // A joint file without positions.
     let joints = d.join("val.joints.csv");
     let o = run(&["--params", p(&res), "--data", p(&joints)]);
-    assert_eq!(o.status.code(), Some(3));
+    o.assert_code(3);
     assert!(
-        stderr(&o).contains("field `x`: missing column"),
+        o.stderr().contains("field `x`: missing column"),
         "{}",
-        stderr(&o)
+        o.stderr()
     );
     // A bad desired cell names line and column.
     let set = MeasurementSet {
@@ -230,11 +229,11 @@ fn bad_inputs_are_clear_errors() {
     let v = d.join("v.csv");
     write_measurements(&v, &set).unwrap();
     let o = run(&["--params", p(&res), "--data", p(&v)]);
-    assert_eq!(o.status.code(), Some(3));
+    o.assert_code(3);
     assert!(
-        stderr(&o).contains("v.csv:2: field `y_desired`"),
+        o.stderr().contains("v.csv:2: field `y_desired`"),
         "{}",
-        stderr(&o)
+        o.stderr()
     );
     // Per-point output into a missing directory: I/O error, nothing printed as success.
     let o = run(&[
@@ -245,13 +244,13 @@ fn bad_inputs_are_clear_errors() {
         "--per-point",
         p(&d.join("none/pp.csv")),
     ]);
-    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
+    o.assert_code(4);
     // A result of another robot.
     let wam = robocal_core::load_robot(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/wam.toml"))
         .unwrap();
     let r = d.join("wam.json");
     result_for(&wam, &wam, &t.frame).write(&r).unwrap();
     let o = run(&["--params", p(&r), "--data", p(&data)]);
-    assert_eq!(o.status.code(), Some(3));
-    assert!(stderr(&o).contains("robot.dof"), "{}", stderr(&o));
+    o.assert_code(3);
+    assert!(o.stderr().contains("robot.dof"), "{}", o.stderr());
 }

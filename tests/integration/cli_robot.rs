@@ -1,30 +1,6 @@
 //! `robocal robot show` and `robocal fk`, including bad robot files and arguments.
 
-use std::path::Path;
-use std::process::{Command, Output};
-
-fn robocal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .output()
-        .expect("run robocal")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn example(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("examples")
-        .join(name)
-        .display()
-        .to_string()
-}
+use crate::util::*;
 
 #[test]
 fn fk_table1_zero_pose_json() {
@@ -36,8 +12,8 @@ fn fk_table1_zero_pose_json() {
         "0,0,0,0,0,0",
         "--json",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    o.assert_ok();
+    let v: serde_json::Value = serde_json::from_str(&o.stdout()).unwrap();
     let got = [
         v["x"].as_f64().unwrap(),
         v["y"].as_f64().unwrap(),
@@ -58,8 +34,8 @@ fn fk_negative_joint_values_and_text_output() {
         "--joints",
         "-10,-20,30,-40,50,-60",
     ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stdout(&o).contains("tool position (mm, base frame): x ="));
+    o.assert_ok();
+    assert!(o.stdout().contains("tool position (mm, base frame): x ="));
 }
 
 #[test]
@@ -74,30 +50,29 @@ fn robot_file_equals_preset() {
         q,
         "--json",
     ]);
-    assert!(a.status.success() && b.status.success(), "{}", stderr(&b));
-    assert_eq!(stdout(&a), stdout(&b));
+    assert!(a.success() && b.success(), "{}", b.stderr());
+    assert_eq!(a.stdout(), b.stdout());
 }
 
 #[test]
 fn robot_show_prints_table_one() {
     let o = robocal(&["robot", "show", "kuka-kr480-r3330"]);
-    assert!(o.status.success());
-    let s = stdout(&o);
+    o.assert_ok();
+    let s = o.stdout();
     assert!(
         s.contains("alpha (deg)") && s.contains("1045.0000") && s.contains("-55.0000"),
         "{s}"
     );
     assert!(s.contains("q2: -130 .. 20"), "{s}");
     let o = robocal(&["robot", "show", &example("wam.toml")]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stdout(&o).contains("7 joints"));
+    o.assert_ok();
+    assert!(o.stdout().contains("7 joints"));
 }
 
 /// Writes a robot file into a temporary directory and runs `fk` on it.
-fn fk_with_file(toml: &str, joints: &str) -> (Output, String) {
-    let dir = tempfile::tempdir().unwrap();
-    let p = dir.path().join("bad.toml");
-    std::fs::write(&p, toml).unwrap();
+fn fk_with_file(toml: &str, joints: &str) -> (Outcome, String) {
+    let dir = Dir::new();
+    let p = dir.write("bad.toml", toml);
     let ps = p.display().to_string();
     (robocal(&["fk", "--robot", &ps, "--joints", joints]), ps)
 }
@@ -106,8 +81,8 @@ const TWO: &str = "convention = \"dh\"\n[[joints]]\nalpha = 90\nd = 100\na = 0\n
 
 fn expect_failure(toml: &str, joints: &str, code: i32, needles: &[&str]) {
     let (o, path) = fk_with_file(toml, joints);
-    assert_eq!(o.status.code(), Some(code), "stderr: {}", stderr(&o));
-    let e = stderr(&o);
+    o.assert_code(code);
+    let e = o.stderr();
     assert!(!e.contains("panicked"), "{e}");
     for n in needles {
         let n = n.replace("{path}", &path);
@@ -118,7 +93,7 @@ fn expect_failure(toml: &str, joints: &str, code: i32, needles: &[&str]) {
 #[test]
 fn good_file_works() {
     let (o, _) = fk_with_file(TWO, "0,0");
-    assert!(o.status.success(), "{}", stderr(&o));
+    o.assert_ok();
 }
 
 #[test]
@@ -171,26 +146,26 @@ fn joint_count_mismatch() {
         "--joints",
         "0,0,x,0,0,0",
     ]);
-    assert_eq!(o.status.code(), Some(2));
+    o.assert_code(2);
     assert!(
-        stderr(&o).contains("value 3 `x` is not a number"),
+        o.stderr().contains("value 3 `x` is not a number"),
         "{}",
-        stderr(&o)
+        o.stderr()
     );
 }
 
 #[test]
 fn unknown_preset_and_missing_file() {
     let o = robocal(&["fk", "--robot", "kuka-kr1000", "--joints", "0,0,0,0,0,0"]);
-    assert_eq!(o.status.code(), Some(2));
+    o.assert_code(2);
     assert!(
-        stderr(&o).contains("unknown robot preset `kuka-kr1000`"),
+        o.stderr().contains("unknown robot preset `kuka-kr1000`"),
         "{}",
-        stderr(&o)
+        o.stderr()
     );
     let o = robocal(&["fk", "--robot", "missing/robot.toml", "--joints", "0"]);
-    assert_eq!(o.status.code(), Some(4));
-    assert!(stderr(&o).contains("missing/robot.toml"), "{}", stderr(&o));
+    o.assert_code(4);
+    assert!(o.stderr().contains("missing/robot.toml"), "{}", o.stderr());
 }
 
 /// `robocal ... | head`: a closed stdout ends the program quietly (SIGPIPE), never with a panic.
@@ -199,7 +174,7 @@ fn unknown_preset_and_missing_file() {
 fn closed_stdout_is_not_a_panic() {
     use std::os::unix::process::ExitStatusExt;
     use std::process::Stdio;
-    let mut child = Command::new(env!("CARGO_BIN_EXE_robocal"))
+    let mut child = command()
         .args(["robot", "show", "kuka-kr480-r3330"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
@@ -207,7 +182,7 @@ fn closed_stdout_is_not_a_panic() {
         .unwrap();
     drop(child.stdout.take());
     let o = child.wait_with_output().unwrap();
-    let e = stderr(&o);
+    let e = String::from_utf8_lossy(&o.stderr).into_owned();
     assert!(!e.contains("panicked"), "{e}");
     assert!(
         o.status.success() || o.status.signal() == Some(13),

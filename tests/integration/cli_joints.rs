@@ -2,72 +2,18 @@
 //! (`examples/kr480-track.toml`) simulated, calibrated, compensated and verified; axis columns
 //! instead of joint columns; `robot show` and `fk` with a track; bad `[controller]` sections.
 
+use crate::util::*;
 use robocal_core::io::CalibrationResult;
 use robocal_core::load_robot;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn robocal(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_robocal"))
-        .args(args)
-        .output()
-        .expect("run robocal")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-fn example(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("examples")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-fn p(path: &Path) -> &str {
-    path.to_str().unwrap()
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = robocal(args);
-    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
-    stdout(&o)
-}
-
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut lines = text.lines();
-    let header = lines.next().unwrap().split(',').map(String::from).collect();
-    let rows = lines
-        .map(|l| l.split(',').map(String::from).collect())
-        .collect();
-    (header, rows)
-}
-
-fn col(h: &[String], name: &str) -> usize {
-    h.iter()
-        .position(|c| c == name)
-        .unwrap_or_else(|| panic!("no column {name} in {h:?}"))
-}
-
-fn num(s: &str) -> f64 {
-    s.parse()
-        .unwrap_or_else(|_| panic!("`{s}` is not a number"))
-}
+use std::path::PathBuf;
 
 /// The track robot's whole cycle: simulate -> calibrate -> compensate -> measure the commanded
 /// poses -> evaluate. The track's values are mm in every file (never converted), the commanded
 /// file carries the controller's axes, and the verification matches the prediction.
 #[test]
 fn simulate_calibrate_compensate_verify_on_the_tracked_robot() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = |f: &str| -> PathBuf { dir.path().join(f) };
+    let dir = Dir::new();
+    let d = |f: &str| -> PathBuf { dir.join(f) };
     let robot = example("kr480-track.toml");
     let nominal = load_robot(&robot).unwrap();
     ok(&[
@@ -100,7 +46,8 @@ fn simulate_calibrate_compensate_verify_on_the_tracked_robot() {
         p(&d("cell.csv")),
         "--out",
         p(&d("res.json")),
-    ]);
+    ])
+    .stdout();
     assert!(out.contains("prismatic"), "{out}");
     let res = CalibrationResult::read(&d("res.json")).unwrap();
     assert_eq!(res.robot.joint_types[0], robocal_core::JointType::Prismatic);
@@ -118,7 +65,8 @@ fn simulate_calibrate_compensate_verify_on_the_tracked_robot() {
         p(&d("cell.csv")),
         "--out",
         p(&d("cmd.csv")),
-    ]);
+    ])
+    .stdout();
     assert!(out.contains("converged           123"), "{out}");
     assert!(out.contains(" mm (line"), "{out}");
     let (h, rows) = read_csv(&d("cmd.csv"));
@@ -166,7 +114,8 @@ fn simulate_calibrate_compensate_verify_on_the_tracked_robot() {
         p(&d("res.json")),
         "--data",
         p(&d("verify.csv")),
-    ]);
+    ])
+    .stdout();
     assert!(out.contains("verification"), "{out}");
     let line = out
         .lines()
@@ -180,8 +129,8 @@ fn simulate_calibrate_compensate_verify_on_the_tracked_robot() {
 /// data with the model's `q1..qn` (FANUC-style J2/J3 coupling: q3 = -(J2 + J3)).
 #[test]
 fn axis_columns_calibrate_like_joint_columns() {
-    let dir = tempfile::tempdir().unwrap();
-    let d = |f: &str| -> PathBuf { dir.path().join(f) };
+    let dir = Dir::new();
+    let d = |f: &str| -> PathBuf { dir.join(f) };
     let robot = example("fanuc-like.toml");
     let r = load_robot(&robot).unwrap();
     ok(&[
@@ -260,11 +209,11 @@ fn axis_columns_calibrate_like_joint_columns() {
         "--out",
         p(&d("both.json")),
     ]);
-    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    o.assert_code(3);
     assert!(
-        stderr(&o).contains("both.csv:6: field `axis3`") && stderr(&o).contains("disagrees"),
+        o.stderr().contains("both.csv:6: field `axis3`") && o.stderr().contains("disagrees"),
         "{}",
-        stderr(&o)
+        o.stderr()
     );
     assert!(!d("both.json").exists());
 }
@@ -272,7 +221,7 @@ fn axis_columns_calibrate_like_joint_columns() {
 #[test]
 fn robot_show_and_fk_with_a_track() {
     let robot = example("kr480-track.toml");
-    let s = ok(&["robot", "show", &robot]);
+    let s = ok(&["robot", "show", &robot]).stdout();
     for n in [
         "1 prismatic",
         "2  revolute",
@@ -282,12 +231,13 @@ fn robot_show_and_fk_with_a_track() {
     ] {
         assert!(s.contains(n), "`{s}` lacks `{n}`");
     }
-    let s = ok(&["robot", "show", &example("fanuc-like.toml")]);
+    let s = ok(&["robot", "show", &example("fanuc-like.toml")]).stdout();
     assert!(s.contains("q3 = -axis3 - axis2"), "{s}");
     // fk: the track's value is mm (1000 mm along x), the arm's degrees.
     let at = |j: &str| -> [f64; 3] {
         let v: serde_json::Value =
-            serde_json::from_str(&ok(&["fk", "--robot", &robot, "--joints", j, "--json"])).unwrap();
+            serde_json::from_str(&ok(&["fk", "--robot", &robot, "--joints", j, "--json"]).stdout())
+                .unwrap();
         [
             v["x"].as_f64().unwrap(),
             v["y"].as_f64().unwrap(),
@@ -304,7 +254,7 @@ fn robot_show_and_fk_with_a_track() {
 
 #[test]
 fn bad_controller_section_names_file_line_and_field() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = Dir::new();
     let text = std::fs::read_to_string(example("fanuc-like.toml")).unwrap();
     for (from, to, needles) in [
         (
@@ -328,12 +278,11 @@ fn bad_controller_section_names_file_line_and_field() {
     ] {
         let bad = text.replace(from, to);
         assert_ne!(bad, text);
-        let path = dir.path().join("bad.toml");
-        std::fs::write(&path, &bad).unwrap();
+        let path = dir.write("bad.toml", &bad);
         let line = bad.lines().position(|l| l == to).unwrap() + 1;
         let o = robocal(&["fk", "--robot", p(&path), "--joints", "0,0,0,0,0,0"]);
-        assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
-        let e = stderr(&o);
+        o.assert_code(3);
+        let e = o.stderr();
         let at = format!("{}:{line}: ", path.display());
         assert!(e.contains(&at), "`{e}` lacks `{at}`");
         for n in needles {

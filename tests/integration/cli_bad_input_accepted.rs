@@ -2,9 +2,9 @@
 //! input type gives exactly what its LF twin gives), joint values that look like radians (a
 //! warning, the run goes on) and duplicated rows outside calibration.
 
-mod bad_input_support;
-
-use bad_input_support::*;
+use crate::util::bad_input::crlf_bom;
+use crate::util::fixtures::cell;
+use crate::util::*;
 use std::path::{Path, PathBuf};
 
 /// Writes `crlf_bom(text of good)` next to the case files.
@@ -16,16 +16,10 @@ fn crlf_copy(dir: &Path, good: &Path, name: &str) -> PathBuf {
     f
 }
 
-fn ok(args: &[&str]) -> std::process::Output {
-    let o = robocal(args);
-    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
-    o
-}
-
 #[test]
 fn crlf_and_byte_order_mark_are_accepted_by_every_reader() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     let data = crlf_copy(d, &fx.data, "data.csv");
     let joints = crlf_copy(d, &fx.joints, "joints.csv");
@@ -62,7 +56,7 @@ fn crlf_and_byte_order_mark_are_accepted_by_every_reader() {
             p(data),
             "--json",
         ]);
-        let mut v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+        let mut v: serde_json::Value = serde_json::from_str(&o.stdout()).unwrap();
         let o = v.as_object_mut().unwrap();
         o.remove("data");
         o.remove("params");
@@ -73,7 +67,7 @@ fn crlf_and_byte_order_mark_are_accepted_by_every_reader() {
     // Result JSON.
     assert_eq!(eval(&fx.data, &result), reference);
     let fk = |res: &Path| {
-        stdout(&ok(&[
+        ok(&[
             "fk",
             "--robot",
             KUKA,
@@ -82,7 +76,8 @@ fn crlf_and_byte_order_mark_are_accepted_by_every_reader() {
             "--joints",
             "10,-80,70,5,30,0",
             "--json",
-        ]))
+        ])
+        .stdout()
     };
     assert_eq!(fk(&result), fk(&fx.result));
 
@@ -136,14 +131,14 @@ fn crlf_and_byte_order_mark_are_accepted_by_every_reader() {
     );
 
     // Robot TOML: the same model.
-    let show = |r: &Path| stdout(&ok(&["robot", "show", p(r)]));
+    let show = |r: &Path| ok(&["robot", "show", p(r)]).stdout();
     assert_eq!(show(&robot), show(&fx.robot_toml));
 }
 
 #[test]
 fn joint_values_that_look_like_radians_are_warned_about_and_the_run_goes_on() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     let to_radians = |text: &str, joints: usize| -> String {
         let mut out = String::new();
@@ -228,8 +223,8 @@ fn joint_values_that_look_like_radians_are_warned_about_and_the_run_goes_on() {
     .collect();
     for (args, f) in runs {
         let o = robocal(&args);
-        let err = stderr(&o);
-        assert!(o.status.success(), "{args:?}: {err}");
+        let err = o.stderr();
+        o.assert_ok();
         assert!(err.contains(&warning(&f)), "{args:?}: {err}");
         assert!(
             err.contains("they look like radians, but files hold degrees"),
@@ -248,7 +243,7 @@ fn joint_values_that_look_like_radians_are_warned_about_and_the_run_goes_on() {
         "--out",
         p(&d.join("r.json")),
     ]);
-    assert!(stderr(&o).contains(&warning(&data)), "{}", stderr(&o));
+    assert!(o.stderr().contains(&warning(&data)), "{}", o.stderr());
     // Degrees do not trigger it.
     let o = ok(&[
         "evaluate",
@@ -259,13 +254,13 @@ fn joint_values_that_look_like_radians_are_warned_about_and_the_run_goes_on() {
         "--data",
         p(&fx.data),
     ]);
-    assert!(!stderr(&o).contains("radians"), "{}", stderr(&o));
+    assert!(!o.stderr().contains("radians"), "{}", o.stderr());
 }
 
 #[test]
 fn duplicated_rows_are_kept_outside_calibration() {
-    let fx = fixture();
-    let dir = tempfile::tempdir().unwrap();
+    let fx = cell();
+    let dir = Dir::new();
     let d = dir.path();
     let text = std::fs::read_to_string(&fx.joints).unwrap();
     let row = text.lines().nth(2).unwrap().to_owned();
@@ -308,6 +303,6 @@ fn duplicated_rows_are_kept_outside_calibration() {
         p(&data),
         "--json",
     ]);
-    let v: serde_json::Value = serde_json::from_str(&stdout(&o)).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&o.stdout()).unwrap();
     assert_eq!(v["n"], 34);
 }
