@@ -20,8 +20,8 @@ pub mod rigid;
 
 use crate::error::{Error, Result};
 use crate::frame::Frame;
-use crate::identification::Observations;
 use crate::model::Robot;
+use crate::observations::Observations;
 use crate::stats::ErrorStats;
 use nalgebra::Vector3;
 
