@@ -77,7 +77,7 @@ pub struct SetErrors {
 
 impl SetErrors {
     fn new(obs: &Observations, reg: &Registration, nominal: &Robot, cal: &Robot) -> SetErrors {
-        let p = Problem::new(nominal, &[], obs, &reg.frame);
+        let p = Problem::new(nominal, &[], obs, reg.frame.pose());
         SetErrors {
             lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
             before: p.error_norms(nominal),
@@ -263,7 +263,7 @@ pub fn calibrate(
         )));
     }
 
-    let problem = Problem::new(nominal, &ident.identified, cal, &registration.frame);
+    let problem = Problem::new(nominal, &ident.identified, cal, registration.frame.pose());
     let mut robot = nominal.clone();
     let mut stages = Vec::new();
     let mut run = |robot: &mut Robot, loss: Loss, stages: &mut Vec<Stage>| -> Result<()> {

@@ -12,7 +12,7 @@ use crate::frame::Frame;
 use crate::identification::objective::Loss;
 use crate::identification::Observations;
 use crate::model::{Param, Robot, MAX_JOINTS};
-use nalgebra::{DMatrix, DVector, Point3, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 use rayon::prelude::*;
 
 /// Largest number of model parameters (all of `alpha, d, a, phi, beta` for [`MAX_JOINTS`] joints
@@ -208,11 +208,7 @@ impl<'a> Problem<'a> {
                     .expect("parameter of the robot")
             })
             .collect();
-        let targets = obs
-            .measured()
-            .iter()
-            .map(|m| (frame * Point3::from(*m)).coords)
-            .collect();
+        let targets = crate::frame::TrackerFrame::new(*frame).points_to_base(obs.measured());
         Problem {
             params: params.to_vec(),
             index,
