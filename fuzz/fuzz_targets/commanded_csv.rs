@@ -26,7 +26,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let truth = robocal_core::preset("kuka-kr480-r3330-table3").expect("preset");
-    let frame = robocal_core::Frame::identity();
+    let frame = robocal_core::frame::TrackerFrame::identity();
     if let Ok(ev) = evaluate(&nominal, &truth, &frame, &set, against) {
         for s in &ev.series {
             assert_eq!(s.errors.len(), set.rows.len());

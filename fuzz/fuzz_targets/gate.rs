@@ -10,6 +10,7 @@ use libfuzzer_sys::arbitrary::{self, Arbitrary};
 use libfuzzer_sys::fuzz_target;
 use nalgebra::Vector3;
 use rand::SeedableRng;
+use robocal_core::frame::TrackerFrame;
 use robocal_core::identification::{calibrate, CalibrationData, CalibrationSettings, Observations};
 use robocal_core::simulation::{random_poses, PoseSampler};
 use robocal_core::{pose, Robot};
@@ -68,15 +69,14 @@ fuzz_target!(|m: Mistakes| {
     let n = c.nominal.dof();
     let scale = SCALES[m.scale as usize % SCALES.len()];
     let t = &m.tracker;
-    let tracker = pose(&[
+    let tracker = TrackerFrame::new(pose(&[
         t[0] as f64 / 10.0,
         t[1] as f64 / 10.0,
         t[2] as f64 / 10.0,
         (t[3] as f64 / 100.0).to_radians(),
         (t[4] as f64 / 400.0).to_radians(),
         (t[5] as f64 / 100.0).to_radians(),
-    ]);
-    let inverse = tracker.inverse();
+    ]));
     let mut obs = Observations::new(n);
     let mut kept = 0;
     for (i, (q, p)) in c.qs.iter().zip(&c.points).enumerate() {
@@ -97,7 +97,7 @@ fuzz_target!(|m: Mistakes| {
             }
         }
         // The reading in the tracker frame, with noise and outliers.
-        let mut r = (inverse * nalgebra::Point3::from(*p)).coords;
+        let mut r = tracker.to_tracker(p);
         let e = m.noise_um as f64 * 1e-3;
         r += Vector3::new(
             e * ((i * 7 % 11) as f64 / 5.0 - 1.0),

@@ -15,7 +15,7 @@ fuzz_target!(|data: &[u8]| {
             let q = vec![0.1; robot.dof()];
             let _ = robot.tool_position(&q);
         }
-        let _ = tf.tracker_frame.to_frame();
+        let _ = tf.tracker_frame.to_tracker_frame();
         let _ = tf.settings.validate(&nominal);
     }
 });

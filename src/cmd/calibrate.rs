@@ -498,7 +498,7 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
         ""
     };
     let reg = &c.registration;
-    let tf = robocal_core::io::result::FrameVec::from_frame(&reg.frame);
+    let tf = robocal_core::io::result::FrameVec::from_tracker_frame(&reg.frame);
     println!();
     match reg.initial {
         robocal_core::registration::InitialFrame::Plane {

@@ -3,7 +3,7 @@
 
 use crate::util::*;
 use rand::SeedableRng;
-use robocal_core::frame::pose;
+use robocal_core::frame::{pose, TrackerFrame};
 use robocal_core::io::CalibrationResult;
 use robocal_core::simulation::{random_poses, PoseSampler, Tracker};
 use robocal_core::{preset, Robot};
@@ -13,7 +13,8 @@ use std::path::{Path, PathBuf};
 
 fn tracker(noise: bool) -> Tracker {
     let (s, p) = if noise { (0.010, 0.005) } else { (0.0, 0.0) };
-    Tracker::new(pose(&[3900.0, -2200.0, -350.0, 2.65, 0.007, -0.012]), s, p).unwrap()
+    let frame = TrackerFrame::new(pose(&[3900.0, -2200.0, -350.0, 2.65, 0.007, -0.012]));
+    Tracker::new(frame, s, p).unwrap()
 }
 
 /// Simulated rows `(q rad, measured point)` of the Table III truth.
@@ -166,8 +167,8 @@ fn calibrate_prints_the_tables_and_writes_the_contract() {
     let mean = rows
         .iter()
         .map(|(q, m)| {
-            let p = f * nalgebra::Point3::new(m[0], m[1], m[2]);
-            (p.coords - robot.tool_position(q)).norm()
+            let p = f.to_base(&nalgebra::Vector3::new(m[0], m[1], m[2]));
+            (p - robot.tool_position(q)).norm()
         })
         .sum::<f64>()
         / rows.len() as f64;
@@ -237,8 +238,8 @@ fn fk_with_the_result_uses_the_calibrated_model() {
         }
         // And the calibrated model predicts what the (noise-free) tracker would measure.
         let m = tr.exact(&truth.tool_position(&qr));
-        let pm = f * nalgebra::Point3::from(m);
-        assert!((pm.coords - lib).norm() < 1e-5, "{pm} vs {lib}");
+        let pm = f.to_base(&m);
+        assert!((pm - lib).norm() < 1e-5, "{pm} vs {lib}");
     }
 }
 

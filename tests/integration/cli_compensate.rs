@@ -3,12 +3,13 @@
 
 use crate::util::library::*;
 use crate::util::*;
-use robocal_core::{preset, Frame, Robot};
+use robocal_core::frame::TrackerFrame;
+use robocal_core::{preset, Robot};
 use std::path::Path;
 
 fn setup() -> (Dir, std::path::PathBuf) {
     let dir = Dir::new();
-    let res = write_result(dir.path(), &Frame::identity());
+    let res = write_result(dir.path(), &TrackerFrame::identity());
     (dir, res)
 }
 
@@ -172,7 +173,7 @@ fn bad_results_and_inputs_are_clear_errors_and_write_nothing() {
     let ur5 = robocal_core::load_robot(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/ur5.toml"))
         .unwrap();
     let r = d.join("ur5.json");
-    result_for(&ur5, &ur5, &Frame::identity())
+    result_for(&ur5, &ur5, &TrackerFrame::identity())
         .write(&r)
         .unwrap();
     fails(
@@ -185,7 +186,7 @@ fn bad_results_and_inputs_are_clear_errors_and_write_nothing() {
     let wam = robocal_core::load_robot(concat!(env!("CARGO_MANIFEST_DIR"), "/examples/wam.toml"))
         .unwrap();
     let r = d.join("wam.json");
-    result_for(&wam, &wam, &Frame::identity())
+    result_for(&wam, &wam, &TrackerFrame::identity())
         .write(&r)
         .unwrap();
     fails(
@@ -197,7 +198,9 @@ fn bad_results_and_inputs_are_clear_errors_and_write_nothing() {
     // Same shape, another nominal model (Table III as nominal).
     let t3: Robot = preset(TRUTH).unwrap();
     let r = d.join("t3.json");
-    result_for(&t3, &t3, &Frame::identity()).write(&r).unwrap();
+    result_for(&t3, &t3, &TrackerFrame::identity())
+        .write(&r)
+        .unwrap();
     fails(
         d,
         &with(&["--params", p(&r)], inp),

@@ -2,7 +2,8 @@
 //! truth files, non-geometric errors and bad input (clear errors, nothing written).
 
 use crate::util::*;
-use nalgebra::{Point3, Vector3};
+use nalgebra::Vector3;
+use robocal_core::frame::TrackerFrame;
 use robocal_core::io::measurements::{read_measurements, MeasurementSet, Positions};
 use robocal_core::io::result::FrameVec;
 use robocal_core::preset;
@@ -40,9 +41,9 @@ fn truth_of(csv: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
 }
 
-fn tracker_frame(v: &serde_json::Value) -> robocal_core::Frame {
+fn tracker_frame(v: &serde_json::Value) -> TrackerFrame {
     let f: FrameVec = serde_json::from_value(v["tracker_frame"].clone()).unwrap();
-    f.to_frame()
+    f.to_tracker_frame()
 }
 
 #[test]
@@ -98,7 +99,7 @@ fn nominal_truth_without_noise_is_the_rigidly_moved_nominal() {
     let m = read(&out);
     assert_eq!(m.rows.len(), 63);
     for row in &m.rows {
-        let expected = (f.inverse() * Point3::from(r.tool_position(&row.q))).coords;
+        let expected = f.to_tracker(&r.tool_position(&row.q));
         // The CSV holds 6 decimals of a millimetre.
         assert!(
             (row.p.unwrap() - expected).norm() < 2e-6,
@@ -128,9 +129,9 @@ fn noise_spread_matches_sigma_over_10000_points() {
     let (mut ss, mut sigma2) = (Vector3::zeros(), 0.0);
     for row in &m.rows {
         let p = r.tool_position(&row.q);
-        let dist_m = (p - f.translation.vector).norm() / 1000.0;
+        let dist_m = (p - f.origin()).norm() / 1000.0;
         let sigma = 0.02 + 0.01 * dist_m;
-        let e = row.p.unwrap() - (f.inverse() * Point3::from(p)).coords;
+        let e = row.p.unwrap() - f.to_tracker(&p);
         ss += e.component_mul(&e);
         sigma2 += sigma * sigma;
     }

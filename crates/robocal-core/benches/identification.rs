@@ -4,7 +4,7 @@
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::SeedableRng;
-use robocal_core::frame::pose;
+use robocal_core::frame::{pose, TrackerFrame};
 use robocal_core::identification::{calibrate, CalibrationData, CalibrationSettings, Observations};
 use robocal_core::simulation::{random_poses, PoseSampler, Tracker};
 use robocal_core::{preset, Robot};
@@ -13,7 +13,7 @@ use std::hint::black_box;
 fn data(truth: &Robot, n: usize, seed: u64) -> Observations {
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let tracker = Tracker::new(
-        pose(&[3900.0, -2200.0, -350.0, 2.65, 0.007, -0.012]),
+        TrackerFrame::new(pose(&[3900.0, -2200.0, -350.0, 2.65, 0.007, -0.012])),
         0.010,
         0.005,
     )

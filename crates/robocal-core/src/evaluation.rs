@@ -17,7 +17,7 @@
 
 use crate::compensation::commanded::{desired_joint_column, DESIRED_POSITION_COLUMNS};
 use crate::error::{Error, Result};
-use crate::frame::Frame;
+use crate::frame::TrackerFrame;
 use crate::io::result::CalibrationResult;
 use crate::io::{Measurement, MeasurementSet};
 use crate::model::Robot;
@@ -87,7 +87,7 @@ pub struct Evaluation {
 pub fn evaluate(
     nominal: &Robot,
     calibrated: &Robot,
-    tracker_frame: &Frame,
+    tracker_frame: &TrackerFrame,
     data: &MeasurementSet,
     against: Against,
 ) -> Result<Evaluation> {
@@ -123,7 +123,7 @@ pub fn evaluate(
 }
 
 /// Whether a data set carries desired positions or desired joints.
-pub fn has_desired_columns(data: &MeasurementSet) -> bool {
+pub(crate) fn has_desired_columns(data: &MeasurementSet) -> bool {
     DesiredSource::find(data, data.dof()).is_ok()
 }
 

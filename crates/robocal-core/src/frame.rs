@@ -2,36 +2,39 @@
 //!
 //! `pose(v) = Trans(x, y, z) * Rz(A) * Ry(B) * Rx(C)` (DESIGN.md). Inside the library angles are in
 //! radians; the conversion to degrees happens at the interfaces.
+//!
+//! [`TrackerFrame`] is the one way a measured point (or frame) gets from the laser tracker's
+//! frame into the robot's base frame.
 
-use nalgebra::{IsometryMatrix3, Matrix3, Rotation3, Translation3, Vector3};
+use nalgebra::{IsometryMatrix3, Matrix3, Point3, Rotation3, Translation3, Vector3};
 
 /// A rigid transform (rotation matrix + translation), the type every frame in robocal uses.
 pub type Frame = IsometryMatrix3<f64>;
 
 /// Rotation about x by `t` radians.
 #[inline]
-pub fn rot_x(t: f64) -> Matrix3<f64> {
+pub(crate) fn rot_x(t: f64) -> Matrix3<f64> {
     let (s, c) = t.sin_cos();
     Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
 }
 
 /// Rotation about y by `t` radians.
 #[inline]
-pub fn rot_y(t: f64) -> Matrix3<f64> {
+pub(crate) fn rot_y(t: f64) -> Matrix3<f64> {
     let (s, c) = t.sin_cos();
     Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
 }
 
 /// Rotation about z by `t` radians.
 #[inline]
-pub fn rot_z(t: f64) -> Matrix3<f64> {
+pub(crate) fn rot_z(t: f64) -> Matrix3<f64> {
     let (s, c) = t.sin_cos();
     Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 }
 
 /// Builds a frame from a rotation matrix (assumed orthonormal) and a translation.
 #[inline]
-pub fn frame(r: Matrix3<f64>, p: Vector3<f64>) -> Frame {
+pub(crate) fn frame(r: Matrix3<f64>, p: Vector3<f64>) -> Frame {
     Frame::from_parts(Translation3::from(p), Rotation3::from_matrix_unchecked(r))
 }
 
@@ -59,7 +62,7 @@ pub fn frame_vector(f: &Frame) -> [f64; 6] {
 }
 
 /// Converts a frame vector from mm/degrees to mm/radians.
-pub fn vec_deg_to_rad(v: &[f64; 6]) -> [f64; 6] {
+pub(crate) fn vec_deg_to_rad(v: &[f64; 6]) -> [f64; 6] {
     [
         v[0],
         v[1],
@@ -85,10 +88,73 @@ pub fn vec_rad_to_deg(v: &[f64; 6]) -> [f64; 6] {
 /// The axes about which the three angles of a frame vector rotate, in the frame's parent:
 /// `[z, Rz(A) y, Rz(A) Ry(B) x]`. Used for the analytic derivatives of `pose(v)` with respect to A,
 /// B and C.
-pub fn euler_axes(a: f64, b: f64) -> [Vector3<f64>; 3] {
+pub(crate) fn euler_axes(a: f64, b: f64) -> [Vector3<f64>; 3] {
     let rz = rot_z(a);
     let rzy = rz * rot_y(b);
     [Vector3::z(), rz.column(1).into(), rzy.column(0).into()]
+}
+
+/// The pose of the laser tracker's frame in the robot's base frame (the paper's measurement frame
+/// MF in the ACS, section II.C; the result JSON's `tracker_frame`): a point `m` measured in the
+/// tracker frame is `pose(tracker_frame) * m` in the base frame.
+///
+/// Every mapping of measurements into the base frame goes through this type, so that the
+/// direction of the transform is written down once.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackerFrame(Frame);
+
+impl TrackerFrame {
+    /// The tracker frame whose pose in the base frame is `pose`.
+    pub fn new(pose: Frame) -> Self {
+        TrackerFrame(pose)
+    }
+
+    /// A tracker frame that coincides with the base frame.
+    pub fn identity() -> Self {
+        TrackerFrame(Frame::identity())
+    }
+
+    /// From its frame vector `[x, y, z, A, B, C]` in mm and **degrees** (the files' units).
+    pub fn from_vector_deg(v: &[f64; 6]) -> Self {
+        TrackerFrame(pose(&vec_deg_to_rad(v)))
+    }
+
+    /// Its frame vector `[x, y, z, A, B, C]` in mm and **degrees** (see [`frame_vector`]).
+    pub fn vector_deg(&self) -> [f64; 6] {
+        vec_rad_to_deg(&frame_vector(&self.0))
+    }
+
+    /// Its pose in the base frame.
+    pub fn pose(&self) -> &Frame {
+        &self.0
+    }
+
+    /// The tracker's origin in the base frame (mm).
+    pub fn origin(&self) -> Vector3<f64> {
+        self.0.translation.vector
+    }
+
+    /// A point measured in the tracker frame, in the base frame: `pose * m`.
+    pub fn to_base(&self, m: &Vector3<f64>) -> Vector3<f64> {
+        (self.0 * Point3::from(*m)).coords
+    }
+
+    /// Points measured in the tracker frame, in the base frame ([`TrackerFrame::to_base`]).
+    pub fn points_to_base(&self, measured: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
+        measured.iter().map(|m| self.to_base(m)).collect()
+    }
+
+    /// A frame measured in the tracker frame (a 6-DoF measurement), in the base frame:
+    /// `pose * f`.
+    pub fn frame_to_base(&self, f: &Frame) -> Frame {
+        self.0 * f
+    }
+
+    /// A point given in the base frame, as the tracker measures it: `pose^-1 * p` (the inverse of
+    /// [`TrackerFrame::to_base`]).
+    pub fn to_tracker(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        (self.0.inverse() * Point3::from(*p)).coords
+    }
 }
 
 #[cfg(test)]
@@ -122,5 +188,32 @@ mod tests {
             let an = axes[k].cross(&q.coords);
             assert!((fd - an).norm() < 1e-8, "{k}: {fd} vs {an}");
         }
+    }
+
+    #[test]
+    fn tracker_frame_maps_points_and_frames_into_the_base_frame() {
+        // A tracker 2 m in front of the robot, turned to face it: its x axis is the base's -x.
+        let t = TrackerFrame::from_vector_deg(&[2000.0, 0.0, 500.0, 180.0, 0.0, 0.0]);
+        let m = Vector3::new(100.0, 20.0, -30.0);
+        let p = t.to_base(&m);
+        assert!(
+            (p - Vector3::new(1900.0, -20.0, 470.0)).norm() < 1e-9,
+            "{p}"
+        );
+        assert!((t.to_tracker(&p) - m).norm() < 1e-9);
+        assert_eq!(t.points_to_base(&[m, m]), vec![p, p]);
+        assert_eq!(t.origin(), Vector3::new(2000.0, 0.0, 500.0));
+        // A measured frame: its origin maps as a point, its axes turn with the tracker.
+        let f = pose(&[100.0, 20.0, -30.0, 0.0, 0.0, 0.0]);
+        let g = t.frame_to_base(&f);
+        assert!((g.translation.vector - p).norm() < 1e-9);
+        assert!((g.rotation.matrix() * Vector3::x() + Vector3::x()).norm() < 1e-12);
+        // The frame vector round trip (degrees at the interface).
+        let v = [10.0, -20.0, 30.0, 40.0, -50.0, 60.0];
+        let w = TrackerFrame::from_vector_deg(&v).vector_deg();
+        for k in 0..6 {
+            assert!((v[k] - w[k]).abs() < 1e-9, "{k}: {v:?} vs {w:?}");
+        }
+        assert_eq!(TrackerFrame::identity().to_base(&m), m);
     }
 }

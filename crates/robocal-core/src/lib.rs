@@ -21,6 +21,7 @@ pub mod identification;
 pub mod io;
 pub mod kinematics;
 pub mod model;
+pub mod observations;
 pub mod ranges;
 pub mod registration;
 pub mod simulation;
@@ -30,9 +31,10 @@ pub mod unit;
 pub use compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
 pub use error::{Error, Result};
 pub use frame::{frame_vector, pose, Frame};
+pub use io::robot::{load_robot, load_robot_file};
 pub use kinematics::poe::{Poe, Twist};
 pub use model::presets::{preset, PRESETS};
-pub use model::robot_file::{load_robot, load_robot_file, parse_robot_toml};
+pub use model::robot_file::parse_robot_toml;
 pub use model::{
     Controller, Convention, JointLimit, JointSpace, JointType, Link, Param, Robot, Unit, MAX_JOINTS,
 };

@@ -74,7 +74,7 @@ fn evaluated(run: &RunData, set: &MeasurementSet, against: Against) -> Result<Ev
         .iter()
         .enumerate()
         .map(|(k, r)| {
-            let measured = (frame * nalgebra::Point3::from(r.p.unwrap_or_default())).coords;
+            let measured = frame.to_base(&r.p.unwrap_or_default());
             let (reach, before, after) = if desired {
                 // The desired position is the measured point minus its error.
                 let e = ev.series[0].errors[k];

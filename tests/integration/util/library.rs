@@ -3,21 +3,23 @@
 
 use super::{KUKA, TRUTH};
 use rand::SeedableRng;
+use robocal_core::frame::TrackerFrame;
 use robocal_core::io::result::{BeforeAfter, ErrorTables, FrameVec, RobotInfo};
 use robocal_core::io::{write_measurements, CalibrationResult, Measurement, MeasurementSet};
 use robocal_core::simulation::{random_poses, PoseSampler, Tracker};
-use robocal_core::{pose, preset, ErrorStats, Frame, Robot};
+use robocal_core::{pose, preset, ErrorStats, Robot};
 use std::path::{Path, PathBuf};
 
 /// The tracker of the virtual cell: about 4 m from the base, turned about its vertical axis.
 pub fn tracker(noise: bool) -> Tracker {
     let (s0, s1) = if noise { (0.010, 0.005) } else { (0.0, 0.0) };
-    Tracker::new(pose(&[3600.0, 1800.0, -250.0, -2.2, 0.003, 0.002]), s0, s1).unwrap()
+    let frame = TrackerFrame::new(pose(&[3600.0, 1800.0, -250.0, -2.2, 0.003, 0.002]));
+    Tracker::new(frame, s0, s1).unwrap()
 }
 
 /// A result file as `calibrate` writes it: `calibrated` as the calibrated model of `nominal`,
 /// with the given tracker frame.
-pub fn result_for(nominal: &Robot, calibrated: &Robot, frame: &Frame) -> CalibrationResult {
+pub fn result_for(nominal: &Robot, calibrated: &Robot, frame: &TrackerFrame) -> CalibrationResult {
     let s = ErrorStats::from_norms(&[1.0, 2.0]);
     CalibrationResult {
         robot: RobotInfo {
@@ -27,7 +29,7 @@ pub fn result_for(nominal: &Robot, calibrated: &Robot, frame: &Frame) -> Calibra
             joint_types: nominal.joint_types().to_vec(),
         },
         parameters: CalibrationResult::parameter_entries(nominal, calibrated),
-        tracker_frame: FrameVec::from_frame(frame),
+        tracker_frame: FrameVec::from_tracker_frame(frame),
         errors: ErrorTables {
             calibration: BeforeAfter {
                 before: s,
@@ -46,7 +48,7 @@ pub fn result_for(nominal: &Robot, calibrated: &Robot, frame: &Frame) -> Calibra
 }
 
 /// Writes the standard result: nominal Table I, "calibrated" = Table III (the simulation's truth).
-pub fn write_result(dir: &Path, frame: &Frame) -> PathBuf {
+pub fn write_result(dir: &Path, frame: &TrackerFrame) -> PathBuf {
     let nom = preset(KUKA).unwrap();
     let cal = preset(TRUTH).unwrap();
     let path = dir.join("result.json");

@@ -5,10 +5,10 @@
 
 use super::{has_desired_columns, Against, DesiredSource, Reference};
 use crate::error::{Error, Result};
-use crate::frame::Frame;
+use crate::frame::TrackerFrame;
 use crate::io::{AtomicFile, Measurement, MeasurementSet};
 use crate::model::Robot;
-use nalgebra::{Point3, Vector3};
+use nalgebra::Vector3;
 use std::io::Write;
 use std::path::Path;
 
@@ -21,7 +21,7 @@ fn types(t: &[crate::model::JointType]) -> String {
 pub struct Evaluator<'a> {
     nominal: &'a Robot,
     calibrated: &'a Robot,
-    tracker_frame: &'a Frame,
+    tracker_frame: &'a TrackerFrame,
     header: &'a MeasurementSet,
     reference: Reference,
     desired: Option<DesiredSource>,
@@ -34,7 +34,7 @@ impl<'a> Evaluator<'a> {
     pub fn new(
         nominal: &'a Robot,
         calibrated: &'a Robot,
-        tracker_frame: &'a Frame,
+        tracker_frame: &'a TrackerFrame,
         header: &'a MeasurementSet,
         against: Against,
     ) -> Result<Evaluator<'a>> {
@@ -108,7 +108,7 @@ impl<'a> Evaluator<'a> {
                 "no measured position (x,y,z)",
             ));
         };
-        let actual = (self.tracker_frame * Point3::from(m)).coords;
+        let actual = self.tracker_frame.to_base(&m);
         let first = match &self.desired {
             None => self.nominal.tool_position(&r.q),
             Some(source) => source.position(self.header, r, self.nominal)?,

@@ -1,7 +1,7 @@
 use super::*;
 use crate::compensation::commanded::write_commanded;
 use crate::compensation::{Compensator, DampedLeastSquares, IkStatus};
-use crate::frame::pose;
+use crate::frame::{pose, TrackerFrame};
 use crate::io::{read_measurements, Positions};
 use crate::model::presets::preset;
 use crate::simulation::{random_poses, PoseSampler, Tracker};
@@ -11,7 +11,12 @@ use std::path::PathBuf;
 
 fn tracker(noise: bool) -> Tracker {
     let (s0, s1) = if noise { (0.010, 0.005) } else { (0.0, 0.0) };
-    Tracker::new(pose(&[3800.0, -1500.0, -300.0, 2.4, 0.004, -0.003]), s0, s1).unwrap()
+    Tracker::new(
+        TrackerFrame::new(pose(&[3800.0, -1500.0, -300.0, 2.4, 0.004, -0.003])),
+        s0,
+        s1,
+    )
+    .unwrap()
 }
 
 /// A measurement set of `truth` at joints `qs`, as `simulate` or a real tracker would give it.
@@ -275,7 +280,7 @@ fn results_of_another_robot_are_rejected() {
             joint_types: vec![],
         },
         parameters: CalibrationResult::parameter_entries(n, c),
-        tracker_frame: crate::io::result::FrameVec::from_frame(&Frame::identity()),
+        tracker_frame: crate::io::result::FrameVec::from_tracker_frame(&TrackerFrame::identity()),
         errors: crate::io::result::ErrorTables {
             calibration: crate::io::result::BeforeAfter {
                 before: ErrorStats::from_norms(&[1.0]),

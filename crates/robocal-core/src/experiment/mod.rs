@@ -402,7 +402,7 @@ pub fn run_experiment(
     let truth_comparison = compare_with_truth(
         &calibration,
         &config.truth,
-        &config.session.tracker_frame.to_frame(),
+        &config.session.tracker_frame.to_tracker_frame(),
         &split.calibration,
         &split_val.validation,
     )?;

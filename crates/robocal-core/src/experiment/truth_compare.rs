@@ -11,13 +11,12 @@
 //! noise), read through the same fitted measurement frame.
 
 use crate::error::{Error, Result};
-use crate::frame::Frame;
+use crate::frame::TrackerFrame;
 use crate::identification::{
     solve, Calibration, Loss, Observations, Problem, SolverOptions, Termination,
 };
 use crate::model::Robot;
 use crate::stats::ErrorStats;
-use nalgebra::Point3;
 
 /// The truth expressed in the calibration's parameters.
 #[derive(Debug, Clone, PartialEq)]
@@ -40,18 +39,17 @@ pub struct TruthComparison {
 pub fn compare_with_truth(
     calibration: &Calibration,
     truth: &Robot,
-    tracker: &Frame,
+    tracker: &TrackerFrame,
     fit: &Observations,
     check: &Observations,
 ) -> Result<TruthComparison> {
     let nominal = &calibration.nominal;
-    let inv = tracker.inverse();
     // Exact tracker readings of the true geometry at every pose.
     let mut exact = Observations::new(nominal.dof());
     for obs in [fit, check] {
         for i in 0..obs.len() {
             let p = truth.tool_position(obs.q(i));
-            exact.push(obs.q(i), (inv * Point3::from(p)).coords, obs.line(i))?;
+            exact.push(obs.q(i), tracker.to_tracker(&p), obs.line(i))?;
         }
     }
     let frame = &calibration.registration.frame;

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::error::Error;
-use crate::frame::pose;
+use crate::frame::{pose, TrackerFrame};
 use crate::model::presets::preset;
 use crate::model::{Param, Robot};
 use crate::simulation::{random_poses, PoseSampler, Tracker};
@@ -22,7 +22,12 @@ fn exact(robot: &Robot, n: usize, seed: u64) -> Observations {
         footprint_radius_mm: 800.0,
         max_tries_per_pose: 10_000,
     };
-    let tr = Tracker::new(pose(&[3900.0, -2200.0, 0.0, 2.6, 0.0, 0.0]), 0.0, 0.0).unwrap();
+    let tr = Tracker::new(
+        TrackerFrame::new(pose(&[3900.0, -2200.0, 0.0, 2.6, 0.0, 0.0])),
+        0.0,
+        0.0,
+    )
+    .unwrap();
     let mut obs = Observations::new(robot.dof());
     for (i, q) in random_poses(robot, n, &sampler, &mut rng)
         .unwrap()

@@ -1,7 +1,8 @@
 //! Identification of the calibrated parameters (paper, sections II.A and III): minimize the
 //! total displacement error `sum |E_i|` (eq. 4) over the parameters the poses can identify.
 //!
-//! - [`observations`]: the measured points and their CSV lines;
+//! - [`split`]: a measurement file's rows sorted by role into [`Observations`]
+//!   ([`crate::observations`]): calibration, validation and plane points;
 //! - [`objective`]: sum of norms (eq. 4), least squares and robust losses;
 //! - [`identifiability`]: which parameters are identifiable, and why the others are fixed;
 //! - [`kinds`]: measurement kinds, the rows each observation contributes;
@@ -16,14 +17,13 @@
 
 pub mod covariance;
 pub mod identifiability;
-pub mod kinds;
 pub mod objective;
-pub mod observations;
 pub mod param_vector;
 pub mod pipeline;
 pub mod plausibility;
 pub mod report;
 pub mod solver;
+pub mod split;
 pub mod system;
 
 #[cfg(test)]
@@ -31,17 +31,18 @@ mod conditioning_tests;
 #[cfg(test)]
 mod tests;
 
+pub use crate::observations::{kinds, Observations};
 pub use covariance::{Correlation, Covariance};
 pub use identifiability::{
     analyze, FixReason, FixedParam, Identifiability, IdentifiabilityOptions,
     DEFAULT_RANK_TOLERANCE, MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
 };
 pub use objective::{Loss, Objective, RobustLoss};
-pub use observations::{split_measurements, Observations, SplitData};
 pub use param_vector::{ParamEntry, ParamVector};
 pub use pipeline::{
     calibrate, Calibration, CalibrationData, CalibrationSettings, DownWeighted, SetErrors, Stage,
 };
 pub use plausibility::{Check, CheckKind, Plausibility};
 pub use solver::{solve, SolverOptions, SolverReport, Termination};
+pub use split::{split_measurements, SplitData};
 pub use system::Problem;

@@ -21,8 +21,8 @@ use crate::identification::param_vector::ParamVector;
 use crate::identification::plausibility::{self, Plausibility};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
-use crate::identification::Observations;
 use crate::model::Robot;
+use crate::observations::Observations;
 use crate::registration::{register, Registration, RegistrationObjective, RegistrationOptions};
 use crate::stats::{percentile, ErrorStats};
 

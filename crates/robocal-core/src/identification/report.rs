@@ -137,7 +137,7 @@ impl Calibration {
                 "source": "plane points",
                 "points": n,
                 "plane_tilt_deg": tilt_deg,
-                "frame": FrameVec::from_frame(&frame),
+                "frame": FrameVec::from_tracker_frame(&frame),
                 "max_error_mm": max_error_mm,
             }),
             InitialFrame::LeastSquares => json!({"source": "least-squares fit"}),
@@ -149,7 +149,7 @@ impl Calibration {
             },
             "initial": initial,
             "iterations": reg.iterations,
-            "frame": FrameVec::from_frame(&reg.frame),
+            "frame": FrameVec::from_tracker_frame(&reg.frame),
             "stats": reg.stats,
         });
         if let Some(a) = &reg.affine {
@@ -294,7 +294,7 @@ impl Calibration {
         CalibrationResult {
             robot: RobotInfo::of(&self.nominal),
             parameters,
-            tracker_frame: FrameVec::from_frame(&self.registration.frame),
+            tracker_frame: FrameVec::from_tracker_frame(&self.registration.frame),
             errors,
             extra,
         }

@@ -10,7 +10,7 @@
 //! buffers allocated once per pass, so the per-observation work allocates nothing. Large sets are
 //! split across threads with rayon.
 
-use crate::frame::Frame;
+use crate::frame::TrackerFrame;
 use crate::identification::kinds::{self, MeasurementKind, ToolState};
 use crate::identification::objective::Loss;
 use crate::identification::Observations;
@@ -263,7 +263,12 @@ impl<'a> Problem<'a> {
     /// measurement kind), whose measured values map into the ACS by the tracker frame `frame`.
     /// Panics if a parameter is not one of the robot's (the callers take them from
     /// `robot.params()`).
-    pub fn new(robot: &Robot, params: &[Param], obs: &'a Observations, frame: &Frame) -> Self {
+    pub fn new(
+        robot: &Robot,
+        params: &[Param],
+        obs: &'a Observations,
+        frame: &TrackerFrame,
+    ) -> Self {
         let kind = obs.kind();
         let index = params
             .iter()
@@ -428,7 +433,7 @@ mod tests {
             obs.push(q, truth.tool_position(q), 0).unwrap();
         }
         let params: Vec<Param> = nominal.params();
-        let p = Problem::new(&nominal, &params, &obs, &Frame::identity());
+        let p = Problem::new(&nominal, &params, &obs, &TrackerFrame::identity());
         for loss in [
             Loss::SumOfNorms { delta: 1e-6 },
             Loss::Squared,

@@ -1,11 +1,11 @@
 //! End-to-end tests of registration + identification on simulated cells.
 
 use super::*;
-use crate::frame::{pose, Frame};
+use crate::frame::{pose, Frame, TrackerFrame};
 use crate::model::presets::preset;
 use crate::model::{Param, Robot};
 use crate::simulation::{random_poses, PoseSampler, Tracker};
-use nalgebra::{Point3, Vector3};
+use nalgebra::Vector3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -13,7 +13,14 @@ use rand_chacha::ChaCha8Rng;
 fn tracker(sigma_mm: f64, per_m: f64) -> Tracker {
     let deg = |v: f64| v.to_radians();
     Tracker::new(
-        pose(&[3900.0, -2200.0, -350.0, deg(152.0), deg(0.4), deg(-0.7)]),
+        TrackerFrame::new(pose(&[
+            3900.0,
+            -2200.0,
+            -350.0,
+            deg(152.0),
+            deg(0.4),
+            deg(-0.7),
+        ])),
         sigma_mm,
         per_m,
     )
@@ -42,9 +49,7 @@ fn measure(truth: &Robot, tr: &Tracker, n: usize, rng: &mut ChaCha8Rng) -> Obser
 /// The truth's own error on a set: measurement noise only (the noise floor).
 fn floor(truth: &Robot, tr: &Tracker, obs: &Observations) -> f64 {
     let e: f64 = (0..obs.len())
-        .map(|i| {
-            ((tr.frame * Point3::from(*obs.m(i))).coords - truth.tool_position(obs.q(i))).norm()
-        })
+        .map(|i| (tr.frame.to_base(obs.m(i)) - truth.tool_position(obs.q(i))).norm())
         .sum();
     e / obs.len() as f64
 }
@@ -208,7 +213,7 @@ fn noise_free_table3_is_reproduced_exactly() {
         let tf = c.registration.frame;
         let m = *cal.m(0);
         let p = c.calibrated.tool_position(cal.q(0));
-        assert!(((tf * Point3::from(m)).coords - p).norm() < 1e-5);
+        assert!((tf.to_base(&m) - p).norm() < 1e-5);
     }
 }
 
@@ -418,7 +423,9 @@ fn standard_deviations_match_the_monte_carlo_spread() {
             // with the noise too: compare the robot's base as seen from the tracker, expressed
             // in the true ACS, `F_true F^-1 pose(B)`.
             let b = crate::frame::frame_vector(
-                &(tr.frame * c.registration.frame.inverse() * *c.calibrated.base_frame()),
+                &(tr.frame.pose()
+                    * c.registration.frame.pose().inverse()
+                    * *c.calibrated.base_frame()),
             );
             est.push(
                 params
@@ -621,7 +628,7 @@ fn solver_reports_why_it_stopped() {
     assert!(again.final_objective <= rep.final_objective * (1.0 + 1e-12));
     // Overflowing residuals make the solver fail, not loop.
     let far = pose(&[f64::MAX, f64::MAX, 0.0, 0.0, 0.0, 0.0]);
-    let problem = Problem::new(&nom, &id.identified, &cal, &far);
+    let problem = Problem::new(&nom, &id.identified, &cal, &TrackerFrame::new(far));
     let mut r = nom.clone();
     let rep = solve(
         &problem,

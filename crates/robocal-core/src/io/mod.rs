@@ -1,4 +1,4 @@
-//! File formats: measurement CSV, atomic output, calibration results.
+//! File formats: measurement CSV, atomic output, calibration results, robot files.
 
 pub mod atomic;
 pub(crate) mod columns;
@@ -7,6 +7,7 @@ pub mod joint_limits;
 pub mod json_keys;
 pub mod measurements;
 pub mod result;
+pub mod robot;
 pub mod set_label;
 mod target;
 mod temporaries;

@@ -5,7 +5,7 @@
 //! [`CalibrationResult::extra`] so that a file written by a newer robocal still reads.
 
 use crate::error::{Error, Result};
-use crate::frame::{self, Frame};
+use crate::frame::TrackerFrame;
 use crate::model::{JointType, Param, Robot, Unit};
 use crate::stats::ErrorStats;
 use indexmap::IndexMap;
@@ -126,7 +126,8 @@ pub struct ParamEntry {
     pub reason: Option<String>,
 }
 
-/// A frame vector in mm and degrees, as a JSON object.
+/// A tracker frame's vector in mm and degrees, as a JSON object (the form of a
+/// [`TrackerFrame`] in files).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FrameVec {
     /// x (mm).
@@ -144,9 +145,9 @@ pub struct FrameVec {
 }
 
 impl FrameVec {
-    /// From a frame.
-    pub fn from_frame(f: &Frame) -> FrameVec {
-        let v = frame::vec_rad_to_deg(&frame::frame_vector(f));
+    /// The frame vector of a tracker frame.
+    pub fn from_tracker_frame(f: &TrackerFrame) -> FrameVec {
+        let v = f.vector_deg();
         FrameVec {
             x: v[0],
             y: v[1],
@@ -157,11 +158,9 @@ impl FrameVec {
         }
     }
 
-    /// To a frame.
-    pub fn to_frame(&self) -> Frame {
-        frame::pose(&frame::vec_deg_to_rad(&[
-            self.x, self.y, self.z, self.a, self.b, self.c,
-        ]))
+    /// The tracker frame this vector describes.
+    pub fn to_tracker_frame(&self) -> TrackerFrame {
+        TrackerFrame::from_vector_deg(&[self.x, self.y, self.z, self.a, self.b, self.c])
     }
 }
 
@@ -304,9 +303,10 @@ impl CalibrationResult {
             .or_else(|| self.implausible_reason().map(NotCalibrated::Implausible))
     }
 
-    /// The tracker frame as a rigid transform.
-    pub fn tracker_frame(&self) -> Frame {
-        self.tracker_frame.to_frame()
+    /// The tracker frame: measured points map into the base frame with
+    /// [`TrackerFrame::to_base`].
+    pub fn tracker_frame(&self) -> TrackerFrame {
+        self.tracker_frame.to_tracker_frame()
     }
 
     /// Applies the calibrated values to `nominal` (the robot given on the command line), checking
@@ -479,7 +479,7 @@ mod tests {
         let r = CalibrationResult {
             robot: RobotInfo::of(&nom),
             parameters: CalibrationResult::parameter_entries(&nom, &nom),
-            tracker_frame: FrameVec::from_frame(&Frame::identity()),
+            tracker_frame: FrameVec::from_tracker_frame(&TrackerFrame::identity()),
             errors: ErrorTables {
                 calibration: BeforeAfter {
                     before: s,

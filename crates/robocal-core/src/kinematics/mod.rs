@@ -16,7 +16,7 @@ pub mod poe;
 use crate::frame::Frame;
 use crate::model::family::{self, PoseFrames};
 use crate::model::{mul_rot_z, Convention, JointType, Link, Robot, MAX_JOINTS};
-use nalgebra::{Matrix3, Point3, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 impl Robot {
     /// The flange frame `pose(B) * T1(q1) * ... * Tn(qn)` (direct DH product).
@@ -217,12 +217,6 @@ impl Robot {
     pub(crate) fn joint_axis(&self, q: &[f64], i: usize) -> (Vector3<f64>, Vector3<f64>) {
         let f = &self.pose_frames(q).axis[i];
         (f.rotation.matrix().column(2).into(), f.translation.vector)
-    }
-
-    /// Transforms a point given in the tracker frame into the base frame:
-    /// `pose(tracker_frame) * m` (the paper's MF to ACS mapping).
-    pub fn map_point(frame: &Frame, m: &Vector3<f64>) -> Vector3<f64> {
-        (frame * Point3::from(*m)).coords
     }
 }
 

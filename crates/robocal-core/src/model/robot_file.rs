@@ -1,4 +1,5 @@
-//! TOML robot descriptions and the `--robot NAME|FILE` argument.
+//! TOML robot descriptions, parsed from text (reading the file, and the `--robot NAME|FILE`
+//! argument, are [`crate::io::robot`]'s).
 //!
 //! ```toml
 //! name = "ur5"
@@ -24,7 +25,7 @@
 //! ```
 
 use super::controller::{Controller, Coupling};
-use super::{presets, Convention, JointLimit, JointType, Link, Robot};
+use super::{Convention, JointLimit, JointType, Link, Robot};
 use crate::error::{Error, Result};
 use crate::ranges;
 use serde::Deserialize;
@@ -74,24 +75,6 @@ fn line_of(text: &str, offset: usize) -> usize {
         .filter(|b| **b == b'\n')
         .count()
         + 1
-}
-
-/// Loads `--robot NAME|FILE`: a preset name, or the path of a TOML robot file.
-pub fn load_robot(arg: &str) -> Result<Robot> {
-    if presets::PRESETS.contains(&arg) {
-        return presets::preset(arg);
-    }
-    let path = Path::new(arg);
-    if path.exists() || arg.ends_with(".toml") || arg.contains(std::path::MAIN_SEPARATOR) {
-        return load_robot_file(path);
-    }
-    presets::preset(arg)
-}
-
-/// Reads a TOML robot description.
-pub fn load_robot_file(path: &Path) -> Result<Robot> {
-    let text = crate::io::input::read_text(path)?;
-    parse_robot_toml(&text, path)
 }
 
 /// Parses a TOML robot description; `path` is only used in error messages.

@@ -17,7 +17,7 @@ pub struct Affine {
 
 impl Affine {
     /// The affine map of a rigid frame.
-    pub fn from_frame(f: &Frame) -> Affine {
+    pub(crate) fn from_frame(f: &Frame) -> Affine {
         Affine {
             matrix: *f.rotation.matrix(),
             translation: f.translation.vector,
@@ -25,7 +25,7 @@ impl Affine {
     }
 
     /// Applies the map to a point.
-    pub fn apply(&self, m: &Vector3<f64>) -> Vector3<f64> {
+    pub(crate) fn apply(&self, m: &Vector3<f64>) -> Vector3<f64> {
         self.matrix * m + self.translation
     }
 
@@ -39,7 +39,7 @@ impl Affine {
     }
 
     /// The twelve parameters `t1..t12` of eq. 8 (column-major).
-    pub fn parameters(&self) -> [f64; 12] {
+    pub(crate) fn parameters(&self) -> [f64; 12] {
         let m = &self.matrix;
         let t = &self.translation;
         [

@@ -3,31 +3,33 @@
 //!
 //! Three steps:
 //! 1. an initial frame from the paper's three points on a plane parallel to the base plane
-//!    ([`plane::plane_frame`]), or, without plane points, the closed-form least-squares fit;
-//! 2. the rigid frame fitted to every calibration point: closed form (Kabsch/Horn,
-//!    [`rigid::fit_rigid`]) for least squares, refined by reweighting to minimize the sum of error
-//!    norms ([`rigid::fit_rigid_sum_of_norms`], the paper's objective, eq. 11) otherwise;
-//! 3. optionally the paper's 12-parameter affine Tr (eq. 8-11, [`affine`]), as a diagnostic: its
+//!    (`plane.rs`), or, without plane points, the closed-form least-squares fit;
+//! 2. the rigid frame fitted to every calibration point: closed form (Kabsch/Horn, `rigid.rs`,
+//!    one case of the Procrustes fit of `procrustes.rs`) for least squares, refined by
+//!    reweighting to minimize the sum of error norms (the paper's objective, eq. 11) otherwise;
+//! 3. optionally the paper's 12-parameter affine Tr (eq. 8-11, [`Affine`]), as a diagnostic: its
 //!    residuals and the scale/shear it needed are reported, but the tracker frame stays rigid
 //!    (a tracker measures lengths; an affine map would absorb link-length errors the
 //!    identification must see).
 //!
 //! The residuals of the fitted frame under the nominal model are the paper's Table II.
 
-pub mod affine;
-pub mod plane;
-pub mod rigid;
+mod affine;
+mod plane;
+pub(crate) mod procrustes;
+mod rigid;
 
 use crate::error::{Error, Result};
-use crate::frame::Frame;
-use crate::identification::Observations;
+use crate::frame::TrackerFrame;
 use crate::model::Robot;
+use crate::observations::Observations;
 use crate::stats::ErrorStats;
-use nalgebra::Vector3;
 
-pub use affine::{fit_affine_sum_of_norms, Affine};
-pub use plane::{plane_frame, plane_tilt_deg};
-pub use rigid::{fit_rigid, fit_rigid_sum_of_norms, residual_norms, IrlsOptions};
+use affine::fit_affine_sum_of_norms;
+pub use affine::Affine;
+use plane::{plane_frame, plane_tilt_deg};
+pub(crate) use rigid::IrlsOptions;
+use rigid::{fit_rigid, fit_rigid_sum_of_norms, residual_norms};
 
 /// What the rigid fit minimizes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -40,7 +42,7 @@ pub enum RegistrationObjective {
 
 /// Registration settings.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RegistrationOptions {
+pub(crate) struct RegistrationOptions {
     /// Objective of the rigid fit.
     pub objective: RegistrationObjective,
     /// Also fit the paper's affine Tr (eq. 8-11) and report it.
@@ -70,7 +72,7 @@ pub enum InitialFrame {
         /// Tilt of the nominal plane against the base plane (deg).
         tilt_deg: f64,
         /// The frame they gave.
-        frame: Frame,
+        frame: TrackerFrame,
         /// Largest residual of the calibration points under that frame (mm).
         max_error_mm: f64,
     },
@@ -94,8 +96,8 @@ pub struct AffineReport {
 /// A fitted measurement frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Registration {
-    /// Pose of the tracker frame in the base frame: a measured point m maps to `frame * m`.
-    pub frame: Frame,
+    /// The fitted tracker frame: a measured point m maps to `frame.to_base(m)`.
+    pub frame: TrackerFrame,
     /// The starting frame.
     pub initial: InitialFrame,
     /// The objective used.
@@ -112,7 +114,7 @@ pub struct Registration {
 
 /// Fits the measurement frame of `cal` to the nominal model `robot` (see the module docs).
 /// `plane` holds the paper's plane points, if measured (empty or `None` otherwise).
-pub fn register(
+pub(crate) fn register(
     robot: &Robot,
     cal: &Observations,
     plane: Option<&Observations>,
@@ -173,8 +175,12 @@ pub fn register(
     let residuals = residual_norms(&frame, measured, &nominal);
     let stats = ErrorStats::from_norms(&residuals);
     let affine = if opts.affine {
-        let (tr, it) =
-            fit_affine_sum_of_norms(measured, &nominal, &Affine::from_frame(&frame), &opts.irls)?;
+        let (tr, it) = fit_affine_sum_of_norms(
+            measured,
+            &nominal,
+            &Affine::from_frame(frame.pose()),
+            &opts.irls,
+        )?;
         let res: Vec<f64> = measured
             .iter()
             .zip(&nominal)
@@ -198,12 +204,4 @@ pub fn register(
         stats,
         affine,
     })
-}
-
-/// Maps measured points (tracker frame) into the base frame with a fitted frame.
-pub fn to_base(frame: &Frame, measured: &[Vector3<f64>]) -> Vec<Vector3<f64>> {
-    measured
-        .iter()
-        .map(|m| (frame * nalgebra::Point3::from(*m)).coords)
-        .collect()
 }

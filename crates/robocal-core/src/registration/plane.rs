@@ -3,7 +3,7 @@
 //! plane parallel to the base plane of the robot").
 
 use crate::error::{Error, Result};
-use crate::frame::{self, Frame};
+use crate::frame::{self, Frame, TrackerFrame};
 use nalgebra::{Matrix3, Vector3};
 
 /// Smallest angle (degrees) the three points may span at any corner before they count as collinear.
@@ -35,10 +35,13 @@ fn triad(p: &[Vector3<f64>; 3], what: &str) -> Result<Frame> {
 /// from the first to the second point to its nominal direction, the first point onto its nominal
 /// position. With a plane parallel to the base plane the normal is the base z axis, which fixes
 /// the frame's tilt exactly as the paper's procedure does.
-pub fn plane_frame(measured: &[Vector3<f64>; 3], nominal: &[Vector3<f64>; 3]) -> Result<Frame> {
+pub fn plane_frame(
+    measured: &[Vector3<f64>; 3],
+    nominal: &[Vector3<f64>; 3],
+) -> Result<TrackerFrame> {
     let m = triad(measured, "measured")?;
     let p = triad(nominal, "nominal positions")?;
-    Ok(p * m.inverse())
+    Ok(TrackerFrame::new(p * m.inverse()))
 }
 
 /// The angle (degrees) between the nominal plane of three points and the base plane (x-y): the
@@ -53,20 +56,19 @@ pub fn plane_tilt_deg(nominal: &[Vector3<f64>; 3]) -> f64 {
 mod tests {
     use super::*;
     use crate::frame::pose;
-    use nalgebra::Point3;
 
     #[test]
     fn three_points_give_the_exact_frame() {
-        let f = pose(&[4000.0, 300.0, -200.0, 2.2, 0.01, 0.02]);
+        let f = TrackerFrame::new(pose(&[4000.0, 300.0, -200.0, 2.2, 0.01, 0.02]));
         let nominal = [
             Vector3::new(2000.0, 0.0, 800.0),
             Vector3::new(2500.0, 600.0, 800.0),
             Vector3::new(1800.0, -700.0, 800.0),
         ];
-        let measured = nominal.map(|p| (f.inverse() * Point3::from(p)).coords);
+        let measured = nominal.map(|p| f.to_tracker(&p));
         let g = plane_frame(&measured, &nominal).unwrap();
         for (m, p) in measured.iter().zip(&nominal) {
-            assert!(((g * Point3::from(*m)).coords - p).norm() < 1e-9);
+            assert!((g.to_base(m) - p).norm() < 1e-9);
         }
         assert!(plane_tilt_deg(&nominal) < 1e-12);
     }

@@ -1,78 +1,40 @@
-//! Closed-form rigid fit (Kabsch/Horn, SVD) and its sum-of-norms refinement.
+//! The rigid fit of the tracker frame: closed form (Kabsch/Horn, [`super::procrustes`]) and its
+//! sum-of-norms refinement.
 
+use super::procrustes::{fit_procrustes, Handedness, Scale};
 use crate::error::{Error, Result};
-use crate::frame::{self, Frame};
-use nalgebra::{Matrix3, Point3, Vector3};
+use crate::frame::{self, TrackerFrame};
+use nalgebra::Vector3;
 
-/// The rigid frame `F` minimizing `sum w_i |F m_i - p_i|^2` (Kabsch/Horn, closed form by SVD).
+/// The tracker frame `F` minimizing `sum w_i |F m_i - p_i|^2` (Kabsch/Horn: [`fit_procrustes`]
+/// with a rotation and scale 1).
 ///
 /// `measured` are points in the tracker frame, `target` the same points in the base frame (e.g.
-/// the nominal tool positions of eq. 1); `weights` default to 1. The result maps tracker
-/// coordinates into the base frame. Fails when the points are (nearly) collinear, where the
-/// rotation about their line is undetermined.
+/// the nominal tool positions of eq. 1); `weights` default to 1. Fails when the points are
+/// (nearly) collinear, where the rotation about their line is undetermined.
 pub fn fit_rigid(
     measured: &[Vector3<f64>],
     target: &[Vector3<f64>],
     weights: Option<&[f64]>,
-) -> Result<Frame> {
-    let n = measured.len();
-    if n != target.len() || weights.is_some_and(|w| w.len() != n) {
-        return Err(Error::invalid(
-            "registration",
-            "measured and target point counts differ",
-        ));
-    }
-    if n < 3 {
-        return Err(Error::invalid(
-            "registration",
-            format!("a rigid fit needs at least 3 points, got {n}"),
-        ));
-    }
-    let w = |i: usize| weights.map_or(1.0, |w| w[i]);
-    let wsum: f64 = (0..n).map(w).sum();
-    if !(wsum > 0.0 && wsum.is_finite()) {
-        return Err(Error::Numerical("registration: weights sum to zero".into()));
-    }
-    let mut cm = Vector3::zeros();
-    let mut cp = Vector3::zeros();
-    for i in 0..n {
-        cm += measured[i] * w(i);
-        cp += target[i] * w(i);
-    }
-    cm /= wsum;
-    cp /= wsum;
-    // Cross-covariance H = sum w (m - cm)(p - cp)^T; the rotation maps m-space into p-space.
-    let mut h = Matrix3::zeros();
-    let mut spread = 0.0;
-    for i in 0..n {
-        let a = measured[i] - cm;
-        h += (a * (target[i] - cp).transpose()) * w(i);
-        spread += w(i) * a.norm_squared();
-    }
-    let svd = h.svd(true, true);
-    let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
-        return Err(Error::Numerical("registration: SVD failed".into()));
-    };
-    let s = svd.singular_values;
-    // Rank test: the second singular value carries the spread across the points' main line.
-    let smax = s.max();
-    let mut sorted = [s[0], s[1], s[2]];
-    sorted.sort_by(|a, b| b.total_cmp(a));
-    if smax.is_nan() || smax <= 0.0 || sorted[1] <= 1e-10 * smax || spread <= 0.0 {
+) -> Result<TrackerFrame> {
+    let fit = fit_procrustes(
+        measured,
+        target,
+        weights,
+        Handedness::Rotation,
+        Scale::Fixed,
+    )?;
+    if !fit.is_determined() {
         return Err(Error::Numerical(
             "registration: the points are collinear (or coincide); the measurement frame is \
              undetermined"
                 .into(),
         ));
     }
-    let v = vt.transpose();
-    let mut d = Matrix3::identity();
-    if (v * u.transpose()).determinant() < 0.0 {
-        d[(2, 2)] = -1.0;
-    }
-    let r = v * d * u.transpose();
-    let t = cp - r * cm;
-    Ok(frame::frame(r, t))
+    Ok(TrackerFrame::new(frame::frame(
+        fit.orthogonal,
+        fit.translation(),
+    )))
 }
 
 /// Options of the iterative (IRLS) fits.
@@ -97,11 +59,15 @@ impl Default for IrlsOptions {
 }
 
 /// Residual norms `|F m_i - p_i|` (mm).
-pub fn residual_norms(f: &Frame, measured: &[Vector3<f64>], target: &[Vector3<f64>]) -> Vec<f64> {
+pub fn residual_norms(
+    f: &TrackerFrame,
+    measured: &[Vector3<f64>],
+    target: &[Vector3<f64>],
+) -> Vec<f64> {
     measured
         .iter()
         .zip(target)
-        .map(|(m, p)| ((f * Point3::from(*m)).coords - p).norm())
+        .map(|(m, p)| (f.to_base(m) - p).norm())
         .collect()
 }
 
@@ -114,9 +80,9 @@ pub fn residual_norms(f: &Frame, measured: &[Vector3<f64>], target: &[Vector3<f6
 pub fn fit_rigid_sum_of_norms(
     measured: &[Vector3<f64>],
     target: &[Vector3<f64>],
-    init: &Frame,
+    init: &TrackerFrame,
     opts: &IrlsOptions,
-) -> Result<(Frame, usize)> {
+) -> Result<(TrackerFrame, usize)> {
     let mut f = *init;
     let mut w = vec![0.0; measured.len()];
     for it in 1..=opts.max_iterations {
@@ -127,7 +93,7 @@ pub fn fit_rigid_sum_of_norms(
         let g = fit_rigid(measured, target, Some(&w))?;
         let moved = measured
             .iter()
-            .map(|m| ((g * Point3::from(*m)) - (f * Point3::from(*m))).norm())
+            .map(|m| (g.to_base(m) - f.to_base(m)).norm())
             .fold(0.0, f64::max);
         f = g;
         if moved <= opts.tolerance_mm {
@@ -157,26 +123,20 @@ mod tests {
 
     #[test]
     fn kabsch_recovers_a_frame_exactly() {
-        let f = pose(&[3500.0, -1200.0, 40.0, 2.6, 0.02, -0.01]);
+        let f = TrackerFrame::new(pose(&[3500.0, -1200.0, 40.0, 2.6, 0.02, -0.01]));
         let base = cloud();
-        let meas: Vec<_> = base
-            .iter()
-            .map(|p| (f.inverse() * Point3::from(*p)).coords)
-            .collect();
+        let meas: Vec<_> = base.iter().map(|p| f.to_tracker(p)).collect();
         let g = fit_rigid(&meas, &base, None).unwrap();
         let e = residual_norms(&g, &meas, &base);
         assert!(e.iter().all(|e| *e < 1e-9), "{e:?}");
-        assert!((g.translation.vector - f.translation.vector).norm() < 1e-8);
+        assert!((g.origin() - f.origin()).norm() < 1e-8);
     }
 
     #[test]
     fn sum_of_norms_ignores_one_gross_outlier() {
-        let f = pose(&[100.0, 20.0, -30.0, 0.3, 0.1, -0.2]);
+        let f = TrackerFrame::new(pose(&[100.0, 20.0, -30.0, 0.3, 0.1, -0.2]));
         let base = cloud();
-        let mut meas: Vec<_> = base
-            .iter()
-            .map(|p| (f.inverse() * Point3::from(*p)).coords)
-            .collect();
+        let mut meas: Vec<_> = base.iter().map(|p| f.to_tracker(p)).collect();
         meas[4] += Vector3::new(5.0, -3.0, 2.0);
         let ls = fit_rigid(&meas, &base, None).unwrap();
         let (l1, _) = fit_rigid_sum_of_norms(&meas, &base, &ls, &IrlsOptions::default()).unwrap();

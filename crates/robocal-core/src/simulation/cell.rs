@@ -113,7 +113,7 @@ impl VirtualCell {
             }
         };
         let tracker = Tracker::new(
-            config.tracker_frame.to_frame(),
+            config.tracker_frame.to_tracker_frame(),
             config.noise_mm,
             config.noise_per_m,
         )?;

@@ -20,10 +20,12 @@
 //! # Example: the paper's 3 + 75 + 73 points from one cell
 //! ```
 //! use robocal_core::simulation::{Tracker, VirtualCell, DEFAULT_TRACKER_FRAME};
-//! use robocal_core::{frame, preset};
+//! use robocal_core::frame::TrackerFrame;
+//! use robocal_core::preset;
 //! let nominal = preset("kuka-kr480-r3330")?;
 //! let truth = preset("kuka-kr480-r3330-table3")?;
-//! let tracker = Tracker::new(frame::pose(&frame::vec_deg_to_rad(&DEFAULT_TRACKER_FRAME)), 0.010, 0.005)?;
+//! let frame = TrackerFrame::from_vector_deg(&DEFAULT_TRACKER_FRAME);
+//! let tracker = Tracker::new(frame, 0.010, 0.005)?;
 //! let mut cell = VirtualCell::new(nominal, truth, tracker, 42)?;
 //! let (plane, _z) = cell.plane_poses()?;
 //! let cal = cell.random_poses(75)?;

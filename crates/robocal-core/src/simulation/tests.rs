@@ -4,7 +4,7 @@ use super::*;
 use crate::io::measurements::{Measurement, MeasurementSet};
 use crate::model::presets::preset;
 use crate::stats::ErrorStats;
-use nalgebra::{Matrix3, Point3, Vector3};
+use nalgebra::{Matrix3, Vector3};
 use std::path::PathBuf;
 
 fn kr480() -> crate::Robot {
@@ -118,14 +118,14 @@ fn truth_nominal_without_noise_is_a_rigid_motion() {
     };
     let s = run(&TruthSpec::Robot(kr480()), &cfg);
     let r = kr480();
-    let frame = cfg.tracker_frame.to_frame();
+    let frame = cfg.tracker_frame.to_tracker_frame();
     assert_eq!(s.measurements.rows.len(), 63);
     for row in &s.measurements.rows {
         let m = row.p.unwrap();
-        let expected = (frame.inverse() * Point3::from(r.tool_position(&row.q))).coords;
+        let expected = frame.to_tracker(&r.tool_position(&row.q));
         assert!((m - expected).norm() < 1e-9, "line {}", row.line);
         // And back: pose(tracker_frame) * m is the nominal point in the base frame.
-        let back = crate::Robot::map_point(&frame, &m);
+        let back = frame.to_base(&m);
         assert!((back - r.tool_position(&row.q)).norm() < 1e-9);
     }
 }
@@ -148,7 +148,7 @@ fn noise_spread_matches_the_model() {
         for (row, e) in s.measurements.rows.iter().zip(&s.exact) {
             let d = row.p.unwrap() - e;
             // The exact reading in the base frame gives the distance to the tracker.
-            let sigma = t.sigma_at(&crate::Robot::map_point(&t.frame, e));
+            let sigma = t.sigma_at(&t.frame.to_base(e));
             for k in 0..3 {
                 ss[k] += d[k] * d[k];
             }
@@ -339,11 +339,11 @@ fn joints_are_measured_in_order_with_their_columns() {
     )
     .unwrap();
     assert_eq!(s.measurements.extra_columns, ["name"]);
-    let f = cfg.tracker_frame.to_frame();
+    let f = cfg.tracker_frame.to_tracker_frame();
     for (a, b) in joints.rows.iter().zip(&s.measurements.rows) {
         assert_eq!(a.q, b.q);
         assert_eq!(a.extra, b.extra);
-        let back = crate::Robot::map_point(&f, &b.p.unwrap());
+        let back = f.to_base(&b.p.unwrap());
         assert!((back - r.tool_position(&a.q)).norm() < 1e-9);
     }
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);

@@ -1,8 +1,8 @@
 //! A simulated laser tracker: a pose in the robot's base frame and a noise model.
 
 use crate::error::{Error, Result};
-use crate::frame::Frame;
-use nalgebra::{Point3, Vector3};
+use crate::frame::TrackerFrame;
+use nalgebra::Vector3;
 use rand::Rng;
 use rand_distr::{Distribution, StandardNormal};
 
@@ -14,9 +14,8 @@ use rand_distr::{Distribution, StandardNormal};
 /// 0.010 mm + 0.005 mm/m).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Tracker {
-    /// Pose of the tracker's frame in the robot's base frame (the result JSON's `tracker_frame`):
-    /// a measured point m maps to `frame * m` in the base frame.
-    pub frame: Frame,
+    /// The tracker's frame in the robot's base frame (the result JSON's `tracker_frame`).
+    pub frame: TrackerFrame,
     /// Constant part of the per-axis standard deviation (mm).
     pub sigma_fixed_mm: f64,
     /// Distance-proportional part of the per-axis standard deviation (mm per metre).
@@ -25,7 +24,7 @@ pub struct Tracker {
 
 impl Tracker {
     /// A tracker at `frame` with the given noise; rejects negative or non-finite sigmas.
-    pub fn new(frame: Frame, sigma_fixed_mm: f64, sigma_per_m: f64) -> Result<Tracker> {
+    pub fn new(frame: TrackerFrame, sigma_fixed_mm: f64, sigma_per_m: f64) -> Result<Tracker> {
         for (name, v) in [
             ("--noise-mm", sigma_fixed_mm),
             ("--noise-per-m", sigma_per_m),
@@ -46,14 +45,14 @@ impl Tracker {
 
     /// The per-axis standard deviation (mm) for a point `p_base` given in the base frame.
     pub fn sigma_at(&self, p_base: &Vector3<f64>) -> f64 {
-        let d_m = (p_base - self.frame.translation.vector).norm() / 1000.0;
+        let d_m = (p_base - self.frame.origin()).norm() / 1000.0;
         self.sigma_fixed_mm + self.sigma_per_m * d_m
     }
 
     /// The exact (noise-free) reading of a point given in the base frame: its coordinates in the
     /// tracker frame.
     pub fn exact(&self, p_base: &Vector3<f64>) -> Vector3<f64> {
-        (self.frame.inverse() * Point3::from(*p_base)).coords
+        self.frame.to_tracker(p_base)
     }
 
     /// A noisy reading of a point given in the base frame.
@@ -78,7 +77,12 @@ mod tests {
 
     #[test]
     fn noise_spread_matches_sigma() {
-        let t = Tracker::new(pose(&[4000.0, 500.0, 0.0, 2.5, 0.0, 0.0]), 0.010, 0.005).unwrap();
+        let t = Tracker::new(
+            TrackerFrame::new(pose(&[4000.0, 500.0, 0.0, 2.5, 0.0, 0.0])),
+            0.010,
+            0.005,
+        )
+        .unwrap();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
         let p = Vector3::new(2000.0, -300.0, 1200.0);
         let exact = t.exact(&p);
@@ -98,7 +102,7 @@ mod tests {
 
     #[test]
     fn rejects_negative_sigma() {
-        assert!(Tracker::new(Frame::identity(), -0.1, 0.0).is_err());
-        assert!(Tracker::new(Frame::identity(), 0.0, f64::NAN).is_err());
+        assert!(Tracker::new(TrackerFrame::identity(), -0.1, 0.0).is_err());
+        assert!(Tracker::new(TrackerFrame::identity(), 0.0, f64::NAN).is_err());
     }
 }

@@ -9,8 +9,8 @@
 //! to a robot description that does not match the data.
 
 use super::similarity::{fit_similarity, Handedness};
-use crate::identification::Observations;
 use crate::model::Robot;
+use crate::observations::Observations;
 use nalgebra::Vector3;
 
 /// Units positions are commonly given in, as the scale that turns them into millimetres.

@@ -25,8 +25,8 @@ pub mod similarity;
 mod tests;
 
 use crate::identification::solver::SolverReport;
-use crate::identification::Observations;
 use crate::model::{Param, Robot, Unit};
+use crate::observations::Observations;
 use crate::registration::Registration;
 use crate::stats::ErrorStats;
 use causes::Causes;

@@ -1,20 +1,11 @@
 //! The best similarity transform between two point sets (Umeyama, 1991), with a rotation or a
-//! reflection: the measure behind the unit and handedness checks.
-//!
-//! Written here rather than taken from a crate because it is twenty lines over nalgebra's 3x3 SVD
-//! and the checks need the reflection variant and the fit's RMS, which the rigid fit of
-//! [`crate::registration::fit_rigid`] does not give.
+//! reflection: the measure behind the unit and handedness checks. It is the registration's
+//! Procrustes fit ([`crate::registration::procrustes`]) with a free scale, and its RMS.
 
-use nalgebra::{Matrix3, Vector3};
+use crate::registration::procrustes::{fit_procrustes, Scale};
+use nalgebra::Vector3;
 
-/// Whether the orthogonal part of a fit is a rotation or a reflection.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Handedness {
-    /// det = +1: a proper rotation (a tracker frame).
-    Rotation,
-    /// det = -1: a rotation combined with a mirror image.
-    Reflection,
-}
+pub use crate::registration::procrustes::Handedness;
 
 /// The outcome of [`fit_similarity`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -34,50 +25,25 @@ pub fn fit_similarity(
     handedness: Handedness,
     free_scale: bool,
 ) -> Option<SimilarityFit> {
-    let n = measured.len();
-    if n < 3 || n != target.len() {
-        return None;
-    }
-    let cm = measured.iter().sum::<Vector3<f64>>() / n as f64;
-    let cp = target.iter().sum::<Vector3<f64>>() / n as f64;
-    let mut h = Matrix3::zeros();
-    let mut spread = 0.0;
-    for (m, p) in measured.iter().zip(target) {
-        let a = m - cm;
-        h += a * (p - cp).transpose();
-        spread += a.norm_squared();
-    }
-    if !(spread > 0.0 && spread.is_finite()) {
-        return None;
-    }
-    let svd = h.svd(true, true);
-    let (u, vt) = (svd.u?, svd.v_t?);
-    let v = vt.transpose();
-    // Q = V D U^T maximizes tr(Q H) = tr(D S) among matrices of the wanted determinant: D flips
-    // the direction of the smallest singular value when V U^T has the wrong sign.
-    let want = match handedness {
-        Handedness::Rotation => 1.0,
-        Handedness::Reflection => -1.0,
-    };
-    let s = svd.singular_values;
-    let mut d = Matrix3::identity();
-    if (v * u.transpose()).determinant() * want < 0.0 {
-        let k = (0..3).min_by(|&i, &j| s[i].total_cmp(&s[j])).unwrap_or(2);
-        d[(k, k)] = -1.0;
-    }
-    let q = v * d * u.transpose();
     let scale = if free_scale {
-        (d * Matrix3::from_diagonal(&s)).trace() / spread
+        Scale::Free
     } else {
-        1.0
+        Scale::Fixed
     };
+    let fit = fit_procrustes(measured, target, None, handedness, scale).ok()?;
+    if fit.spread <= 0.0 {
+        return None;
+    }
     let sum_sq: f64 = measured
         .iter()
         .zip(target)
-        .map(|(m, p)| (scale * (q * (m - cm)) - (p - cp)).norm_squared())
+        .map(|(m, p)| (fit.apply(m) - p).norm_squared())
         .sum();
-    let rms = (sum_sq / n as f64).sqrt();
-    (scale.is_finite() && rms.is_finite()).then_some(SimilarityFit { scale, rms })
+    let rms = (sum_sq / measured.len() as f64).sqrt();
+    (fit.scale.is_finite() && rms.is_finite()).then_some(SimilarityFit {
+        scale: fit.scale,
+        rms,
+    })
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 
 use super::*;
 use crate::experiment::{run_experiment, ExperimentConfig};
-use crate::frame::pose;
+use crate::frame::{pose, TrackerFrame};
 use crate::identification::{
     calibrate, Calibration, CalibrationData, CalibrationSettings, SolverOptions,
 };
@@ -57,7 +57,14 @@ fn measure(nominal: &Robot, truth: &Robot, n: usize, seed: u64) -> Cell {
     };
     let qs = random_poses(nominal, n, &sampler, &mut rng).unwrap();
     let tr = Tracker::new(
-        pose(&[3100.0, -2200.0, 1200.0, 125f64.to_radians(), 0.0, 0.0]),
+        TrackerFrame::new(pose(&[
+            3100.0,
+            -2200.0,
+            1200.0,
+            125f64.to_radians(),
+            0.0,
+            0.0,
+        ])),
         0.01,
         0.005,
     )

@@ -164,8 +164,7 @@ fn every_screw_column_matches_central_differences() {
         env!("CARGO_MANIFEST_DIR"),
         "/../../examples/kr480-track.toml"
     );
-    let track =
-        crate::model::robot_file::load_robot_file(std::path::Path::new(track_file)).unwrap();
+    let track = crate::load_robot_file(std::path::Path::new(track_file)).unwrap();
     assert_eq!(track.joint_type(0), JointType::Prismatic);
     let track = offsets(&track, &[0.1; 7]);
     for robot in [kuka, track] {

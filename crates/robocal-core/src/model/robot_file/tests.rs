@@ -2,6 +2,7 @@
 //! types and the `[controller]` section.
 
 use super::*;
+use crate::io::robot::load_robot;
 use crate::model::JointType;
 
 const GOOD: &str = r#"
@@ -95,19 +96,6 @@ fn bad_frame_vector_length() {
 #[test]
 fn no_joints() {
     expect_err("convention = \"mdh\"\njoints = []\n", &["joints"]);
-}
-
-#[test]
-fn unknown_preset() {
-    let e = load_robot("kuka-kr999").err().unwrap().to_string();
-    assert!(e.contains("unknown robot preset `kuka-kr999`"), "{e}");
-    assert!(e.contains("kuka-kr480-r3330"), "{e}");
-}
-
-#[test]
-fn missing_file() {
-    let e = load_robot("no/such/robot.toml").err().unwrap().to_string();
-    assert!(e.contains("no/such/robot.toml"), "{e}");
 }
 
 const TRACKED: &str = r#"

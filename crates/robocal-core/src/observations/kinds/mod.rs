@@ -15,8 +15,8 @@ mod point;
 
 pub use point::Point;
 
-use crate::frame::Frame;
-use crate::identification::Observations;
+use crate::frame::TrackerFrame;
+use crate::observations::Observations;
 use nalgebra::{Matrix3, Vector3};
 
 /// Largest number of residual rows one observation may have.
@@ -62,7 +62,7 @@ pub trait MeasurementKind: Sync {
 
     /// Observation `i`'s measured values mapped into the base frame by the tracker frame
     /// `frame` (the paper's MF to ACS mapping), written to `out` (`target_len` numbers).
-    fn target(&self, obs: &Observations, i: usize, frame: &Frame, out: &mut [f64]);
+    fn target(&self, obs: &Observations, i: usize, frame: &TrackerFrame, out: &mut [f64]);
 
     /// The residual rows `measured - model` for one observation (`rows` numbers; for a point,
     /// the paper's E_i of eq. 3).

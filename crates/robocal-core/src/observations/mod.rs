@@ -1,8 +1,9 @@
-//! Calibration data in the form the solvers use: joint vectors and measured points, each with
-//! the CSV line it came from.
+//! Measured tool points in the form the registration and the solvers use: joint vectors and
+//! measured points (tracker frame), each with the CSV line it came from.
+
+pub mod kinds;
 
 use crate::error::{Error, Result};
-use crate::io::{MeasurementSet, SetLabel};
 use crate::model::Robot;
 use nalgebra::Vector3;
 use std::path::{Path, PathBuf};
@@ -42,8 +43,8 @@ impl Observations {
     }
 
     /// The measurement kind of these observations (one reflector's point).
-    pub fn kind(&self) -> &'static dyn crate::identification::kinds::MeasurementKind {
-        &crate::identification::kinds::Point
+    pub fn kind(&self) -> &'static dyn kinds::MeasurementKind {
+        &kinds::Point
     }
 
     /// Adds a point: joint values (rad), measured position (mm, tracker frame), CSV line (0 when
@@ -167,47 +168,4 @@ impl Observations {
         }
         Ok(())
     }
-}
-
-/// The points of a measurement file sorted by their role, from an optional `set` column
-/// ([`SetLabel`]): `plane` marks the paper's three points for the initial measurement frame,
-/// `validation` (or `val`) validation points, `calibration` (or an empty cell, or no `set`
-/// column) calibration points. Any other label is an error.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SplitData {
-    /// Calibration points.
-    pub calibration: Observations,
-    /// Validation points found in the file (`set` = `validation`).
-    pub validation: Observations,
-    /// Plane points for the initial frame (`set` = `plane`).
-    pub plane: Observations,
-}
-
-/// Sorts a measurement file's rows by their `set` column (see [`SplitData`]). Every row must have
-/// a measured position, and every `set` label must be known ([`MeasurementSet::set_labels`]).
-pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
-    let mk = || Observations::with_source(set.dof(), &set.path);
-    let mut out = SplitData {
-        calibration: mk(),
-        validation: mk(),
-        plane: mk(),
-    };
-    let labels = set.set_labels()?;
-    for (r, label) in set.rows.iter().zip(labels) {
-        let Some(p) = r.p else {
-            return Err(Error::parse(
-                &set.path,
-                Some(r.line),
-                Some("x"),
-                "no measured position (x,y,z) in this row",
-            ));
-        };
-        let target = match label {
-            SetLabel::Plane => &mut out.plane,
-            SetLabel::Validation => &mut out.validation,
-            SetLabel::Calibration => &mut out.calibration,
-        };
-        target.push(&r.q, p, r.line)?;
-    }
-    Ok(out)
 }

@@ -3,9 +3,9 @@
 //! velocities `dp`.
 
 use super::{Measurability, MeasurementKind, ToolState};
-use crate::frame::Frame;
-use crate::identification::Observations;
-use nalgebra::{Point3, Vector3};
+use crate::frame::TrackerFrame;
+use crate::observations::Observations;
+use nalgebra::Vector3;
 
 /// A measured tool point.
 pub struct Point;
@@ -35,8 +35,8 @@ impl MeasurementKind for Point {
     }
 
     #[inline]
-    fn target(&self, obs: &Observations, i: usize, frame: &Frame, out: &mut [f64]) {
-        let t = (frame * Point3::from(obs.measured()[i])).coords;
+    fn target(&self, obs: &Observations, i: usize, frame: &TrackerFrame, out: &mut [f64]) {
+        let t = frame.to_base(&obs.measured()[i]);
         out.copy_from_slice(t.as_slice());
     }
 
