@@ -51,7 +51,7 @@ fn run(
             identifiability: id,
             ..Default::default()
         },
-        &mut |_, _, _| {},
+        &(),
     )
 }
 
