@@ -101,6 +101,12 @@ mod tests {
         let e = robocal_core::Error::invalid("calibration data", "no robot points");
         assert_eq!(cli_text(&e), "calibration data: no robot points");
         assert_eq!(with_flags("robot `kr` and `d2`"), "robot `kr` and `d2`");
+        assert_eq!(
+            with_flags(
+                "choose another `plane_z_mm` or leave the plane points out (`plane_points`)"
+            ),
+            "choose another --plane-z-mm or leave the plane points out (--no-plane)"
+        );
         // A file's fields keep their names, even where a setting has the same one.
         let e =
             robocal_core::Error::parse("r.json", Some(3), None, "missing field `tracker_frame`");

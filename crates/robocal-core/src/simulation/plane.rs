@@ -179,7 +179,7 @@ pub fn plane_poses<R: Rng + ?Sized>(
         format!(
             "found no three poses with the tool at z = {z:.1} mm, {radius:.1} mm from the base \
              axis, 120 degrees apart, within the joint limits; choose another `plane_z_mm` or \
-             turn `plane_points` off"
+             leave the plane points out (`plane_points`)"
         ),
     ))
 }
