@@ -74,13 +74,14 @@ pub fn implausible(message: impl Into<String>) -> anyhow::Error {
     .into()
 }
 
-/// The message of an error and its causes, outermost first, joined by `: `. A cause whose text
+/// The message of an error and its causes, outermost first, joined by `: `, with the library's
+/// setting names shown as this program's flags ([`crate::cmd::flags`]). A cause whose text
 /// the message already ends with is left out (an I/O error is part of its wrapper's text:
 /// `FILE: No such file or directory`, not `FILE: No such file...: No such file...`).
 pub fn message(e: &anyhow::Error) -> String {
     let mut s = String::new();
     for cause in e.chain() {
-        let c = cause.to_string();
+        let c = crate::cmd::flags::cli_text(cause);
         if s.ends_with(&c) {
             continue;
         }

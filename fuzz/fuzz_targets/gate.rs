@@ -132,7 +132,7 @@ fuzz_target!(|m: Mistakes| {
         plane: None,
         validation: None,
     };
-    let Ok(cal) = calibrate(&c.nominal, data, &settings, &mut |_, _, _| {}) else {
+    let Ok(cal) = calibrate(&c.nominal, data, &settings, &()) else {
         return;
     };
     // A mirrored frame together with a reversed joint sign can describe a mirrored robot that fits

@@ -36,7 +36,7 @@ fuzz_target!(|data: &[u8]| {
             };
             let comp = Compensator::new(&nominal, &nominal, solver).expect("same robot");
             let rows = &set.rows[..set.rows.len().min(4)];
-            if let Ok(out) = comp.reach_all(rows, &mut |_, _| {}) {
+            if let Ok(out) = comp.reach_all(rows, &()) {
                 for c in out {
                     assert!(c.commanded.iter().all(|v| v.is_finite()));
                 }

@@ -179,71 +179,143 @@ fn read(
     Ok(split)
 }
 
-pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
-    limits::count(
-        "--max-iterations",
-        a.max_iterations,
-        1,
-        limits::MAX_CALIBRATION_ITERATIONS,
-        "a solver that has not converged by then will not",
-    )?;
-    if let Some(s) = a.robust_scale {
-        limits::magnitude("--robust-scale", s, limits::MAX_LENGTH_MM, "mm")?;
-    }
-    let mut robot = common::robot(&a.robot)?;
-    let betas = apply_beta(&mut robot, &a.beta)?;
-    if betas.is_empty() && a.beta.trim() == "parallel" {
-        eprintln!(
-            "note: --beta parallel: robot `{}` has no pair of consecutive parallel axes; no tilt \
-             parameter added",
-            robot.name()
-        );
-    }
-    let fix = param_list(&robot, &a.fix, "--fix")?;
-    let free = param_list(&robot, &a.free, "--free")?;
-    if fix.len() == robot.param_count() {
-        return Err(exit::usage(format!(
-            "--fix names every parameter of robot `{}` ({}): nothing is left to identify",
-            robot.name(),
-            robot.param_count()
-        )));
-    }
-    let rank_tolerance = a.rank_tol.unwrap_or(DEFAULT_RANK_TOLERANCE);
-    if !(MIN_RANK_TOLERANCE..1.0).contains(&rank_tolerance) {
-        return Err(exit::usage(format!(
-            "--rank-tol {rank_tolerance:?}: not in [{MIN_RANK_TOLERANCE:e}, 1); it is the \
-             smallest independence (sine of the angle between a parameter's effect and the \
-             others') accepted, and below {MIN_RANK_TOLERANCE:e} double precision cannot tell a \
-             parameter from an exact duplicate (whose independence computes as 1e-17 to 1e-14 \
-             from rounding)"
-        )));
-    }
-    IoPlan::new()
-        .robot("--robot", &a.robot)
-        .input("--data", &a.data)
-        .input_opt("--validate", a.validate.as_deref())
-        .output(
-            "--out",
-            &a.out,
-            "the result is a file that later commands read, and the tables go to standard output",
-        )
-        .check()?;
-    if let Some(v) = &a.validate {
-        if super::io_plan::same_file(v, &a.data) {
+/// Everything `calibrate` needs, checked completely before any work (ripgrep's high-level
+/// arguments): ranges, parameter names, the robot, the files plan. The command body only reads
+/// it.
+struct Settings {
+    /// The `--robot` argument as given (recorded in the result).
+    robot_arg: String,
+    /// The nominal robot, with the Hayati tilts of `--beta`.
+    robot: Robot,
+    /// The joints given a tilt parameter (0-based).
+    betas: Vec<usize>,
+    data: PathBuf,
+    validate: Option<PathBuf>,
+    nominal_limits: bool,
+    /// The library's settings: objective, identifiability, solver.
+    calibration: CalibrationSettings,
+    keep_partial: bool,
+    accept_implausible: bool,
+    out: PathBuf,
+}
+
+impl TryFrom<&CalibrateArgs> for Settings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &CalibrateArgs) -> anyhow::Result<Settings> {
+        limits::count(
+            "--max-iterations",
+            a.max_iterations,
+            1,
+            limits::MAX_CALIBRATION_ITERATIONS,
+            "a solver that has not converged by then will not",
+        )?;
+        if let Some(s) = a.robust_scale {
+            limits::magnitude("--robust-scale", s, limits::MAX_LENGTH_MM, "mm")?;
+        }
+        let mut robot = common::robot(&a.robot)?;
+        let betas = apply_beta(&mut robot, &a.beta)?;
+        if betas.is_empty() && a.beta.trim() == "parallel" {
+            eprintln!(
+                "note: --beta parallel: robot `{}` has no pair of consecutive parallel axes; no \
+                 tilt parameter added",
+                robot.name()
+            );
+        }
+        let fix = param_list(&robot, &a.fix, "--fix")?;
+        let free = param_list(&robot, &a.free, "--free")?;
+        if fix.len() == robot.param_count() {
             return Err(exit::usage(format!(
-                "--validate {}: this is the --data file {} (the same file); validation points \
-                 must be points the calibration did not fit: give another file, or mark \
-                 validation rows of --data with set = validation",
-                v.display(),
-                a.data.display()
+                "--fix names every parameter of robot `{}` ({}): nothing is left to identify",
+                robot.name(),
+                robot.param_count()
             )));
         }
+        if let Some(p) = fix.iter().find(|p| free.contains(p)) {
+            // Exit code 3, as when the library finds it.
+            return Err(exit::input(format!(
+                "--fix: `{}` is given both to --fix and to --free",
+                p.name()
+            )));
+        }
+        let rank_tolerance = a.rank_tol.unwrap_or(DEFAULT_RANK_TOLERANCE);
+        if !(MIN_RANK_TOLERANCE..1.0).contains(&rank_tolerance) {
+            return Err(exit::usage(format!(
+                "--rank-tol {rank_tolerance:?}: not in [{MIN_RANK_TOLERANCE:e}, 1); it is the \
+                 smallest independence (sine of the angle between a parameter's effect and the \
+                 others') accepted, and below {MIN_RANK_TOLERANCE:e} double precision cannot \
+                 tell a parameter from an exact duplicate (whose independence computes as 1e-17 \
+                 to 1e-14 from rounding)"
+            )));
+        }
+        IoPlan::new()
+            .robot("--robot", &a.robot)
+            .input("--data", &a.data)
+            .input_opt("--validate", a.validate.as_deref())
+            .output(
+                "--out",
+                &a.out,
+                "the result is a file that later commands read, and the tables go to standard \
+                 output",
+            )
+            .check()?;
+        if let Some(v) = &a.validate {
+            if super::io_plan::same_file(v, &a.data) {
+                return Err(exit::usage(format!(
+                    "--validate {}: this is the --data file {} (the same file); validation \
+                     points must be points the calibration did not fit: give another file, or \
+                     mark validation rows of --data with set = validation",
+                    v.display(),
+                    a.data.display()
+                )));
+            }
+        }
+        let calibration = CalibrationSettings {
+            objective: match a.objective {
+                ObjectiveArg::SumOfNorms => Objective::SumOfNorms,
+                ObjectiveArg::LeastSquares => Objective::LeastSquares,
+                ObjectiveArg::Robust => Objective::Robust(match a.robust_loss {
+                    RobustArg::Cauchy => RobustLoss::Cauchy,
+                    RobustArg::Huber => RobustLoss::Huber,
+                }),
+            },
+            robust_scale_mm: a.robust_scale,
+            affine_registration: a.affine,
+            identifiability: IdentifiabilityOptions {
+                rank_tolerance,
+                fix,
+                free,
+                allow_ill_conditioned: a.rank_tol.is_some(),
+            },
+            solver: SolverOptions {
+                max_iterations: a.max_iterations,
+                ..Default::default()
+            },
+        };
+        Ok(Settings {
+            robot_arg: a.robot.clone(),
+            robot,
+            betas,
+            data: a.data.clone(),
+            validate: a.validate.clone(),
+            nominal_limits: a.nominal_limits,
+            calibration,
+            keep_partial: a.keep_partial,
+            accept_implausible: a.accept_implausible,
+            out: a.out.clone(),
+        })
     }
+}
+
+pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
+    let s = Settings::try_from(&a)?;
+    let Settings { robot, betas, .. } = &s;
+    let rank_tolerance = s.calibration.identifiability.rank_tolerance;
     let mut outside = Vec::new();
-    let data = read(&a.data, &robot, a.nominal_limits, &mut outside)?;
+    let data = read(&s.data, robot, s.nominal_limits, &mut outside)?;
     let mut validation = data.validation.clone();
-    if let Some(v) = &a.validate {
-        let vd = read(v, &robot, a.nominal_limits, &mut outside)?;
+    if let Some(v) = &s.validate {
+        let vd = read(v, robot, s.nominal_limits, &mut outside)?;
         if !vd.plane.is_empty() {
             eprintln!(
                 "note: {}: {} plane point(s) ignored in the validation set",
@@ -254,28 +326,6 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         validation = merge(validation, &vd.calibration)?;
         validation = merge(validation, &vd.validation)?;
     }
-    let settings = CalibrationSettings {
-        objective: match a.objective {
-            ObjectiveArg::SumOfNorms => Objective::SumOfNorms,
-            ObjectiveArg::LeastSquares => Objective::LeastSquares,
-            ObjectiveArg::Robust => Objective::Robust(match a.robust_loss {
-                RobustArg::Cauchy => RobustLoss::Cauchy,
-                RobustArg::Huber => RobustLoss::Huber,
-            }),
-        },
-        robust_scale_mm: a.robust_scale,
-        affine_registration: a.affine,
-        identifiability: IdentifiabilityOptions {
-            rank_tolerance,
-            fix,
-            free,
-            allow_ill_conditioned: a.rank_tol.is_some(),
-        },
-        solver: SolverOptions {
-            max_iterations: a.max_iterations,
-            ..Default::default()
-        },
-    };
     println!(
         "robot {} ({} joints, {}){}; {} calibration point(s){}{}",
         robot.name(),
@@ -305,24 +355,18 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             format!(", {} validation point(s)", validation.len())
         },
     );
-    let bar = crate::progress::spinner("calibrating");
+    let bar = crate::progress::Bar::new("calibrating");
     let result = calibrate(
-        &robot,
+        robot,
         CalibrationData {
             calibration: &data.calibration,
             plane: Some(&data.plane),
             validation: Some(&validation),
         },
-        &settings,
-        &mut |stage, i, _| {
-            if i > 0 {
-                bar.set_message(format!("{stage}: iteration {i}"));
-            } else {
-                bar.set_message(stage.to_owned());
-            }
-        },
+        &s.calibration,
+        &bar,
     );
-    bar.finish_and_clear();
+    bar.finish();
     let cal = result
         .map_err(|e| match e {
             robocal_core::Error::Numerical(m) if m.contains("rank tolerance") => {
@@ -332,7 +376,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             }
             e => e,
         })
-        .with_context(|| format!("calibrating from {}", a.data.display()))?;
+        .with_context(|| format!("calibrating from {}", s.data.display()))?;
     let converged = cal.solver().termination.converged();
     let implausible = cal.plausibility.implausible();
     print_report(&cal, converged, implausible);
@@ -344,12 +388,12 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         );
     }
     let mut extra = serde_json::Map::new();
-    extra.insert("robot_arg".into(), json!(a.robot));
-    extra.insert("data".into(), json!(a.data.display().to_string()));
-    if let Some(v) = &a.validate {
+    extra.insert("robot_arg".into(), json!(s.robot_arg));
+    extra.insert("data".into(), json!(s.data.display().to_string()));
+    if let Some(v) = &s.validate {
         extra.insert("validate".into(), json!(v.display().to_string()));
     }
-    extra.insert("nominal_limits".into(), json!(a.nominal_limits));
+    extra.insert("nominal_limits".into(), json!(s.nominal_limits));
     if !outside.is_empty() {
         let rows: Vec<_> = outside
             .iter()
@@ -367,25 +411,25 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         String::new()
     };
     if converged && !implausible {
-        res.write(&a.out)?;
-        println!("result written to {}", a.out.display());
+        res.write(&s.out)?;
+        println!("result written to {}", s.out.display());
         return Ok(());
     }
     if converged {
         // Converged but implausible: not a calibration. Fail; keep it only if asked, marked.
         let summary = common::indent(&cal.plausibility.summary());
-        if a.accept_implausible {
-            res.write(&a.out)?;
+        if s.accept_implausible {
+            res.write(&s.out)?;
             println!(
                 "result written to {} marked \"status\": \"implausible\"",
-                a.out.display()
+                s.out.display()
             );
             eprintln!(
                 "WARNING: IMPLAUSIBLE FIT WRITTEN (--accept-implausible): the fit failed the \
                  plausibility gate and is NOT a calibration:\n{summary}\n{} is marked \
                  \"status\": \"implausible\"; compensate refuses it unless given \
                  --accept-implausible too",
-                a.out.display()
+                s.out.display()
             );
             return Ok(());
         }
@@ -393,7 +437,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             "implausible fit: the solver converged, but the result cannot be a calibration; \
              nothing written to {}. Failed checks:\n{summary}\n(fix the data or the robot; \
              --accept-implausible writes it anyway, marked \"status\": \"implausible\")",
-            a.out.display()
+            s.out.display()
         )));
     }
     // Not converged: not a calibration. Fail; keep the partial result only if asked, marked.
@@ -404,22 +448,22 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             .iter()
             .map(|s| s.report.iterations)
             .sum::<usize>(),
-        a.max_iterations
+        s.calibration.solver.max_iterations
     );
-    if a.keep_partial {
+    if s.keep_partial {
         res.extra.insert("partial_reason".into(), json!(why));
-        res.write(&a.out)?;
+        res.write(&s.out)?;
         Err(exit::numerical(format!(
             "{why}: the parameters above are a partial result, not a calibration; written to {} \
              marked \"status\": \"partial\" (--keep-partial){failed_gate}",
-            a.out.display()
+            s.out.display()
         )))
     } else {
         Err(exit::numerical(format!(
             "{why}: the parameters above are a partial result, not a calibration; nothing \
              written to {} (raise --max-iterations, or use --keep-partial to \
              write the partial result, marked as such){failed_gate}",
-            a.out.display()
+            s.out.display()
         )))
     }
 }
@@ -552,7 +596,11 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
         id.condition_number
     );
     for f in &id.fixed {
-        println!("  {:<8} fixed: {}", f.param.name(), f.describe());
+        println!(
+            "  {:<8} fixed: {}",
+            f.param.name(),
+            super::flags::with_flags(&f.describe())
+        );
     }
     println!();
     let pv = c.param_vector();

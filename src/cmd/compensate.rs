@@ -56,74 +56,114 @@ pub struct CompensateArgs {
 /// Rows listed one by one in warnings before the rest are summarized.
 const LISTED: usize = 20;
 
-pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
-    let solver = DampedLeastSquares {
-        tolerance_mm: a.tolerance_mm,
-        max_iterations: a.max_iterations,
-        ..DampedLeastSquares::default()
-    };
-    solver.validate().map_err(|e| {
-        exit::usage(
-            e.to_string()
-                .replace("tolerance_mm", "--tolerance-mm")
-                .replace("max_iterations", "--max-iterations"),
-        )
-    })?;
-    limits::count(
-        "--max-iterations",
-        a.max_iterations,
-        1,
-        limits::MAX_IK_ITERATIONS,
-        "per row; a solve converges in a handful",
-    )?;
-    limits::magnitude(
-        "--tolerance-mm",
-        a.tolerance_mm,
-        limits::MAX_LENGTH_MM,
-        "mm",
-    )?;
-    let mut outputs = IoPlan::new()
-        .robot("--robot", &a.robot)
-        .input("--params", &a.params)
-        .recorded_in("--params", &a.params)
-        .input_opt("--joints", a.joints.as_deref())
-        .input_opt("--targets", a.targets.as_deref())
-        .output_or_stdout("--out", &a.out)
-        .check()?;
-    let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
-    if let Some(why) = res.partial_reason() {
-        return Err(exit::input(format!(
-            "--params {}: a partial result, not a calibration ({why}); compensation refuses \
-             it: re-run calibrate with a higher --max-iterations",
-            a.params.display()
-        )));
-    }
-    if let Some(why) = res.implausible_reason() {
-        if !a.accept_implausible {
-            return Err(exit::implausible(format!(
-                "--params {}: an IMPLAUSIBLE result, not a calibration: it failed the \
-                 plausibility gate:\n{}\ncompensation refuses it (fix the data or the robot \
-                 and calibrate again, or give --accept-implausible to use it anyway)",
-                a.params.display(),
-                super::common::indent(&why)
+/// Everything `compensate` needs, checked completely before any work: the solver's settings
+/// (ranges), the files plan, the models and the result (partial or implausible results refused).
+struct Settings {
+    nominal: Robot,
+    calibrated: Robot,
+    solver: DampedLeastSquares,
+    joints: Option<PathBuf>,
+    targets: Option<PathBuf>,
+    out: PathBuf,
+    outputs: super::io_plan::Outputs,
+    strict: bool,
+    params: PathBuf,
+}
+
+impl TryFrom<&CompensateArgs> for Settings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &CompensateArgs) -> anyhow::Result<Settings> {
+        let solver = DampedLeastSquares {
+            tolerance_mm: a.tolerance_mm,
+            max_iterations: a.max_iterations,
+            ..DampedLeastSquares::default()
+        };
+        solver
+            .validate()
+            .map_err(|e| exit::usage(super::flags::cli_text(&e)))?;
+        limits::count(
+            "--max-iterations",
+            a.max_iterations,
+            1,
+            limits::MAX_IK_ITERATIONS,
+            "per row; a solve converges in a handful",
+        )?;
+        limits::magnitude(
+            "--tolerance-mm",
+            a.tolerance_mm,
+            limits::MAX_LENGTH_MM,
+            "mm",
+        )?;
+        let outputs = IoPlan::new()
+            .robot("--robot", &a.robot)
+            .input("--params", &a.params)
+            .recorded_in("--params", &a.params)
+            .input_opt("--joints", a.joints.as_deref())
+            .input_opt("--targets", a.targets.as_deref())
+            .output_or_stdout("--out", &a.out)
+            .check()?;
+        let (nominal, calibrated, res) = calibrated_model(&a.robot, &a.params)?;
+        if let Some(why) = res.partial_reason() {
+            return Err(exit::input(format!(
+                "--params {}: a partial result, not a calibration ({why}); compensation refuses \
+                 it: re-run calibrate with a higher --max-iterations",
+                a.params.display()
             )));
         }
-        eprintln!(
-            "WARNING: --accept-implausible: compensating with {}, a result that FAILED the \
-             plausibility gate; the commanded joints may be far from right:\n{}",
-            a.params.display(),
-            super::common::indent(&why)
-        );
+        if let Some(why) = res.implausible_reason() {
+            if !a.accept_implausible {
+                return Err(exit::implausible(format!(
+                    "--params {}: an IMPLAUSIBLE result, not a calibration: it failed the \
+                     plausibility gate:\n{}\ncompensation refuses it (fix the data or the robot \
+                     and calibrate again, or give --accept-implausible to use it anyway)",
+                    a.params.display(),
+                    super::common::indent(&why)
+                )));
+            }
+            eprintln!(
+                "WARNING: --accept-implausible: compensating with {}, a result that FAILED the \
+                 plausibility gate; the commanded joints may be far from right:\n{}",
+                a.params.display(),
+                super::common::indent(&why)
+            );
+        }
+        Ok(Settings {
+            nominal,
+            calibrated,
+            solver,
+            joints: a.joints.clone(),
+            targets: a.targets.clone(),
+            out: a.out.clone(),
+            outputs,
+            strict: a.strict,
+            params: a.params.clone(),
+        })
     }
+}
+
+pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
+    let Settings {
+        nominal,
+        calibrated: cal,
+        solver,
+        joints: joints_path,
+        targets,
+        out,
+        mut outputs,
+        strict,
+        params,
+    } = Settings::try_from(&a)?;
     let dof = nominal.dof();
     let joints = nominal.joint_space();
+    let tolerance_mm = solver.tolerance_mm;
     let comp = Compensator::new(&nominal, &cal, solver)?;
     let pb = crate::progress::spinner("compensating");
     let mut tally = Tally::default();
     let mut q = vec![0.0; dof];
     // Rows are solved and written one at a time: only the summary is kept, so files of any
     // length fit in memory.
-    let (input, writer) = if let Some(path) = &a.joints {
+    let (input, writer) = if let Some(path) = &joints_path {
         let context = || format!("--joints {}", path.display());
         let mut reader =
             MeasurementReader::open(path, joints, Positions::Optional).with_context(context)?;
@@ -134,12 +174,8 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 path.display()
             );
         }
-        let mut w = CommandedWriter::to_output(
-            outputs.open(&a.out)?,
-            joints,
-            true,
-            reader.extra_columns(),
-        )?;
+        let mut w =
+            CommandedWriter::to_output(outputs.open(&out)?, joints, true, reader.extra_columns())?;
         let mut outside = Listing::default();
         while let Some(r) = reader.next_row().with_context(context)? {
             nominal.check_joints(&r.q, &format!("{}:{}", path.display(), r.line))?;
@@ -172,15 +208,14 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         }
         (path, w)
     } else {
-        let path = a
-            .targets
+        let path = targets
             .as_ref()
             .expect("clap requires --joints or --targets");
         let set =
             read_targets(path, joints).with_context(|| format!("--targets {}", path.display()))?;
         check_extra_columns(path, joints, &set.extra_columns)?;
         let mut w =
-            CommandedWriter::to_output(outputs.open(&a.out)?, joints, false, &set.extra_columns)?;
+            CommandedWriter::to_output(outputs.open(&out)?, joints, false, &set.extra_columns)?;
         for t in &set.rows {
             if let Some(s) = &t.seed {
                 cal.check_joints(s, &format!("{}:{}", path.display(), t.line))?;
@@ -200,7 +235,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
     pb.finish_and_clear();
 
     if tally.failed.count > 0 {
-        if a.strict {
+        if strict {
             // The writer is dropped: nothing is written.
             return Err(exit::numerical(format!(
                 "--strict: {} of {} row(s) of {} did not converge; nothing written:\n  {}",
@@ -217,12 +252,19 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
             eprintln!(
                 "warning: ... and {} more (see the status column of {})",
                 tally.failed.count - LISTED,
-                super::io_plan::shown(&a.out)
+                super::io_plan::shown(&out)
             );
         }
     }
     writer.commit()?;
-    print_summary(&a, input, &tally);
+    print_summary(
+        joints_path.is_some(),
+        &params,
+        tolerance_mm,
+        &out,
+        input,
+        &tally,
+    );
     Ok(())
 }
 
@@ -328,8 +370,17 @@ fn describe_failure(line: usize, c: &Compensation) -> String {
     )
 }
 
-fn print_summary(a: &CompensateArgs, input: &std::path::Path, t: &Tally) {
-    let mode = if a.joints.is_some() {
+/// Prints the summary of a run on `input` (desired joints if `joints`, else targets), solved on
+/// the calibrated model of `params`, written to `out`.
+fn print_summary(
+    joints: bool,
+    params: &std::path::Path,
+    tolerance_mm: f64,
+    out: &std::path::Path,
+    input: &std::path::Path,
+    t: &Tally,
+) {
+    let mode = if joints {
         "desired poses; target = nominal tool position (eq. 13)"
     } else {
         "Cartesian targets (base frame)"
@@ -338,14 +389,14 @@ fn print_summary(a: &CompensateArgs, input: &std::path::Path, t: &Tally) {
         "{}: {} {mode}; solved on the calibrated model of {}",
         input.display(),
         t.rows,
-        a.params.display()
+        params.display()
     );
     for (s, n) in IkStatus::ALL.iter().zip(t.counts) {
         println!("  {:<14} {n:>8}", s.as_str());
     }
     println!(
         "  residual       max {:.3e} mm over converged rows, {:.3e} mm over all (tolerance {:e} mm)",
-        t.max_residual_converged, t.max_residual, a.tolerance_mm
+        t.max_residual_converged, t.max_residual, tolerance_mm
     );
     let it_mean = t.iterations as f64 / t.rows.max(1) as f64;
     println!(
@@ -360,5 +411,5 @@ fn print_summary(a: &CompensateArgs, input: &std::path::Path, t: &Tally) {
             );
         }
     }
-    println!("wrote {} ({} rows)", super::io_plan::shown(&a.out), t.rows);
+    println!("wrote {} ({} rows)", super::io_plan::shown(out), t.rows);
 }

@@ -7,7 +7,7 @@ use anyhow::Context;
 use clap::Args;
 use robocal_core::compensation::IkStatus;
 use robocal_core::experiment::{
-    files, run_experiment, Experiment, ExperimentConfig, Phase, PAPER_NOMINAL, PAPER_TRUTH,
+    files, run_experiment, Experiment, ExperimentConfig, PAPER_NOMINAL, PAPER_TRUTH,
 };
 use robocal_core::io::write_all_atomic;
 use robocal_core::registration::InitialFrame;
@@ -53,33 +53,47 @@ fn sh(p: &Path) -> String {
     }
 }
 
-pub fn run(a: DemoArgs) -> anyhow::Result<()> {
-    let dir = &a.out;
-    IoPlan::new()
-        .output_dir("--out", dir, &OUTPUT_FILES)
-        .check()?;
-    let path = |name: &str| dir.join(name);
-    let mut cfg = ExperimentConfig::paper(a.seed)?;
-    // Record the files as `robocal calibrate` run by hand on them would.
-    cfg.result_settings.insert(
-        "data".into(),
-        path(files::CELL).display().to_string().into(),
-    );
-    cfg.result_settings.insert(
-        "validate".into(),
-        path(files::VALIDATION).display().to_string().into(),
-    );
+/// Everything `demo` needs, checked before any work: the output directory plan and the
+/// experiment's configuration.
+struct Settings {
+    out: PathBuf,
+    experiment: ExperimentConfig,
+}
 
-    let steps = Phase::ALL.len() as u64 + 1;
-    let bar = crate::progress::bar(steps, "demo");
-    let exp = run_experiment(cfg, &mut |phase, _, _| {
-        let k = Phase::ALL.iter().position(|p| *p == phase).unwrap_or(0);
-        bar.set_position(k as u64);
-        bar.set_message(phase.describe());
-    })
-    .context("running the experiment")?;
-    bar.set_position(steps - 1);
-    bar.set_message("writing the report");
+impl TryFrom<&DemoArgs> for Settings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &DemoArgs) -> anyhow::Result<Settings> {
+        IoPlan::new()
+            .output_dir("--out", &a.out, &OUTPUT_FILES)
+            .check()?;
+        let mut experiment = ExperimentConfig::paper(a.seed)?;
+        // Record the files as `robocal calibrate` run by hand on them would.
+        let path = |name: &str| a.out.join(name).display().to_string();
+        experiment
+            .result_settings
+            .insert("data".into(), path(files::CELL).into());
+        experiment
+            .result_settings
+            .insert("validate".into(), path(files::VALIDATION).into());
+        Ok(Settings {
+            out: a.out.clone(),
+            experiment,
+        })
+    }
+}
+
+pub fn run(a: DemoArgs) -> anyhow::Result<()> {
+    let Settings {
+        out,
+        experiment: cfg,
+    } = Settings::try_from(&a)?;
+    let dir = &out;
+    let path = |name: &str| dir.join(name);
+
+    let bar = crate::progress::Bar::new("demo");
+    let exp = run_experiment(cfg, &bar).context("running the experiment")?;
+    bar.note("writing the report");
     let report = ReportData::from_experiment(&exp, &dir.display().to_string())?;
     let rendered = robocal_report::render(&report)?;
     std::fs::create_dir_all(dir).map_err(|e| robocal_core::Error::Io {
@@ -95,7 +109,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     writes.push((path(HISTOGRAM_FILE), rendered.histogram_svg.as_bytes()));
     let refs: Vec<(&Path, &[u8])> = writes.iter().map(|(p, b)| (p.as_path(), *b)).collect();
     write_all_atomic(&refs)?;
-    bar.finish_and_clear();
+    bar.finish();
 
     print_run(&exp);
     print_files(&exp, dir);

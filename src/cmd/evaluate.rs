@@ -66,39 +66,85 @@ pub(super) fn calibrated_model(
     Ok((m.nominal, cal, res))
 }
 
+/// Everything `evaluate` needs, checked completely before any work: flag combinations, the
+/// files plan, the models and the result (checked to belong together).
+struct Settings {
+    nominal: Robot,
+    calibrated: Robot,
+    result: CalibrationResult,
+    against: Against,
+    params: PathBuf,
+    data: PathBuf,
+    per_point: Option<PathBuf>,
+    outputs: io_plan::Outputs,
+    json: bool,
+    nominal_limits: bool,
+}
+
+impl TryFrom<&EvaluateArgs> for Settings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &EvaluateArgs) -> anyhow::Result<Settings> {
+        let stdout_data = a.per_point.as_deref() == Some(Path::new(io_plan::STDOUT));
+        if stdout_data && a.json {
+            return Err(crate::exit::usage(
+                "--per-point - and --json both want standard output: write the per-point \
+                 errors to a file",
+            ));
+        }
+        let mut plan = IoPlan::new();
+        plan.robot("--robot", &a.robot)
+            .input("--params", &a.params)
+            .recorded_in("--params", &a.params)
+            .input("--data", &a.data);
+        if let Some(p) = &a.per_point {
+            plan.output_or_stdout("--per-point", p);
+        }
+        let outputs = plan.check()?;
+        let (nominal, calibrated, result) = calibrated_model(&a.robot, &a.params)?;
+        common::warn_not_calibrated(&result, &a.params);
+        let against = match a.against {
+            AgainstArg::Auto => Against::Auto,
+            AgainstArg::Model => Against::Model,
+            AgainstArg::Desired => Against::Desired,
+        };
+        Ok(Settings {
+            nominal,
+            calibrated,
+            result,
+            against,
+            params: a.params.clone(),
+            data: a.data.clone(),
+            per_point: a.per_point.clone(),
+            outputs,
+            json: a.json,
+            nominal_limits: a.nominal_limits,
+        })
+    }
+}
+
 pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
-    let stdout_data = a.per_point.as_deref() == Some(Path::new(io_plan::STDOUT));
-    if stdout_data && a.json {
-        return Err(crate::exit::usage(
-            "--per-point - and --json both want standard output: write the per-point errors to \
-             a file",
-        ));
-    }
-    let mut plan = IoPlan::new();
-    plan.robot("--robot", &a.robot)
-        .input("--params", &a.params)
-        .recorded_in("--params", &a.params)
-        .input("--data", &a.data);
-    if let Some(p) = &a.per_point {
-        plan.output_or_stdout("--per-point", p);
-    }
-    let mut outputs = plan.check()?;
-    let (nominal, cal, res) = calibrated_model(&a.robot, &a.params)?;
-    common::warn_not_calibrated(&res, &a.params);
-    let against = match a.against {
-        AgainstArg::Auto => Against::Auto,
-        AgainstArg::Model => Against::Model,
-        AgainstArg::Desired => Against::Desired,
-    };
+    let Settings {
+        nominal,
+        calibrated: cal,
+        result: res,
+        against,
+        params,
+        data,
+        per_point: per_point_path,
+        mut outputs,
+        json,
+        nominal_limits,
+    } = Settings::try_from(&a)?;
     // Row by row: only the error norms are kept (16 bytes per row), so files of any length fit.
-    let context = || format!("--data {}", a.data.display());
-    let mut reader = MeasurementReader::open(&a.data, nominal.joint_space(), Positions::Required)
+    let context = || format!("--data {}", data.display());
+    let mut reader = MeasurementReader::open(&data, nominal.joint_space(), Positions::Required)
         .with_context(context)?;
     let header = reader.header();
     let frame = res.tracker_frame();
     let ev = Evaluator::new(&nominal, &cal, &frame, &header, against)?;
     let names = ev.series();
-    let mut per_point = match &a.per_point {
+    let mut per_point = match &per_point_path {
         Some(p) => Some(PerPointWriter::to_output(
             outputs.open(p)?,
             &header,
@@ -108,7 +154,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     };
     let mut norms = [Vec::new(), Vec::new()];
     let mut not_converged = Statuses::new(&header);
-    let mut outside = OutsideLimits::new(&nominal, &a.data);
+    let mut outside = OutsideLimits::new(&nominal, &data);
     while let Some(r) = reader.next_row().with_context(context)? {
         outside.check(r.line, &r.q);
         let e = ev.errors(&r)?;
@@ -124,7 +170,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     }
     let n_outside = outside.count();
     // Refused before anything is written (the per-point writer is dropped).
-    super::common::check_limits(outside, a.nominal_limits, &mut Vec::new())?;
+    super::common::check_limits(outside, nominal_limits, &mut Vec::new())?;
     if let Some(w) = per_point {
         w.commit()?;
     }
@@ -140,10 +186,10 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         })
         .collect();
     let reference = ev.reference();
-    if a.json {
+    if json {
         let mut o = serde_json::Map::new();
-        o.insert("data".into(), a.data.display().to_string().into());
-        o.insert("params".into(), a.params.display().to_string().into());
+        o.insert("data".into(), data.display().to_string().into());
+        o.insert("params".into(), params.display().to_string().into());
         o.insert(
             "reference".into(),
             match reference {
@@ -153,7 +199,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             .into(),
         );
         o.insert("n".into(), n.into());
-        if a.nominal_limits {
+        if nominal_limits {
             o.insert("rows_outside_limits".into(), n_outside.into());
         }
         for s in &series {
@@ -168,12 +214,18 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
                 }),
             );
         }
-        if let Some(p) = &a.per_point {
+        if let Some(p) = &per_point_path {
             o.insert("per_point".into(), p.display().to_string().into());
         }
         println!("{}", serde_json::to_string_pretty(&o)?);
     } else {
-        print_table(&a, n, reference, &series, &res);
+        print_table(
+            (&data, &params, per_point_path.as_deref()),
+            n,
+            reference,
+            &series,
+            &res,
+        );
     }
     Ok(())
 }
@@ -253,8 +305,9 @@ fn cell(v: f64) -> String {
     }
 }
 
+/// Prints the statistics of `files` (`--data`, `--params`, `--per-point`).
 fn print_table(
-    a: &EvaluateArgs,
+    (data, params, per_point_path): (&Path, &Path, Option<&Path>),
     n: usize,
     reference: Reference,
     series: &[Series],
@@ -268,9 +321,9 @@ fn print_table(
     };
     println!(
         "{}: {} points; {what}; tracker frame of {}",
-        a.data.display(),
+        data.display(),
         n,
-        a.params.display()
+        params.display()
     );
     match reference {
         Reference::Model => {
@@ -301,7 +354,7 @@ fn print_table(
             let val = res.errors.validation.map(|v| v.after);
             println!(
                 "  predicted: the calibrated model's errors in {} (Table IV)",
-                a.params.display()
+                params.display()
             );
             println!();
             print!("{:<14} {:>12} {:>12}", "", "verification", "pred. cal.");
@@ -338,7 +391,7 @@ fn print_table(
             }
         }
     }
-    if let Some(p) = &a.per_point {
+    if let Some(p) = per_point_path {
         println!("wrote {} ({n} rows)", io_plan::shown(p));
     }
 }

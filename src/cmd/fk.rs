@@ -20,16 +20,37 @@ pub struct FkArgs {
     json: bool,
 }
 
-pub fn run(a: FkArgs) -> anyhow::Result<()> {
-    let m = common::model(&a.robot, a.params.as_deref())?;
-    if let (Some((_, res)), Some(p)) = (&m.calibrated, &a.params) {
-        common::warn_not_calibrated(res, p);
+/// Everything `fk` needs, checked before any work: the model (nominal or calibrated) and the
+/// joint values (count, numbers, ranges).
+struct Settings {
+    model: common::Model,
+    q: Vec<f64>,
+    json: bool,
+}
+
+impl TryFrom<&FkArgs> for Settings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &FkArgs) -> anyhow::Result<Settings> {
+        let model = common::model(&a.robot, a.params.as_deref())?;
+        if let (Some((_, res)), Some(p)) = (&model.calibrated, &a.params) {
+            common::warn_not_calibrated(res, p);
+        }
+        let q = common::joints_arg(&a.joints, model.active())?;
+        Ok(Settings {
+            model,
+            q,
+            json: a.json,
+        })
     }
-    let r = m.active();
-    let q = common::joints_arg(&a.joints, r)?;
+}
+
+pub fn run(a: FkArgs) -> anyhow::Result<()> {
+    let Settings { model, q, json } = Settings::try_from(&a)?;
+    let r = model.active();
     let pose = r.tool_pose(&q);
     let p = pose.translation.vector;
-    if a.json {
+    if json {
         println!("{}", serde_json::json!({ "x": p.x, "y": p.y, "z": p.z }));
     } else {
         let v = robocal_core::frame::vec_rad_to_deg(&robocal_core::frame_vector(&pose));

@@ -6,6 +6,7 @@ mod compensate;
 mod demo;
 mod evaluate;
 mod fk;
+pub(crate) mod flags;
 mod io_plan;
 mod limits;
 mod paper_tables;

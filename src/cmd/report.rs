@@ -83,43 +83,88 @@ fn read(
     Ok(Some(set))
 }
 
-pub fn run(a: ReportArgs) -> anyhow::Result<()> {
-    let mut plan = IoPlan::new();
-    plan.input("RESULT", &a.result)
-        .recorded_in("RESULT", &a.result)
-        .input_opt("--data", a.data.as_deref())
-        .input_opt("--validate", a.validate.as_deref())
-        .input_opt("--verify", a.verify.as_deref())
-        .output_dir("--out", &a.out, &[HTML_FILE, HISTOGRAM_FILE]);
-    if let Some(r) = &a.robot {
-        plan.robot("--robot", r);
+/// Everything `report` needs, checked before any work: the files plan, the robot (given or
+/// recorded in the result), the models and the measurement files to show.
+struct Settings {
+    result_path: PathBuf,
+    result: CalibrationResult,
+    nominal: robocal_core::Robot,
+    calibrated: robocal_core::Robot,
+    /// The calibration data: given, or recorded in the result and still there.
+    data: Option<PathBuf>,
+    /// The validation data: given, or recorded in the result and still there.
+    validate: Option<PathBuf>,
+    verify: Option<PathBuf>,
+    paper: bool,
+    out: PathBuf,
+}
+
+impl TryFrom<&ReportArgs> for Settings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &ReportArgs) -> anyhow::Result<Settings> {
+        let mut plan = IoPlan::new();
+        plan.input("RESULT", &a.result)
+            .recorded_in("RESULT", &a.result)
+            .input_opt("--data", a.data.as_deref())
+            .input_opt("--validate", a.validate.as_deref())
+            .input_opt("--verify", a.verify.as_deref())
+            .output_dir("--out", &a.out, &[HTML_FILE, HISTOGRAM_FILE]);
+        if let Some(r) = &a.robot {
+            plan.robot("--robot", r);
+        }
+        plan.check()?;
+        let result = CalibrationResult::read(&a.result)?;
+        let robot = match (&a.robot, recorded(&result, "robot_arg")) {
+            (Some(r), _) => r.clone(),
+            (None, Some(r)) => r.to_owned(),
+            (None, None) => {
+                return Err(exit::usage(format!(
+                    "{} does not record its robot: give --robot NAME|FILE",
+                    a.result.display()
+                )))
+            }
+        };
+        let (nominal, calibrated, result) = calibrated_model(&robot, &a.result).with_context(|| {
+            if a.robot.is_none() {
+                format!("the robot `{robot}` recorded in the result (give --robot to choose another)")
+            } else {
+                format!("--robot {robot}")
+            }
+        })?;
+        super::common::warn_not_calibrated(&result, &a.result);
+        let data_path = file_arg(&a.data, &result, "data", "--data");
+        let val_path = file_arg(&a.validate, &result, "validate", "--validate");
+        Ok(Settings {
+            result_path: a.result.clone(),
+            result,
+            nominal,
+            calibrated,
+            data: data_path,
+            validate: val_path,
+            verify: a.verify.clone(),
+            paper: a.paper,
+            out: a.out.clone(),
+        })
     }
-    plan.check()?;
-    let result = CalibrationResult::read(&a.result)?;
-    let robot = match (&a.robot, recorded(&result, "robot_arg")) {
-        (Some(r), _) => r.clone(),
-        (None, Some(r)) => r.to_owned(),
-        (None, None) => {
-            return Err(exit::usage(format!(
-                "{} does not record its robot: give --robot NAME|FILE",
-                a.result.display()
-            )))
-        }
-    };
-    let (nominal, calibrated, result) = calibrated_model(&robot, &a.result).with_context(|| {
-        if a.robot.is_none() {
-            format!("the robot `{robot}` recorded in the result (give --robot to choose another)")
-        } else {
-            format!("--robot {robot}")
-        }
-    })?;
-    super::common::warn_not_calibrated(&result, &a.result);
+}
+
+pub fn run(a: ReportArgs) -> anyhow::Result<()> {
+    let Settings {
+        result_path,
+        result,
+        nominal,
+        calibrated,
+        data: data_path,
+        validate: val_path,
+        verify,
+        paper,
+        out,
+    } = Settings::try_from(&a)?;
     let joints = nominal.joint_space();
-    let data_path = file_arg(&a.data, &result, "data", "--data");
-    let val_path = file_arg(&a.validate, &result, "validate", "--validate");
     let data = read(&data_path, joints, "--data")?;
     let validation = read(&val_path, joints, "--validate")?;
-    let verification = read(&a.verify, joints, "--verify")?;
+    let verification = read(&verify, joints, "--verify")?;
     let mut report = ReportData::from_run(&RunData {
         result: &result,
         nominal: &nominal,
@@ -127,30 +172,30 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         calibration: data.as_ref(),
         validation: validation.as_ref(),
         verification: verification.as_ref(),
-        with_paper: a.paper,
+        with_paper: paper,
     })?;
     report.subtitle = Some(format!(
         "Result {}{}{}",
-        a.result.display(),
+        result_path.display(),
         data_path.as_ref().map_or(String::new(), |p| format!(
             "; calibration data {}",
             p.display()
         )),
-        a.verify
+        verify
             .as_ref()
             .map_or(String::new(), |p| format!("; verification {}", p.display()))
     ));
     report.settings.insert(
         0,
-        robocal_report::Setting::new("Result file", a.result.display()),
+        robocal_report::Setting::new("Result file", result_path.display()),
     );
-    if let Some(v) = &a.verify {
+    if let Some(v) = &verify {
         report.settings.push(robocal_report::Setting::new(
             "Verification data",
             v.display(),
         ));
     }
-    let files = write_report(&a.out, &report)?;
+    let files = write_report(&out, &report)?;
     print_summary(&report);
     println!(
         "report: {} (histogram: {})",

@@ -21,6 +21,23 @@ pub struct ShowArgs {
     params: Option<PathBuf>,
 }
 
+/// Everything `robot show` needs, checked before any work: the model, nominal or calibrated.
+struct ShowSettings {
+    model: common::Model,
+}
+
+impl TryFrom<&ShowArgs> for ShowSettings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &ShowArgs) -> anyhow::Result<ShowSettings> {
+        let model = common::model(&a.robot, a.params.as_deref())?;
+        if let (Some((_, res)), Some(p)) = (&model.calibrated, &a.params) {
+            common::warn_not_calibrated(res, p);
+        }
+        Ok(ShowSettings { model })
+    }
+}
+
 pub fn run(c: RobotCmd) -> anyhow::Result<()> {
     match c {
         RobotCmd::List => {
@@ -30,10 +47,7 @@ pub fn run(c: RobotCmd) -> anyhow::Result<()> {
             Ok(())
         }
         RobotCmd::Show(a) => {
-            let m = common::model(&a.robot, a.params.as_deref())?;
-            if let (Some((_, res)), Some(p)) = (&m.calibrated, &a.params) {
-                common::warn_not_calibrated(res, p);
-            }
+            let ShowSettings { model: m } = ShowSettings::try_from(&a)?;
             let r = m.active();
             let label = match &m.calibrated {
                 Some((_, res)) if res.partial_reason().is_some() => {

@@ -9,8 +9,8 @@ use robocal_core::io::measurements::{measurements_csv, read_measurements, Positi
 use robocal_core::io::result::FrameVec;
 use robocal_core::io::write_all_atomic;
 use robocal_core::simulation::{
-    simulate, simulate_joints, GeometricErrors, GravityModel, OutlierModel, SimulationConfig,
-    TruthFile, TruthSpec, SET_VALIDATION,
+    check_truth_matches, simulate, simulate_joints, GeometricErrors, GravityModel, OutlierModel,
+    SimulationConfig, TruthFile, TruthSpec, SET_VALIDATION,
 };
 use robocal_core::Robot;
 use std::path::{Path, PathBuf};
@@ -244,45 +244,87 @@ fn truth_path(out: &Path) -> PathBuf {
     out.with_extension("truth.json")
 }
 
-pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
-    if a.validation_out.is_some() && a.validation == 0 {
-        return Err(exit::usage(
-            "--validation-out needs --validation N (N >= 1)",
-        ));
-    }
-    let truth_out = truth_path(&a.out);
-    check_counts(&a)?;
-    let mut plan = IoPlan::new();
-    plan.robot("--robot", &a.robot);
-    if a.truth != "random" {
-        plan.robot("--truth", &a.truth);
-    }
-    plan.input_opt("--joints", a.joints.as_deref())
-        .output(
-            "--out",
-            &a.out,
-            "the truth file is written beside it (FILE.truth.json)",
-        )
-        .derived_output(
-            "--out",
-            &a.out,
-            &truth_out,
-            "the truth file written beside it",
-        );
-    if let Some(v) = &a.validation_out {
-        plan.output(
-            "--validation-out",
-            v,
-            "the truth file records which file holds each set",
-        );
-    }
-    plan.check()?;
-    let nominal = common::robot(&a.robot)?;
-    let (truth, truth_tracker) = truth_arg(&a, &nominal)?;
-    let cfg = config(&a, &nominal, truth_tracker)?;
-    cfg.validate(&nominal)?;
+/// Everything `simulate` needs, checked completely before any work: counts, flag combinations,
+/// the files plan, the robots and every setting of the simulation (ranges, per-joint lists). The
+/// command body only reads it.
+struct Settings {
+    nominal: Robot,
+    truth: TruthSpec,
+    cfg: SimulationConfig,
+    joints: Option<PathBuf>,
+    out: PathBuf,
+    truth_out: PathBuf,
+    validation_out: Option<PathBuf>,
+}
 
-    let joints = match &a.joints {
+impl TryFrom<&SimulateArgs> for Settings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &SimulateArgs) -> anyhow::Result<Settings> {
+        if a.validation_out.is_some() && a.validation == 0 {
+            return Err(exit::usage(
+                "--validation-out needs --validation N (N >= 1)",
+            ));
+        }
+        let truth_out = truth_path(&a.out);
+        check_counts(a)?;
+        let mut plan = IoPlan::new();
+        plan.robot("--robot", &a.robot);
+        if a.truth != "random" {
+            plan.robot("--truth", &a.truth);
+        }
+        plan.input_opt("--joints", a.joints.as_deref())
+            .output(
+                "--out",
+                &a.out,
+                "the truth file is written beside it (FILE.truth.json)",
+            )
+            .derived_output(
+                "--out",
+                &a.out,
+                &truth_out,
+                "the truth file written beside it",
+            );
+        if let Some(v) = &a.validation_out {
+            plan.output(
+                "--validation-out",
+                v,
+                "the truth file records which file holds each set",
+            );
+        }
+        plan.check()?;
+        let nominal = common::robot(&a.robot)?;
+        let (truth, truth_tracker) = truth_arg(a, &nominal)?;
+        let cfg = config(a, &nominal, truth_tracker)?;
+        cfg.validate(&nominal)?;
+        match &truth {
+            TruthSpec::Random(e) => e.validate()?,
+            TruthSpec::Robot(t) => check_truth_matches(&nominal, t)?,
+        }
+        Ok(Settings {
+            nominal,
+            truth,
+            cfg,
+            joints: a.joints.clone(),
+            out: a.out.clone(),
+            truth_out,
+            validation_out: a.validation_out.clone(),
+        })
+    }
+}
+
+pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
+    let Settings {
+        nominal,
+        truth,
+        cfg,
+        joints,
+        out,
+        truth_out,
+        validation_out,
+    } = Settings::try_from(&a)?;
+
+    let joints = match &joints {
         Some(p) => Some(read_measurements(
             p,
             nominal.joint_space(),
@@ -294,24 +336,22 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         Some(j) => j.rows.len(),
         None => cfg.poses + cfg.validation_poses + if cfg.plane_points { 3 } else { 0 },
     };
-    let bar = (rows >= BAR_FROM).then(|| crate::progress::bar(0, "simulating"));
-    let mut progress = |done: usize, total: usize| {
-        if let Some(b) = &bar {
-            b.set_length(total as u64);
-            b.set_position(done as u64);
-        }
+    let bar = (rows >= BAR_FROM).then(|| crate::progress::Bar::new("simulating"));
+    let observer: &dyn robocal_core::Observer = match &bar {
+        Some(b) => b,
+        None => &(),
     };
     let sim = match joints {
         // The joint file is dropped as soon as it is measured (large files: memory).
-        Some(j) => simulate_joints(&nominal, &truth, &cfg, &j, &mut progress)?,
-        None => simulate(&nominal, &truth, &cfg, &mut progress)?,
+        Some(j) => simulate_joints(&nominal, &truth, &cfg, &j, observer)?,
+        None => simulate(&nominal, &truth, &cfg, observer)?,
     };
     if let Some(b) = &bar {
-        b.finish_and_clear();
+        b.finish();
     }
 
     // Split the validation rows off if asked; every row's file, in row order, for the truth file.
-    let split = a.validation_out.as_ref().map(|_| {
+    let split = validation_out.as_ref().map(|_| {
         (
             sim.select(SET_VALIDATION, false),
             sim.select(SET_VALIDATION, true),
@@ -328,9 +368,9 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         .iter()
         .map(|r| {
             let is_val = set_col.is_some_and(|k| r.extra[k] == SET_VALIDATION);
-            match (&a.validation_out, is_val) {
+            match (&validation_out, is_val) {
                 (Some(v), true) => v.as_path(),
-                _ => a.out.as_path(),
+                _ => out.as_path(),
             }
         })
         .collect();
@@ -339,10 +379,10 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         path: p.to_owned(),
         source: e,
     };
-    let main_csv = measurements_csv(main).map_err(|e| io(&a.out, e))?;
+    let main_csv = measurements_csv(main).map_err(|e| io(&out, e))?;
     let json = truth_file.to_json()?;
-    let mut writes: Vec<(&Path, Vec<u8>)> = vec![(a.out.as_path(), main_csv)];
-    if let (Some(p), Some(v)) = (&a.validation_out, val) {
+    let mut writes: Vec<(&Path, Vec<u8>)> = vec![(out.as_path(), main_csv)];
+    if let (Some(p), Some(v)) = (&validation_out, val) {
         writes.push((p.as_path(), measurements_csv(v).map_err(|e| io(p, e))?));
     }
     writes.push((truth_out.as_path(), json.into_bytes()));

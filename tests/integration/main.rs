@@ -28,6 +28,7 @@ mod cli_demo;
 mod cli_evaluate;
 mod cli_joints;
 mod cli_robot;
+mod cli_settings;
 mod cli_simulate;
 #[cfg(unix)]
 mod cli_trust_files;

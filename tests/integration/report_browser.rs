@@ -97,7 +97,7 @@ fn report_renders_in_chromium() {
 #[test]
 fn demo_report_renders_in_chromium() {
     use robocal_core::experiment::{run_experiment, ExperimentConfig};
-    let e = run_experiment(ExperimentConfig::paper(1).unwrap(), &mut |_, _, _| {}).unwrap();
+    let e = run_experiment(ExperimentConfig::paper(1).unwrap(), &()).unwrap();
     render_and_check(&robocal_report::ReportData::from_experiment(&e, "robocal-report").unwrap());
 }
 

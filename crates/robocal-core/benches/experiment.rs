@@ -11,7 +11,7 @@ fn bench(c: &mut Criterion) {
     let config = ExperimentConfig::paper(1).unwrap();
     c.bench_function("paper_experiment", |b| {
         b.iter(|| {
-            let e = run_experiment(black_box(config.clone()), &mut |_, _, _| {}).unwrap();
+            let e = run_experiment(black_box(config.clone()), &()).unwrap();
             e.verified().mean_mm
         })
     });

@@ -50,7 +50,7 @@ fn bench(c: &mut Criterion) {
                         validation: None,
                     },
                     &settings,
-                    &mut |_, _, _| {},
+                    &(),
                 )
                 .unwrap();
                 black_box(cal.calibration.after_stats())

@@ -15,7 +15,7 @@ fn benches(c: &mut Criterion) {
         ..SimulationConfig::default()
     };
     c.bench_function("session 3+75+73 (plane IK included)", |b| {
-        b.iter(|| simulate(&nominal, &truth, black_box(&cfg), &mut |_, _| {}).unwrap())
+        b.iter(|| simulate(&nominal, &truth, black_box(&cfg), &()).unwrap())
     });
     let cell = VirtualCell::from_config(&nominal, &truth, &cfg).unwrap();
     c.bench_function("random_poses 10000", |b| {

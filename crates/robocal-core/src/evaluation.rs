@@ -242,7 +242,7 @@ pub fn check_result_nominal(
                 Some(&format!("parameters.{name}.nominal")),
                 format!(
                     "the result was made for a robot with nominal {name} = {} {}, but robot `{}` \
-                     has {mine} {}: wrong --robot or wrong result file (result robot: `{}`)",
+                     has {mine} {}: wrong nominal robot or wrong result file (result robot: `{}`)",
                     e.nominal,
                     e.unit.as_str(),
                     nominal.name(),

@@ -10,6 +10,17 @@
 //! (files, reports). A prismatic joint's value is millimetres everywhere; every conversion of joint
 //! values goes through [`JointSpace`] (`Robot::joint_space`), which also holds the controller's
 //! axis map. See `DESIGN.md` for the conventions.
+//!
+//! The library never prints. Long work (simulating, calibrating, compensating many rows, Monte
+//! Carlo trials, a whole experiment) reports its progress to one observer type,
+//! [`progress::Observer`]: `fn progress(&self, stage: Stage, done: usize, total: usize)`, with
+//! [`progress::Stage`] naming every long stage (the solver's iterations too). Pass `&()` to
+//! ignore it, or a closure `|stage, done, total| ...`; observers are `Send + Sync`, so Monte
+//! Carlo trials report from rayon's worker threads.
+//!
+//! Errors about settings name the setting, never a command-line flag: the field of the settings
+//! struct (`noise_mm`, `gravity.payload_kg`, `identifiability.fix`), as the `field` of
+//! [`Error::Invalid`] or in backticks inside a message. A front end maps them to its own words.
 #![warn(missing_docs)]
 
 pub mod compensation;
@@ -22,11 +33,15 @@ pub mod io;
 pub mod kinematics;
 pub mod model;
 pub mod observations;
+pub mod progress;
 pub mod ranges;
 pub mod registration;
 pub mod simulation;
 pub mod stats;
 pub mod unit;
+
+#[cfg(test)]
+mod messages_tests;
 
 pub use compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
 pub use error::{Error, Result};
@@ -38,4 +53,5 @@ pub use model::robot_file::parse_robot_toml;
 pub use model::{
     Controller, Convention, JointLimit, JointSpace, JointType, Link, Param, Robot, Unit, MAX_JOINTS,
 };
+pub use progress::{Observer, Stage};
 pub use stats::ErrorStats;

@@ -276,7 +276,7 @@ mod runs {
     use robocal_core::identification::{calibrate, split_measurements, CalibrationData};
 
     fn experiment() -> Experiment {
-        run_experiment(ExperimentConfig::paper(1).unwrap(), &mut |_, _, _| {}).unwrap()
+        run_experiment(ExperimentConfig::paper(1).unwrap(), &()).unwrap()
     }
 
     fn svg_count(html: &str) -> usize {
@@ -387,7 +387,7 @@ mod runs {
                 validation: None,
             },
             &Default::default(),
-            &mut |_, _, _| {},
+            &(),
         )
         .unwrap();
         let result = cal.to_result(Default::default());

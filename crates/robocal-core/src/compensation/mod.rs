@@ -21,6 +21,7 @@ pub use targets::{parse_targets, read_targets, Target, TargetSet};
 
 use crate::error::{Error, Result};
 use crate::model::{JointType, Robot, MAX_JOINTS};
+use crate::progress::{Observer, Stage};
 use nalgebra::Vector3;
 
 /// How an inverse-kinematics solve ended.
@@ -136,7 +137,7 @@ pub struct Compensator<'a, S: IkSolver = DampedLeastSquares> {
     pub seeds: usize,
 }
 
-/// How often batch functions call the progress callback (rows).
+/// How often batch functions report to their observer (rows).
 const PROGRESS_EVERY: usize = 256;
 
 impl<'a, S: IkSolver> Compensator<'a, S> {
@@ -216,12 +217,12 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
         best.expect("at least one seed")
     }
 
-    /// Compensates every desired joint vector (rad), in order (eq. 12-14). `progress(done, total)`
-    /// is called as rows complete.
+    /// Compensates every desired joint vector (rad), in order (eq. 12-14). `observer` hears
+    /// [`Stage::Compensation`] as rows complete.
     pub fn compensate_all(
         &self,
         desired: &[Vec<f64>],
-        progress: &mut dyn FnMut(usize, usize),
+        observer: &dyn Observer,
     ) -> Result<Vec<Compensation>> {
         let n = self.nominal.dof();
         let mut out = Vec::with_capacity(desired.len());
@@ -236,18 +237,19 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
                 report,
             });
             if (k + 1) % PROGRESS_EVERY == 0 {
-                progress(k + 1, desired.len());
+                observer.progress(Stage::Compensation, k + 1, desired.len());
             }
         }
-        progress(desired.len(), desired.len());
+        observer.progress(Stage::Compensation, desired.len(), desired.len());
         Ok(out)
     }
 
-    /// Reaches every target of a target file, in order (see [`Compensator::reach`]).
+    /// Reaches every target of a target file, in order (see [`Compensator::reach`]); `observer`
+    /// hears [`Stage::Compensation`] as rows complete.
     pub fn reach_all(
         &self,
         targets: &[Target],
-        progress: &mut dyn FnMut(usize, usize),
+        observer: &dyn Observer,
     ) -> Result<Vec<Compensation>> {
         let n = self.calibrated.dof();
         let mut out = Vec::with_capacity(targets.len());
@@ -270,10 +272,10 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
                 report,
             });
             if (k + 1) % PROGRESS_EVERY == 0 {
-                progress(k + 1, targets.len());
+                observer.progress(Stage::Compensation, k + 1, targets.len());
             }
         }
-        progress(targets.len(), targets.len());
+        observer.progress(Stage::Compensation, targets.len(), targets.len());
         Ok(out)
     }
 }

@@ -211,7 +211,7 @@ fn targets_outside_the_workspace_are_reported() {
             extra: vec![],
         },
     ];
-    let out = comp.reach_all(&targets, &mut |_, _| {}).unwrap();
+    let out = comp.reach_all(&targets, &()).unwrap();
     assert_eq!(out.len(), 2);
     assert_eq!(out[0].report.status, IkStatus::Unreachable);
     assert_eq!(out[1].report.status, IkStatus::Converged);
@@ -320,7 +320,7 @@ fn mismatched_models_and_bad_settings_are_errors() {
     assert!(s.validate().is_err());
     let comp = Compensator::new(&nom, &nom, DampedLeastSquares::default()).unwrap();
     let e = comp
-        .compensate_all(&[vec![0.0; 5]], &mut |_, _| {})
+        .compensate_all(&[vec![0.0; 5]], &())
         .unwrap_err()
         .to_string();
     assert!(

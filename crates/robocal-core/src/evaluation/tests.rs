@@ -107,7 +107,7 @@ fn verification_reduces_measured_errors_5x_and_matches_the_prediction() {
             validation: None,
         },
         &Default::default(),
-        &mut |_, _, _| {},
+        &(),
     )
     .unwrap();
     let cal = calibration.calibrated.clone();
@@ -121,7 +121,7 @@ fn verification_reduces_measured_errors_5x_and_matches_the_prediction() {
 
     // Compensation, through the commanded file.
     let comp = Compensator::new(&nom, &cal, DampedLeastSquares::default()).unwrap();
-    let rows = comp.compensate_all(&desired, &mut |_, _| {}).unwrap();
+    let rows = comp.compensate_all(&desired, &()).unwrap();
     assert!(rows.iter().all(|c| c.report.status == IkStatus::Converged));
     let dir = tmp("verify");
     let path = dir.join("commanded.csv");
@@ -172,7 +172,7 @@ fn desired_positions_from_joints_or_positions() {
     let t = tracker(false);
     let desired = poses(&nom, 10, 3);
     let comp = Compensator::new(&nom, &truth, DampedLeastSquares::default()).unwrap();
-    let rows = comp.compensate_all(&desired, &mut |_, _| {}).unwrap();
+    let rows = comp.compensate_all(&desired, &()).unwrap();
     let dir = tmp("desired");
     let path = dir.join("c.csv");
     let none: Vec<&[String]> = vec![&[]; rows.len()];
@@ -297,7 +297,7 @@ fn results_of_another_robot_are_rejected() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("r.json: field `parameters.") && e.contains("wrong --robot"),
+        e.contains("r.json: field `parameters.") && e.contains("wrong nominal robot"),
         "{e}"
     );
 }

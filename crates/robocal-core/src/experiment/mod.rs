@@ -40,6 +40,7 @@ use crate::io::measurements::{measurements_csv, parse_measurements};
 use crate::io::{CalibrationResult, MeasurementSet, Positions};
 use crate::model::presets::preset;
 use crate::model::{JointSpace, Robot};
+use crate::progress::{As, Observer, Stage};
 use crate::simulation::{
     simulate, simulate_joints, GravityModel, Simulation, SimulationConfig, TruthFile, TruthSpec,
     SET_CALIBRATION, SET_VALIDATION,
@@ -157,42 +158,15 @@ impl ExperimentConfig {
     }
 }
 
-/// The steps of an experiment, for progress reports.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Phase {
-    /// Drawing and measuring the poses.
-    Measurement,
-    /// Registration, identifiability, identification, uncertainty.
-    Calibration,
-    /// Inverse kinematics of the calibration poses.
-    Compensation,
-    /// Measuring the commanded joints and comparing with the desired positions.
-    Verification,
-    /// Expressing the truth in the identified parameters.
-    TruthComparison,
-}
-
-impl Phase {
-    /// Every phase, in order.
-    pub const ALL: [Phase; 5] = [
-        Phase::Measurement,
-        Phase::Calibration,
-        Phase::Compensation,
-        Phase::Verification,
-        Phase::TruthComparison,
-    ];
-
-    /// A few words for a progress bar.
-    pub fn describe(self) -> &'static str {
-        match self {
-            Phase::Measurement => "measuring",
-            Phase::Calibration => "calibrating",
-            Phase::Compensation => "compensating",
-            Phase::Verification => "verifying",
-            Phase::TruthComparison => "comparing with the truth",
-        }
-    }
-}
+/// The phases of an experiment, in order: the stages [`run_experiment`] reports (each phase's
+/// inner steps are reported as the phase).
+pub const PHASES: [Stage; 5] = [
+    Stage::Measurement,
+    Stage::Calibration,
+    Stage::Compensation,
+    Stage::Verification,
+    Stage::TruthComparison,
+];
 
 /// What an experiment produced.
 #[derive(Debug, Clone)]
@@ -270,22 +244,19 @@ fn csv_bytes(set: &MeasurementSet, name: &str) -> Result<Vec<u8>> {
     })
 }
 
-/// Runs the experiment (see the module docs). `progress(phase, done, total)` is called as the
+/// Runs the experiment (see the module docs). `observer` hears the phases ([`PHASES`]) as the
 /// work advances (`done` and `total` count steps within the phase).
-pub fn run_experiment(
-    config: ExperimentConfig,
-    progress: &mut dyn FnMut(Phase, usize, usize),
-) -> Result<Experiment> {
+pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Result<Experiment> {
     let nominal = &config.nominal;
     let joints = nominal.joint_space();
 
     // 1. The measurement session, split into the files `simulate --validation-out` writes.
-    progress(Phase::Measurement, 0, 1);
+    observer.progress(Stage::Measurement, 0, 1);
     let session = simulate(
         nominal,
         &TruthSpec::Robot(config.truth.clone()),
         &config.session,
-        &mut |d, t| progress(Phase::Measurement, d, t),
+        observer,
     )?;
     let main = session.select(SET_VALIDATION, false);
     let val = session.select(SET_VALIDATION, true);
@@ -316,7 +287,7 @@ pub fn run_experiment(
     }
     let desired_csv = csv_bytes(&desired_set, files::DESIRED)?;
     let desired = parse_csv(&desired_csv, files::DESIRED, joints, Positions::Optional)?;
-    progress(Phase::Measurement, 1, 1);
+    observer.progress(Stage::Measurement, 1, 1);
 
     // 2. Calibration from the files, as `robocal calibrate --data cell.csv --validate
     //    validation.csv` reads them.
@@ -330,7 +301,10 @@ pub fn run_experiment(
             validation: Some(&split_val.validation),
         },
         &config.calibration,
-        &mut |_, i, n| progress(Phase::Calibration, i, n),
+        &As {
+            inner: observer,
+            stage: Stage::Calibration,
+        },
     )?;
     if calibration.plausibility.implausible() {
         return Err(Error::Implausible(format!(
@@ -350,12 +324,12 @@ pub fn run_experiment(
     result_json.push('\n');
     let result = CalibrationResult::parse(&result_json, Path::new(files::RESULT))?;
     let calibrated = result.calibrated_robot(nominal, Path::new(files::RESULT))?;
-    progress(Phase::Calibration, 1, 1);
+    observer.progress(Stage::Calibration, 1, 1);
 
     // 3. Compensation of the calibration poses (eq. 12-14).
     let comp = Compensator::new(nominal, &calibrated, config.ik)?;
     let qs: Vec<Vec<f64>> = desired.rows.iter().map(|r| r.q.clone()).collect();
-    let compensation = comp.compensate_all(&qs, &mut |d, t| progress(Phase::Compensation, d, t))?;
+    let compensation = comp.compensate_all(&qs, observer)?;
     let extra_rows: Vec<&[String]> = desired.rows.iter().map(|r| r.extra.as_slice()).collect();
     let commanded_bytes = commanded_csv(
         joints,
@@ -385,7 +359,10 @@ pub fn run_experiment(
         &TruthSpec::Robot(truth_again),
         &vconfig,
         &commanded,
-        &mut |d, t| progress(Phase::Verification, d, t),
+        &As {
+            inner: observer,
+            stage: Stage::Verification,
+        },
     )?;
     let verify_csv = csv_bytes(&verification.measurements, files::VERIFY)?;
     let verify = parse_csv(&verify_csv, files::VERIFY, joints, Positions::Required)?;
@@ -398,7 +375,7 @@ pub fn run_experiment(
     )?;
 
     // 5. The truth in the identified parameters.
-    progress(Phase::TruthComparison, 0, 1);
+    observer.progress(Stage::TruthComparison, 0, 1);
     let truth_comparison = compare_with_truth(
         &calibration,
         &config.truth,
@@ -406,7 +383,7 @@ pub fn run_experiment(
         &split.calibration,
         &split_val.validation,
     )?;
-    progress(Phase::TruthComparison, 1, 1);
+    observer.progress(Stage::TruthComparison, 1, 1);
 
     let files = vec![
         (files::CELL, cell_csv),

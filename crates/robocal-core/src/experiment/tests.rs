@@ -3,7 +3,7 @@ use crate::io::measurements::parse_measurements;
 use crate::simulation::SET_PLANE;
 
 fn run(config: ExperimentConfig) -> Experiment {
-    run_experiment(config, &mut |_, _, _| {}).unwrap()
+    run_experiment(config, &()).unwrap()
 }
 
 fn file<'a>(e: &'a Experiment, name: &str) -> &'a [u8] {
@@ -20,14 +20,18 @@ fn file<'a>(e: &'a Experiment, name: &str) -> &'a [u8] {
 /// the error before calibration (Table V).
 #[test]
 fn paper_experiment_gives_the_papers_tables() {
-    let mut phases = Vec::new();
-    let e = run_experiment(ExperimentConfig::paper(1).unwrap(), &mut |p, _, _| {
-        if phases.last() != Some(&p) {
-            phases.push(p)
-        }
-    })
+    let phases = std::sync::Mutex::new(Vec::new());
+    let e = run_experiment(
+        ExperimentConfig::paper(1).unwrap(),
+        &|p: crate::Stage, _, _| {
+            let mut phases = phases.lock().unwrap();
+            if phases.last() != Some(&p) {
+                phases.push(p)
+            }
+        },
+    )
     .unwrap();
-    assert_eq!(phases, Phase::ALL.to_vec());
+    assert_eq!(phases.into_inner().unwrap(), PHASES.to_vec());
     let v = e.result.errors.validation.expect("validation set");
     let (before, after) = (e.before(), e.predicted());
     eprintln!(
@@ -236,9 +240,9 @@ fn without_gravity_calibration_errors_match_the_standard_deviations() {
 fn bad_settings_are_errors_not_panics() {
     let mut c = ExperimentConfig::paper(1).unwrap();
     c.session.noise_mm = -1.0;
-    let e = run_experiment(c, &mut |_, _, _| {}).unwrap_err();
-    assert!(e.to_string().contains("--noise-mm"), "{e}");
+    let e = run_experiment(c, &()).unwrap_err();
+    assert!(e.to_string().contains("noise_mm"), "{e}");
     let mut c = ExperimentConfig::paper(1).unwrap();
     c.session.poses = 0;
-    assert!(run_experiment(c, &mut |_, _, _| {}).is_err());
+    assert!(run_experiment(c, &()).is_err());
 }

@@ -65,7 +65,7 @@ pub fn compare_with_truth(
         &mut equivalent,
         &Loss::Squared,
         &SolverOptions::default(),
-        &mut |_, _| {},
+        &(),
     );
     if let Termination::Failed(m) = &report.termination {
         return Err(Error::Numerical(format!(

@@ -56,7 +56,7 @@ fn run(
             identifiability: id,
             ..Default::default()
         },
-        &mut |_, _, _| {},
+        &(),
     )
 }
 

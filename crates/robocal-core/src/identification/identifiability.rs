@@ -111,7 +111,7 @@ impl FixedParam {
     /// The reason as a sentence, e.g. `same effect as base_z`.
     pub fn describe(&self) -> String {
         match &self.reason {
-            FixReason::User => "fixed by --fix".to_string(),
+            FixReason::User => "fixed on request".to_string(),
             FixReason::NoEffect => "no effect on the tool point".to_string(),
             FixReason::Unseen { what } => format!("no effect on the tool point ({what})"),
             FixReason::Duplicate { of, .. } => {
@@ -398,7 +398,7 @@ pub fn analyze(
     }
     if !bad.is_empty() {
         return Err(Error::Numerical(format!(
-            "--free: cannot identify {} from these poses ({}); free only one of a set of \
+            "`identifiability.free`: cannot identify {} from these poses ({}); free only one of a set of \
              parameters with the same effect",
             if bad.len() == 1 {
                 "this parameter"

@@ -74,6 +74,17 @@ pub enum Loss {
 }
 
 impl Loss {
+    /// The loss's name for progress reports and messages: `sum of norms`, `least squares`,
+    /// `Huber` or `Cauchy`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Loss::SumOfNorms { .. } => "sum of norms",
+            Loss::Squared => "least squares",
+            Loss::Huber { .. } => "Huber",
+            Loss::Cauchy { .. } => "Cauchy",
+        }
+    }
+
     /// `l(r)`.
     #[inline]
     pub fn value(&self, r: f64) -> f64 {

@@ -23,6 +23,7 @@ use crate::identification::solver::{solve, SolverOptions, SolverReport, Terminat
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
 use crate::observations::Observations;
+use crate::progress::{self, Observer};
 use crate::registration::{register, Registration, RegistrationObjective, RegistrationOptions};
 use crate::stats::{percentile, ErrorStats};
 
@@ -167,13 +168,14 @@ impl Calibration {
     }
 }
 
-/// Runs a calibration of `nominal` (see the module docs). `progress(stage, step, steps)` is
-/// called as the work advances.
+/// Runs a calibration of `nominal` (see the module docs). `observer` hears the stages
+/// (registration, identifiability, the solver's iterations per objective, uncertainty,
+/// plausibility) as the work advances.
 pub fn calibrate(
     nominal: &Robot,
     data: CalibrationData,
     settings: &CalibrationSettings,
-    progress: &mut dyn FnMut(&str, usize, usize),
+    observer: &dyn Observer,
 ) -> Result<Calibration> {
     let cal = data.calibration;
     for obs in [Some(cal), data.plane, data.validation]
@@ -197,13 +199,16 @@ pub fn calibrate(
     let idopts = &settings.identifiability;
     if let Some(p) = idopts.fix.iter().find(|p| idopts.free.contains(p)) {
         return Err(Error::invalid(
-            "--fix/--free",
-            format!("`{}` is given both to --fix and to --free", p.name()),
+            "identifiability.fix",
+            format!(
+                "`{}` is given both to `identifiability.fix` and to `identifiability.free`",
+                p.name()
+            ),
         ));
     }
     if !(idopts.rank_tolerance >= MIN_RANK_TOLERANCE && idopts.rank_tolerance < 1.0) {
         return Err(Error::invalid(
-            "rank tolerance",
+            "identifiability.rank_tolerance",
             format!(
                 "{:e} is not in [{MIN_RANK_TOLERANCE:e}, 1): it is the smallest independence \
                  (sine of the angle between a parameter's effect and the others') accepted, and \
@@ -216,13 +221,13 @@ pub fn calibrate(
     if let Some(c) = settings.robust_scale_mm {
         if !(c > 0.0 && c.is_finite()) {
             return Err(Error::invalid(
-                "--robust-scale",
+                "robust_scale_mm",
                 format!("{c} is not a positive length (mm)"),
             ));
         }
     }
 
-    progress("registration", 0, 1);
+    observer.progress(progress::Stage::Registration, 0, 1);
     let reg_opts = RegistrationOptions {
         objective: match settings.objective {
             Objective::LeastSquares => RegistrationObjective::LeastSquares,
@@ -233,7 +238,7 @@ pub fn calibrate(
     };
     let registration = register(nominal, cal, data.plane, &reg_opts)?;
 
-    progress("identifiability", 0, 1);
+    observer.progress(progress::Stage::Identifiability, 0, 1);
     let ident = analyze(nominal, cal, idopts)?;
     let k = ident.identified.len();
     let ill_conditioned = ident.ill_conditioned().then(|| {
@@ -277,16 +282,9 @@ pub fn calibrate(
     let problem = Problem::new(nominal, &ident.identified, cal, &registration.frame);
     let mut robot = nominal.clone();
     let mut stages = Vec::new();
-    let mut run = |robot: &mut Robot, loss: Loss, stages: &mut Vec<Stage>| -> Result<()> {
-        let name = match loss {
-            Loss::SumOfNorms { .. } => "sum of norms",
-            Loss::Squared => "least squares",
-            Loss::Huber { .. } => "Huber",
-            Loss::Cauchy { .. } => "Cauchy",
-        };
-        let report = solve(&problem, robot, &loss, &settings.solver, &mut |i, n| {
-            progress(name, i, n)
-        });
+    let run = |robot: &mut Robot, loss: Loss, stages: &mut Vec<Stage>| -> Result<()> {
+        let name = loss.name();
+        let report = solve(&problem, robot, &loss, &settings.solver, observer);
         if let Termination::Failed(m) = &report.termination {
             return Err(Error::Numerical(format!(
                 "identification ({name}) failed after {} iterations: {m}",
@@ -338,7 +336,7 @@ pub fn calibrate(
         }
     };
 
-    progress("uncertainty", 0, 1);
+    observer.progress(progress::Stage::Uncertainty, 0, 1);
     let acc = problem.accumulate(&robot, &final_loss, Level::Full);
     let mut covariance = Covariance::from_accumulated(&ident.identified, &acc);
     if let Some(why) = ill_conditioned {
@@ -364,7 +362,7 @@ pub fn calibrate(
         }
         downweighted.sort_by(|a, b| b.error_mm.total_cmp(&a.error_mm));
     }
-    progress("plausibility", 0, 1);
+    observer.progress(progress::Stage::Plausibility, 0, 1);
     let plausibility = plausibility::assess(&plausibility::Fit {
         nominal,
         calibrated: &robot,

@@ -12,6 +12,7 @@
 use crate::identification::objective::Loss;
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
+use crate::progress::{Observer, Stage};
 use nalgebra::{DMatrix, DVector};
 
 /// Solver settings.
@@ -111,13 +112,14 @@ pub struct SolverReport {
 }
 
 /// Minimizes `sum l(|e_i|)` over the problem's parameters, starting from (and updating) `robot`.
-/// `progress(iteration, max_iterations)` is called once per iteration.
+/// `observer` hears `(Stage::Identification(name), iteration, max_iterations)` once per
+/// iteration, `name` naming the loss ([`Loss::name`]).
 pub fn solve(
     problem: &Problem,
     robot: &mut Robot,
     loss: &Loss,
     opts: &SolverOptions,
-    progress: &mut dyn FnMut(usize, usize),
+    observer: &dyn Observer,
 ) -> SolverReport {
     let k = problem.params().len();
     let n = problem.len().max(1) as f64;
@@ -156,7 +158,7 @@ pub fn solve(
     let mut x_new = DVector::zeros(k);
     'outer: for it in 1..=opts.max_iterations {
         report.iterations = it;
-        progress(it, opts.max_iterations);
+        observer.progress(Stage::Identification(loss.name()), it, opts.max_iterations);
         if !acc.objective.is_finite() || acc.b.iter().any(|v| !v.is_finite()) {
             report.termination =
                 Termination::Failed("non-finite residuals or Jacobian".to_string());

@@ -76,7 +76,7 @@ fn run(
             validation: val,
         },
         s,
-        &mut |_, _, _| {},
+        &(),
     )
     .unwrap()
 }
@@ -172,7 +172,7 @@ fn fix_and_free_override_the_choice() {
     );
     assert_eq!(
         id.fixed_reason(Param::a(4)).unwrap().describe(),
-        "fixed by --fix"
+        "fixed on request"
     );
     assert_eq!(id.identified.len(), 25);
     // Freeing a parameter that cannot be identified is an error naming it and why.
@@ -182,7 +182,7 @@ fn fix_and_free_override_the_choice() {
     };
     let e = analyze(&nom, &obs, &bad).unwrap_err().to_string();
     assert!(
-        e.contains("--free") && e.contains("d3: same effect as d2"),
+        e.contains("`identifiability.free`") && e.contains("d3: same effect as d2"),
         "{e}"
     );
     let bad = IdentifiabilityOptions {
@@ -491,7 +491,7 @@ fn plane_points_give_the_initial_frame() {
             validation: None,
         },
         &CalibrationSettings::default(),
-        &mut |_, _, _| {},
+        &(),
     )
     .unwrap();
     match c.registration.initial {
@@ -526,7 +526,7 @@ fn bad_input_is_rejected_with_reasons() {
         }
     }
     let err = |c: &Observations, s: &CalibrationSettings| {
-        calibrate(&nominal(), data(c), s, &mut |_, _, _| {})
+        calibrate(&nominal(), data(c), s, &())
             .unwrap_err()
             .to_string()
     };
@@ -551,7 +551,7 @@ fn bad_input_is_rejected_with_reasons() {
     let ok = measure(&truth, &tr, 40, &mut rng);
     let e = err(&ok, &both);
     assert!(
-        e.contains("d2") && e.contains("--fix") && e.contains("--free"),
+        e.contains("d2") && e.contains("identifiability.fix") && e.contains("identifiability.free"),
         "{e}"
     );
     let mut seven = Observations::new(7);
@@ -590,36 +590,27 @@ fn solver_reports_why_it_stopped() {
     let loss = Loss::SumOfNorms { delta: 1e-6 };
     // One iteration: stopped by the limit, objective lowered, progress called once.
     let mut r = nom.clone();
-    let mut calls = Vec::new();
+    let calls = std::sync::Mutex::new(Vec::new());
     let opts = SolverOptions {
         max_iterations: 1,
         ..Default::default()
     };
-    let rep = solve(&problem, &mut r, &loss, &opts, &mut |i, n| {
-        calls.push((i, n))
+    let rep = solve(&problem, &mut r, &loss, &opts, &|s: crate::Stage, i, n| {
+        calls.lock().unwrap().push((s, i, n))
     });
     assert_eq!(rep.termination, Termination::MaxIterations);
     assert!(!rep.termination.converged());
-    assert_eq!(calls, vec![(1, 1)]);
+    assert_eq!(
+        calls.into_inner().unwrap(),
+        vec![(crate::Stage::Identification("sum of norms"), 1, 1)]
+    );
     assert!(rep.final_objective < rep.initial_objective);
     // To convergence, then again from the solution: converged at once, nothing moves.
     let mut r = nom.clone();
-    let rep = solve(
-        &problem,
-        &mut r,
-        &loss,
-        &SolverOptions::default(),
-        &mut |_, _| {},
-    );
+    let rep = solve(&problem, &mut r, &loss, &SolverOptions::default(), &());
     assert!(rep.termination.converged(), "{rep:?}");
     let before = problem.values(&r);
-    let again = solve(
-        &problem,
-        &mut r,
-        &loss,
-        &SolverOptions::default(),
-        &mut |_, _| {},
-    );
+    let again = solve(&problem, &mut r, &loss, &SolverOptions::default(), &());
     assert!(
         again.termination.converged() && again.iterations <= 2,
         "{again:?}"
@@ -630,13 +621,7 @@ fn solver_reports_why_it_stopped() {
     let far = pose(&[f64::MAX, f64::MAX, 0.0, 0.0, 0.0, 0.0]);
     let problem = Problem::new(&nom, &id.identified, &cal, &TrackerFrame::new(far));
     let mut r = nom.clone();
-    let rep = solve(
-        &problem,
-        &mut r,
-        &loss,
-        &SolverOptions::default(),
-        &mut |_, _| {},
-    );
+    let rep = solve(&problem, &mut r, &loss, &SolverOptions::default(), &());
     assert!(matches!(rep.termination, Termination::Failed(_)), "{rep:?}");
 }
 

@@ -94,11 +94,11 @@ impl Default for SimulationConfig {
 impl SimulationConfig {
     /// Checks every setting against the nominal robot: finite, and within its plausible range
     /// ([`crate::ranges`]: lengths within ±1 km, noise and sizes not negative). Errors name the
-    /// command-line option. The number of poses is checked by [`super::simulate`], which needs
+    /// setting (the field of this struct). The number of poses is checked by [`super::simulate`], which needs
     /// it (measuring given joints does not).
     pub fn validate(&self, nominal: &Robot) -> Result<()> {
-        in_range("--noise-mm", self.noise_mm, &ranges::SIZE_MM)?;
-        in_range("--noise-per-m", self.noise_per_m, &ranges::NOISE_PER_M)?;
+        in_range("noise_mm", self.noise_mm, &ranges::SIZE_MM)?;
+        in_range("noise_per_m", self.noise_per_m, &ranges::NOISE_PER_M)?;
         let t = &self.tracker_frame;
         let (l, a) = (&ranges::LENGTH, &ranges::ANGLE);
         for (k, v, range) in [
@@ -111,14 +111,14 @@ impl SimulationConfig {
         ] {
             range
                 .check(v)
-                .map_err(|msg| Error::invalid("--tracker", format!("{k}: {msg}")))?;
+                .map_err(|msg| Error::invalid("tracker_frame", format!("{k}: {msg}")))?;
         }
-        in_range("--floor-mm", self.floor_z_mm, &ranges::LENGTH)?;
+        in_range("floor_z_mm", self.floor_z_mm, &ranges::LENGTH)?;
         if let Some(r) = self.footprint_radius_mm {
-            in_range("--footprint-mm", r, &ranges::SIZE_MM)?;
+            in_range("footprint_radius_mm", r, &ranges::SIZE_MM)?;
         }
         if let Some(z) = self.plane_z_mm {
-            in_range("--plane-z-mm", z, &ranges::LENGTH)?;
+            in_range("plane_z_mm", z, &ranges::LENGTH)?;
         }
         if let Some(g) = &self.gravity {
             g.validate(nominal.dof())?;

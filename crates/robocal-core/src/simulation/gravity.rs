@@ -68,12 +68,12 @@ impl GravityModel {
     pub fn validate(&self, dof: usize) -> Result<()> {
         for (name, v, range) in [
             (
-                "--compliance",
+                "gravity.compliance_rad_per_nm",
                 &self.compliance_rad_per_nm,
                 &crate::ranges::COMPLIANCE,
             ),
             (
-                "--link-masses-kg",
+                "gravity.link_masses_kg",
                 &self.link_masses_kg,
                 &crate::ranges::MASS,
             ),
@@ -102,18 +102,21 @@ impl GravityModel {
         }
         if !self.payload_kg.is_finite() || self.payload_kg < 0.0 {
             return Err(Error::invalid(
-                "--payload-kg",
+                "gravity.payload_kg",
                 format!("{} must be a finite number >= 0", self.payload_kg),
             ));
         }
-        crate::ranges::in_range("--payload-kg", self.payload_kg, &crate::ranges::MASS)?;
+        crate::ranges::in_range("gravity.payload_kg", self.payload_kg, &crate::ranges::MASS)?;
         if self.gravity_m_s2.iter().any(|g| !g.is_finite()) {
-            return Err(Error::invalid("gravity", "not a finite vector"));
+            return Err(Error::invalid(
+                "gravity.gravity_m_s2",
+                "not a finite vector",
+            ));
         }
         if self.payload_kg == 0.0 && self.link_masses_kg.iter().all(|m| *m == 0.0) {
             return Err(Error::invalid(
-                "--payload-kg",
-                "gravity deflection needs a mass: give --payload-kg and/or --link-masses-kg",
+                "gravity.payload_kg",
+                "gravity deflection needs a mass: give `gravity.payload_kg` and/or `gravity.link_masses_kg`",
             ));
         }
         Ok(())

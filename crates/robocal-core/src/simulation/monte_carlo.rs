@@ -6,6 +6,7 @@ use super::session::{simulate, Simulation};
 use super::truth::TruthSpec;
 use crate::error::Result;
 use crate::model::Robot;
+use crate::progress::{Observer, Stage};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -17,14 +18,9 @@ pub fn trial_seed(base: u64, trial: usize) -> u64 {
 
 /// Runs `f(trial, seed)` for `trials` trials in parallel and returns the results in trial
 /// order. Each trial gets its own seed ([`trial_seed`]) and must draw all its randomness from
-/// it; the results then do not depend on the thread count or scheduling. `progress(done, total)`
-/// is called (from worker threads) as trials finish.
-pub fn run_trials<T, F>(
-    trials: usize,
-    base_seed: u64,
-    progress: Option<&(dyn Fn(usize, usize) + Sync)>,
-    f: F,
-) -> Vec<T>
+/// it; the results then do not depend on the thread count or scheduling. `observer`
+/// hears [`Stage::Trials`] (from worker threads) as trials finish.
+pub fn run_trials<T, F>(trials: usize, base_seed: u64, observer: &dyn Observer, f: F) -> Vec<T>
 where
     T: Send,
     F: Fn(usize, u64) -> T + Sync,
@@ -35,9 +31,7 @@ where
         .map(|i| {
             let r = f(i, trial_seed(base_seed, i));
             let d = done.fetch_add(1, Ordering::Relaxed) + 1;
-            if let Some(p) = progress {
-                p(d, trials);
-            }
+            observer.progress(Stage::Trials, d, trials);
             r
         })
         .collect()
@@ -51,14 +45,14 @@ pub fn simulate_trials(
     truth: &TruthSpec,
     config: &SimulationConfig,
     trials: usize,
-    progress: Option<&(dyn Fn(usize, usize) + Sync)>,
+    observer: &dyn Observer,
 ) -> Result<Vec<Simulation>> {
-    run_trials(trials, config.seed, progress, |_, seed| {
+    run_trials(trials, config.seed, observer, |_, seed| {
         let cfg = SimulationConfig {
             seed,
             ..config.clone()
         };
-        simulate(nominal, truth, &cfg, &mut |_, _| {})
+        simulate(nominal, truth, &cfg, &())
     })
     .into_iter()
     .collect()

@@ -47,13 +47,13 @@ impl OutlierModel {
     pub fn validate(&self) -> Result<()> {
         if !self.fraction.is_finite() || !(0.0..=1.0).contains(&self.fraction) {
             return Err(Error::invalid(
-                "--outlier-fraction",
+                "outliers.fraction",
                 format!("{} is not a fraction in [0, 1]", self.fraction),
             ));
         }
         for (name, v) in [
-            ("--outlier-min-mm", self.min_mm),
-            ("--outlier-max-mm", self.max_mm),
+            ("outliers.min_mm", self.min_mm),
+            ("outliers.max_mm", self.max_mm),
         ] {
             if !v.is_finite() || v < 0.0 {
                 return Err(Error::invalid(
@@ -65,9 +65,9 @@ impl OutlierModel {
         }
         if self.min_mm > self.max_mm {
             return Err(Error::invalid(
-                "--outlier-min-mm",
+                "outliers.min_mm",
                 format!(
-                    "{} is greater than --outlier-max-mm {}",
+                    "{} is greater than `outliers.max_mm` {}",
                     self.min_mm, self.max_mm
                 ),
             ));
@@ -135,7 +135,7 @@ mod tests {
                 ..OutlierModel::default()
             };
             let e = m.validate().unwrap_err().to_string();
-            assert!(e.contains("--outlier-fraction"), "{e}");
+            assert!(e.contains("outliers.fraction"), "{e}");
         }
         let m = OutlierModel {
             fraction: 0.1,

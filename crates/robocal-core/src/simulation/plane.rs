@@ -133,11 +133,11 @@ pub fn plane_poses<R: Rng + ?Sized>(
 ) -> Result<(Vec<Vec<f64>>, f64)> {
     if let Some(z) = plane_z_mm {
         if !z.is_finite() {
-            return Err(Error::invalid("--plane-z-mm", "not a finite number"));
+            return Err(Error::invalid("plane_z_mm", "not a finite number"));
         }
         if z < sampler.floor_z_mm {
             return Err(Error::invalid(
-                "--plane-z-mm",
+                "plane_z_mm",
                 format!("{z} mm is below the floor ({} mm)", sampler.floor_z_mm),
             ));
         }
@@ -178,8 +178,8 @@ pub fn plane_poses<R: Rng + ?Sized>(
         "plane points",
         format!(
             "found no three poses with the tool at z = {z:.1} mm, {radius:.1} mm from the base \
-             axis, 120 degrees apart, within the joint limits; choose another --plane-z-mm or \
-             use --no-plane"
+             axis, 120 degrees apart, within the joint limits; choose another `plane_z_mm` or \
+             leave the plane points out (`plane_points`)"
         ),
     ))
 }

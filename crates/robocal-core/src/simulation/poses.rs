@@ -43,7 +43,7 @@ pub fn random_poses<R: Rng + ?Sized>(
     rng: &mut R,
 ) -> Result<Vec<Vec<f64>>> {
     if n == 0 {
-        return Err(Error::invalid("--poses", "must be at least 1"));
+        return Err(Error::invalid("poses", "must be at least 1"));
     }
     let mut out = Vec::with_capacity(n);
     let mut q = vec![0.0; robot.dof()];

@@ -11,6 +11,7 @@ use crate::io::measurements::{Measurement, MeasurementSet};
 use crate::io::result::RobotInfo;
 use crate::io::SetLabel;
 use crate::model::Robot;
+use crate::progress::{Observer, Stage};
 use crate::stats::ErrorStats;
 use indexmap::IndexMap;
 use std::path::{Path, PathBuf};
@@ -74,7 +75,7 @@ fn chunked(
     n: usize,
     done: &mut usize,
     total: usize,
-    progress: &mut dyn FnMut(usize, usize),
+    observer: &dyn Observer,
     mut draw: impl FnMut(usize) -> Result<Vec<Vec<f64>>>,
 ) -> Result<Vec<Vec<f64>>> {
     let mut out = Vec::with_capacity(n);
@@ -82,7 +83,7 @@ fn chunked(
         let k = CHUNK.min(n - out.len());
         out.extend(draw(k)?);
         *done += k;
-        progress(*done, total);
+        observer.progress(Stage::Measurement, *done, total);
     }
     Ok(out)
 }
@@ -90,15 +91,15 @@ fn chunked(
 /// Simulates a measurement session with random poses: the three plane points (if
 /// `config.plane_points`), `config.poses` calibration points and `config.validation_poses`
 /// validation points, measured in that order in the cell of `nominal`, `truth` and `config`.
-/// `progress(done, total)` is called as poses are drawn and measured.
+/// `observer` hears [`Stage::Measurement`] as poses are drawn and measured (readings of all).
 pub fn simulate(
     nominal: &Robot,
     truth: &TruthSpec,
     config: &SimulationConfig,
-    progress: &mut dyn FnMut(usize, usize),
+    observer: &dyn Observer,
 ) -> Result<Simulation> {
     if config.poses == 0 {
-        return Err(Error::invalid("--poses", "must be at least 1"));
+        return Err(Error::invalid("poses", "must be at least 1"));
     }
     let mut cell = VirtualCell::from_config(nominal, truth, config)?;
     let n_plane = if config.plane_points { 3 } else { 0 };
@@ -107,16 +108,16 @@ pub fn simulate(
     let (plane, plane_z) = if config.plane_points {
         let (q, z) = cell.plane_poses()?;
         done += 3;
-        progress(done, total);
+        observer.progress(Stage::Measurement, done, total);
         (q, Some(z))
     } else {
         (Vec::new(), None)
     };
-    let cal = chunked(config.poses, &mut done, total, progress, |k| {
+    let cal = chunked(config.poses, &mut done, total, observer, |k| {
         cell.random_poses(k)
     })?;
     let val = if config.validation_poses > 0 {
-        chunked(config.validation_poses, &mut done, total, progress, |k| {
+        chunked(config.validation_poses, &mut done, total, observer, |k| {
             cell.validation_poses(k)
         })?
     } else {
@@ -126,7 +127,7 @@ pub fn simulate(
     all.extend(plane.iter().cloned());
     all.extend(cal.iter().cloned());
     all.extend(val.iter().cloned());
-    let readings = measure(&mut cell, &all, &mut done, total, progress)?;
+    let readings = measure(&mut cell, &all, &mut done, total, observer)?;
     let pts = &readings.points;
     let (a, b) = (plane.len(), plane.len() + cal.len());
     let mut rows = Vec::with_capacity(all.len());
@@ -162,7 +163,7 @@ pub fn simulate_joints(
     truth: &TruthSpec,
     config: &SimulationConfig,
     joints: &MeasurementSet,
-    progress: &mut dyn FnMut(usize, usize),
+    observer: &dyn Observer,
 ) -> Result<Simulation> {
     if joints.dof() != nominal.dof() {
         return Err(Error::JointCount {
@@ -193,7 +194,7 @@ pub fn simulate_joints(
     let qs: Vec<Vec<f64>> = joints.rows.iter().map(|r| r.q.clone()).collect();
     let mut done = qs.len();
     let total = 2 * qs.len();
-    let readings = measure(&mut cell, &qs, &mut done, total, progress)?;
+    let readings = measure(&mut cell, &qs, &mut done, total, observer)?;
     let rows = joints
         .rows
         .iter()
@@ -231,11 +232,11 @@ fn measure(
     qs: &[Vec<f64>],
     done: &mut usize,
     total: usize,
-    progress: &mut dyn FnMut(usize, usize),
+    observer: &dyn Observer,
 ) -> Result<Readings> {
     let r = cell.measure(qs)?;
     *done += qs.len();
-    progress(*done, total);
+    observer.progress(Stage::Measurement, *done, total);
     Ok(r)
 }
 

@@ -15,12 +15,8 @@ fn table3() -> TruthSpec {
     TruthSpec::Robot(preset("kuka-kr480-r3330-table3").unwrap())
 }
 
-fn quiet() -> impl FnMut(usize, usize) {
-    |_, _| {}
-}
-
 fn run(truth: &TruthSpec, cfg: &SimulationConfig) -> Simulation {
-    simulate(&kr480(), truth, cfg, &mut quiet()).unwrap()
+    simulate(&kr480(), truth, cfg, &()).unwrap()
 }
 
 fn points(s: &Simulation) -> Vec<Vector3<f64>> {
@@ -330,14 +326,7 @@ fn joints_are_measured_in_order_with_their_columns() {
         noise_per_m: 0.0,
         ..SimulationConfig::default()
     };
-    let s = simulate_joints(
-        &r,
-        &TruthSpec::Robot(r.clone()),
-        &cfg,
-        &joints,
-        &mut quiet(),
-    )
-    .unwrap();
+    let s = simulate_joints(&r, &TruthSpec::Robot(r.clone()), &cfg, &joints, &()).unwrap();
     assert_eq!(s.measurements.extra_columns, ["name"]);
     let f = cfg.tracker_frame.to_tracker_frame();
     for (a, b) in joints.rows.iter().zip(&s.measurements.rows) {
@@ -353,7 +342,7 @@ fn joints_are_measured_in_order_with_their_columns() {
 fn bad_settings_are_rejected() {
     let nominal = kr480();
     let err = |truth: &TruthSpec, cfg: SimulationConfig| {
-        simulate(&nominal, truth, &cfg, &mut quiet())
+        simulate(&nominal, truth, &cfg, &())
             .unwrap_err()
             .to_string()
     };
@@ -366,7 +355,7 @@ fn bad_settings_are_rejected() {
             ..d()
         },
     );
-    assert!(e.contains("--noise-mm"), "{e}");
+    assert!(e.contains("noise_mm"), "{e}");
     let e = err(
         &t,
         SimulationConfig {
@@ -374,9 +363,9 @@ fn bad_settings_are_rejected() {
             ..d()
         },
     );
-    assert!(e.contains("--noise-per-m"), "{e}");
+    assert!(e.contains("noise_per_m"), "{e}");
     let e = err(&t, SimulationConfig { poses: 0, ..d() });
-    assert!(e.contains("--poses"), "{e}");
+    assert!(e.contains("poses"), "{e}");
     let e = err(
         &t,
         SimulationConfig {
@@ -387,7 +376,7 @@ fn bad_settings_are_rejected() {
             ..d()
         },
     );
-    assert!(e.contains("--outlier-fraction"), "{e}");
+    assert!(e.contains("outliers.fraction"), "{e}");
     let e = err(
         &t,
         SimulationConfig {
@@ -403,7 +392,7 @@ fn bad_settings_are_rejected() {
         }),
         d(),
     );
-    assert!(e.contains("--angle-error-deg"), "{e}");
+    assert!(e.contains("truth.angle_sigma_deg"), "{e}");
     let three = crate::model::robot_file::parse_robot_toml(
         "convention = \"mdh\"\n[[joints]]\nalpha = 0\nd = 0\na = 100\n\
          [[joints]]\nalpha = 0\nd = 0\na = 100\n[[joints]]\nalpha = 0\nd = 0\na = 100\n",
@@ -430,11 +419,23 @@ fn monte_carlo_is_reproducible_across_thread_counts() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| simulate_trials(&nominal, &truth, &cfg, 6, None).unwrap())
+            .install(|| simulate_trials(&nominal, &truth, &cfg, 6, &()).unwrap())
     };
     let one = go(1);
     let two = go(2);
     assert_eq!(one.len(), 6);
+    // The observer hears every trial, from the worker threads.
+    let seen = std::sync::atomic::AtomicUsize::new(0);
+    let observer = |s: crate::Stage, done: usize, total: usize| {
+        assert_eq!((s, total), (crate::Stage::Trials, 6));
+        seen.fetch_max(done, std::sync::atomic::Ordering::Relaxed);
+    };
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap()
+        .install(|| simulate_trials(&nominal, &truth, &cfg, 6, &observer).unwrap());
+    assert_eq!(seen.into_inner(), 6);
     for (i, (a, b)) in one.iter().zip(&two).enumerate() {
         assert_eq!(a.measurements, b.measurements);
         assert_eq!(a.cell.seed(), trial_seed(100, i));

@@ -25,10 +25,7 @@ pub struct Tracker {
 impl Tracker {
     /// A tracker at `frame` with the given noise; rejects negative or non-finite sigmas.
     pub fn new(frame: TrackerFrame, sigma_fixed_mm: f64, sigma_per_m: f64) -> Result<Tracker> {
-        for (name, v) in [
-            ("--noise-mm", sigma_fixed_mm),
-            ("--noise-per-m", sigma_per_m),
-        ] {
+        for (name, v) in [("noise_mm", sigma_fixed_mm), ("noise_per_m", sigma_per_m)] {
             if !v.is_finite() || v < 0.0 {
                 return Err(Error::invalid(
                     name,

@@ -41,12 +41,12 @@ impl GeometricErrors {
     pub fn validate(&self) -> Result<()> {
         for (name, v, range) in [
             (
-                "--length-error-mm",
+                "truth.length_sigma_mm",
                 self.length_sigma_mm,
                 &crate::ranges::SIZE_MM,
             ),
             (
-                "--angle-error-deg",
+                "truth.angle_sigma_deg",
                 self.angle_sigma_deg,
                 &crate::ranges::SIZE_DEG,
             ),
@@ -109,7 +109,7 @@ impl TruthSpec {
 pub fn check_truth_matches(nominal: &Robot, truth: &Robot) -> Result<()> {
     if truth.dof() != nominal.dof() {
         return Err(Error::invalid(
-            "--truth",
+            "truth",
             format!(
                 "truth robot `{}` has {} joints, the nominal robot `{}` has {}",
                 truth.name(),
@@ -121,7 +121,7 @@ pub fn check_truth_matches(nominal: &Robot, truth: &Robot) -> Result<()> {
     }
     if truth.convention() != nominal.convention() {
         return Err(Error::invalid(
-            "--truth",
+            "truth",
             format!(
                 "truth robot `{}` uses {} parameters, the nominal robot `{}` uses {}",
                 truth.name(),
@@ -140,7 +140,7 @@ pub fn check_truth_matches(nominal: &Robot, truth: &Robot) -> Result<()> {
                 .join(", ")
         };
         return Err(Error::invalid(
-            "--truth",
+            "truth",
             format!(
                 "truth robot `{}` has joints {}, the nominal robot `{}` has {}",
                 truth.name(),
@@ -225,7 +225,7 @@ mod tests {
             ..GeometricErrors::default()
         };
         let msg = e.validate().unwrap_err().to_string();
-        assert!(msg.contains("--length-error-mm"), "{msg}");
+        assert!(msg.contains("truth.length_sigma_mm"), "{msg}");
         let kr = preset("kuka-kr480-r3330").unwrap();
         let ur5 = crate::model::robot_file::parse_robot_toml(
             "convention = \"mdh\"\n[[joints]]\nalpha = 0\nd = 0\na = 0\n",

@@ -151,7 +151,7 @@ impl TruthFile {
                     &format!("parameters.{name}.nominal"),
                     format!(
                         "the truth file was made for a nominal robot (`{}`) with {name} = {} {}, \
-                         but robot `{}` has {mine} {}: wrong --robot or wrong truth file",
+                         but robot `{}` has {mine} {}: wrong nominal robot or wrong truth file",
                         self.nominal,
                         e.nominal,
                         e.unit.as_str(),
@@ -215,7 +215,7 @@ mod tests {
             plane_points: false,
             ..SimulationConfig::default()
         };
-        simulate(&nominal, &truth, &cfg, &mut |_, _| {})
+        simulate(&nominal, &truth, &cfg, &())
             .unwrap()
             .truth_file(&[])
     }

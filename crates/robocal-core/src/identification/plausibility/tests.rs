@@ -113,7 +113,7 @@ fn fit_with(
             validation: val,
         },
         s,
-        &mut |_, _, _| {},
+        &(),
     )
     .unwrap()
 }
@@ -409,7 +409,7 @@ fn an_implausible_fit_is_marked_in_the_result_and_read_back_as_such() {
 #[test]
 fn the_gate_passes_the_demo_for_seeds_1_to_30() {
     for seed in 1..=30 {
-        let e = run_experiment(ExperimentConfig::paper(seed).unwrap(), &mut |_, _, _| {})
+        let e = run_experiment(ExperimentConfig::paper(seed).unwrap(), &())
             .unwrap_or_else(|err| panic!("seed {seed}: {err}"));
         let p = &e.calibration.plausibility;
         assert!(p.passed(), "seed {seed}: {}", p.summary());

@@ -1,0 +1,125 @@
+//! The one table from the library's setting names to this program's flags.
+//!
+//! `robocal-core` never names a command-line flag: its errors name the setting (the field of its
+//! settings struct, e.g. `noise_mm` or `gravity.payload_kg`), as the `field` of an
+//! [`robocal_core::Error::Invalid`] or in backticks inside a message (`` `outliers.max_mm` ``).
+//! When the program reports an error ([`crate::exit::message`]) it shows the flag the user typed
+//! instead, through [`cli_text`].
+
+/// Library setting -> the flag that sets it.
+const FLAGS: &[(&str, &str)] = &[
+    // simulation::SimulationConfig
+    ("noise_mm", "--noise-mm"),
+    ("noise_per_m", "--noise-per-m"),
+    ("tracker_frame", "--tracker"),
+    ("floor_z_mm", "--floor-mm"),
+    ("footprint_radius_mm", "--footprint-mm"),
+    ("plane_z_mm", "--plane-z-mm"),
+    ("plane_points", "--no-plane"),
+    ("poses", "--poses"),
+    ("truth", "--truth"),
+    ("truth.length_sigma_mm", "--length-error-mm"),
+    ("truth.angle_sigma_deg", "--angle-error-deg"),
+    ("gravity.compliance_rad_per_nm", "--compliance"),
+    ("gravity.link_masses_kg", "--link-masses-kg"),
+    ("gravity.payload_kg", "--payload-kg"),
+    ("outliers.fraction", "--outlier-fraction"),
+    ("outliers.min_mm", "--outlier-min-mm"),
+    ("outliers.max_mm", "--outlier-max-mm"),
+    // identification::CalibrationSettings
+    ("identifiability.fix", "--fix"),
+    ("identifiability.free", "--free"),
+    ("identifiability.rank_tolerance", "--rank-tol"),
+    ("robust_scale_mm", "--robust-scale"),
+    // compensation::DampedLeastSquares
+    ("tolerance_mm", "--tolerance-mm"),
+    ("max_iterations", "--max-iterations"),
+];
+
+/// The flag that sets a library setting, if there is one.
+pub fn flag_for(setting: &str) -> Option<&'static str> {
+    FLAGS.iter().find(|(s, _)| *s == setting).map(|(_, f)| *f)
+}
+
+/// Phrases the library uses for a setting that is no field of its settings structs, and the flag
+/// that sets it.
+const PHRASES: &[(&str, &str)] = &[("wrong nominal robot", "wrong --robot")];
+
+/// `text` with every setting named in backticks (`` `noise_mm` ``) replaced by its flag.
+pub fn with_flags(text: &str) -> String {
+    let mut out = text.to_owned();
+    for (setting, flag) in FLAGS {
+        let quoted = format!("`{setting}`");
+        if out.contains(&quoted) {
+            out = out.replace(&quoted, flag);
+        }
+    }
+    out
+}
+
+/// The text of one error as the user of this program should read it. A library error about
+/// settings ([`robocal_core::Error::Invalid`], `Numerical`, `Implausible`) names the flags: the
+/// field (`--noise-mm: ...` for `noise_mm: ...`) and the settings in backticks in its message.
+/// Other library errors only get [`PHRASES`] replaced: their backticks quote the fields of files
+/// (`missing field `tracker_frame``), which must stay as they are; and the program's own errors
+/// already speak of flags.
+pub fn cli_text(e: &(dyn std::error::Error + 'static)) -> String {
+    use robocal_core::Error as E;
+    let Some(core) = e.downcast_ref::<E>() else {
+        return e.to_string();
+    };
+    let text = match core {
+        E::Invalid { field, message } => match flag_for(field) {
+            Some(flag) => format!("{flag}: {}", with_flags(message)),
+            None => format!("{field}: {}", with_flags(message)),
+        },
+        E::Numerical(m) | E::Implausible(m) => with_flags(m),
+        other => other.to_string(),
+    };
+    PHRASES
+        .iter()
+        .fold(text, |t, (phrase, flag)| t.replace(phrase, flag))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn setting_errors_name_the_flag() {
+        let e = robocal_core::Error::invalid("noise_mm", "-1 mm is out of range");
+        assert_eq!(cli_text(&e), "--noise-mm: -1 mm is out of range");
+        let e = robocal_core::Error::invalid(
+            "outliers.min_mm",
+            "5 is greater than `outliers.max_mm` 2",
+        );
+        assert_eq!(
+            cli_text(&e),
+            "--outlier-min-mm: 5 is greater than --outlier-max-mm 2"
+        );
+        // Fields that are not settings, and words that only look like one, stay.
+        let e = robocal_core::Error::invalid("calibration data", "no robot points");
+        assert_eq!(cli_text(&e), "calibration data: no robot points");
+        assert_eq!(with_flags("robot `kr` and `d2`"), "robot `kr` and `d2`");
+        assert_eq!(
+            with_flags(
+                "choose another `plane_z_mm` or leave the plane points out (`plane_points`)"
+            ),
+            "choose another --plane-z-mm or leave the plane points out (--no-plane)"
+        );
+        // A file's fields keep their names, even where a setting has the same one.
+        let e =
+            robocal_core::Error::parse("r.json", Some(3), None, "missing field `tracker_frame`");
+        assert_eq!(cli_text(&e), "r.json:3: missing field `tracker_frame`");
+        let e = robocal_core::Error::parse("r.json", None, None, "wrong nominal robot or file");
+        assert_eq!(cli_text(&e), "r.json: wrong --robot or file");
+    }
+
+    #[test]
+    fn every_setting_and_flag_is_listed_once() {
+        for (i, (s, f)) in FLAGS.iter().enumerate() {
+            assert!(f.starts_with("--") && !s.contains("--"), "{s} {f}");
+            assert!(FLAGS[..i].iter().all(|(t, _)| t != s), "{s} twice");
+        }
+    }
+}
