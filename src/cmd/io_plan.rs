@@ -102,6 +102,14 @@ impl IoPlan {
         self
     }
 
+    /// An optional robot argument.
+    pub fn robot_opt(&mut self, flag: &str, arg: Option<&str>) -> &mut Self {
+        if let Some(a) = arg {
+            self.robot(flag, a);
+        }
+        self
+    }
+
     /// The files a calibration result records (its measurement files and robot file, as
     /// `robocal calibrate` was given them), which later commands read by default: they are
     /// protected like inputs. A result that cannot be read records nothing here (reading it

@@ -30,7 +30,7 @@ pub fn run(c: RobotCmd) -> anyhow::Result<()> {
             Ok(())
         }
         RobotCmd::Show(a) => {
-            let m = common::model(&a.robot, a.params.as_deref())?;
+            let m = common::model(Some(&a.robot), a.params.as_deref())?;
             if let (Some((_, res)), Some(p)) = (&m.calibrated, &a.params) {
                 common::warn_not_calibrated(res, p);
             }

@@ -42,12 +42,7 @@ pub fn tracker(noise: bool) -> Tracker {
 pub fn result_for(nominal: &Robot, calibrated: &Robot, frame: &Frame) -> CalibrationResult {
     let s = ErrorStats::from_norms(&[1.0, 2.0]);
     CalibrationResult {
-        robot: RobotInfo {
-            name: nominal.name().into(),
-            dof: nominal.dof(),
-            convention: nominal.convention().as_str().into(),
-            joint_types: nominal.joint_types().to_vec(),
-        },
+        robot: RobotInfo::of(nominal),
         parameters: CalibrationResult::parameter_entries(nominal, calibrated),
         tracker_frame: FrameVec::from_frame(frame),
         errors: ErrorTables {

@@ -269,10 +269,8 @@ fn results_of_another_robot_are_rejected() {
     let table3 = preset("kuka-kr480-r3330-table3").unwrap();
     let result = |n: &Robot, c: &Robot| CalibrationResult {
         robot: crate::io::result::RobotInfo {
-            name: n.name().into(),
-            dof: n.dof(),
-            convention: n.convention().as_str().into(),
             joint_types: vec![],
+            ..crate::io::result::RobotInfo::shape_of(n)
         },
         parameters: CalibrationResult::parameter_entries(n, c),
         tracker_frame: crate::io::result::FrameVec::from_frame(&Frame::identity()),

@@ -10,6 +10,7 @@
 //! `sin_cos` per joint; every mutation goes through [`Robot::set`] which keeps the cache valid.
 
 pub mod controller;
+pub mod description;
 mod joints;
 mod params;
 pub mod presets;
