@@ -15,7 +15,7 @@ use robocal_core::identification::{
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::{read_measurements, Positions};
 use robocal_core::{ErrorStats, Param, Robot};
-use serde_json::json;
+use robocal_core::io::result_sections::RowsOutside;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -343,21 +343,23 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
              {rank_tolerance:e} given explicitly)"
         );
     }
-    let mut extra = serde_json::Map::new();
-    extra.insert("robot_arg".into(), json!(a.robot));
-    extra.insert("data".into(), json!(a.data.display().to_string()));
-    if let Some(v) = &a.validate {
-        extra.insert("validate".into(), json!(v.display().to_string()));
+    let mut res = cal.to_result();
+    if let Some(s) = &mut res.settings {
+        s.robot_arg = Some(a.robot.clone());
+        s.data = Some(a.data.display().to_string());
+        s.validate = a.validate.as_ref().map(|v| v.display().to_string());
+        s.nominal_limits = Some(a.nominal_limits);
+        s.rows_outside_limits = (!outside.is_empty()).then(|| {
+            outside
+                .iter()
+                .map(|o| RowsOutside {
+                    file: o.path().display().to_string(),
+                    rows: o.count(),
+                    lines: o.lines().to_vec(),
+                })
+                .collect()
+        });
     }
-    extra.insert("nominal_limits".into(), json!(a.nominal_limits));
-    if !outside.is_empty() {
-        let rows: Vec<_> = outside
-            .iter()
-            .map(|o| json!({"file": o.path().display().to_string(), "rows": o.count(), "lines": o.lines()}))
-            .collect();
-        extra.insert("rows_outside_limits".into(), json!(rows));
-    }
-    let mut res = cal.to_result(extra);
     let failed_gate = if implausible {
         format!(
             "\nThe fit also FAILED the plausibility gate:\n{}",
@@ -407,7 +409,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         a.max_iterations
     );
     if a.keep_partial {
-        res.extra.insert("partial_reason".into(), json!(why));
+        res.partial_reason = Some(why.clone());
         res.write(&a.out)?;
         Err(exit::numerical(format!(
             "{why}: the parameters above are a partial result, not a calibration; written to {} \

@@ -6,6 +6,7 @@ use super::io_plan::IoPlan;
 use crate::exit;
 use anyhow::Context;
 use clap::Args;
+use robocal_core::io::result_sections::Settings;
 use robocal_core::io::{read_measurements, CalibrationResult, MeasurementSet, Positions};
 use robocal_core::JointSpace;
 use robocal_report::{write_report, ReportData, RunData, HISTOGRAM_FILE, HTML_FILE};
@@ -41,16 +42,17 @@ pub struct ReportArgs {
     out: PathBuf,
 }
 
-/// A string setting recorded in the result by `robocal calibrate`.
-fn recorded<'a>(result: &'a CalibrationResult, key: &str) -> Option<&'a str> {
-    result.extra.get("settings")?.get(key)?.as_str()
+/// A file setting recorded in the result by `robocal calibrate` (`robot_arg`, `data`,
+/// `validate`).
+fn recorded(result: &CalibrationResult, key: fn(&Settings) -> &Option<String>) -> Option<&str> {
+    result.settings.as_ref().and_then(|s| key(s).as_deref())
 }
 
 /// The file given, or the one the result recorded if it still exists (with a note if not).
 fn file_arg(
     given: &Option<PathBuf>,
     result: &CalibrationResult,
-    key: &str,
+    key: fn(&Settings) -> &Option<String>,
     flag: &str,
 ) -> Option<PathBuf> {
     if let Some(p) = given {
@@ -103,7 +105,7 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
     let recorded_robot = if a.robot.is_some() || !result.robot.joints.is_empty() {
         None
     } else {
-        match recorded(&result, "robot_arg") {
+        match recorded(&result, |s| &s.robot_arg) {
             Some(r) => Some(r.to_owned()),
             None => {
                 return Err(exit::usage(format!(
@@ -127,8 +129,8 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         })?;
     super::common::warn_not_calibrated(&result, &a.result);
     let joints = nominal.joint_space();
-    let data_path = file_arg(&a.data, &result, "data", "--data");
-    let val_path = file_arg(&a.validate, &result, "validate", "--validate");
+    let data_path = file_arg(&a.data, &result, |s| &s.data, "--data");
+    let val_path = file_arg(&a.validate, &result, |s| &s.validate, "--validate");
     let data = read(&data_path, joints, "--data")?;
     let validation = read(&val_path, joints, "--validate")?;
     let verification = read(&a.verify, joints, "--verify")?;

@@ -6,6 +6,10 @@
 
 use crate::error::{Error, Result};
 use crate::frame::{self, Frame};
+use crate::io::result_sections::{
+    sorted_opt, DownweightedEntry, Identifiability, PlausibilitySection, Points, Registration,
+    Settings, Solver, Uncertainty,
+};
 use crate::model::description::{ControllerDescription, JointDescription, RobotDescription};
 use crate::model::{Convention, JointType, Param, Robot, Unit};
 use crate::stats::ErrorStats;
@@ -313,9 +317,108 @@ pub struct CalibrationResult {
     pub tracker_frame: FrameVec,
     /// Error tables.
     pub errors: ErrorTables,
-    /// Any further keys (identifiability, solver report, settings, ...).
+    /// Points the robust loss down-weighted.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub downweighted_points: Option<Vec<DownweightedEntry>>,
+    /// Which parameters the data identify.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub identifiability: Option<Identifiability>,
+    /// Why the fit failed the plausibility gate (with `status` implausible).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub implausible_reason: Option<String>,
+    /// Why the result is partial (with `status` partial).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub partial_reason: Option<String>,
+    /// The plausibility gate's checks.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub plausibility: Option<PlausibilitySection>,
+    /// Per-point errors.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub points: Option<Points>,
+    /// The measurement frame fit.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub registration: Option<Registration>,
+    /// How the calibration was run.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub settings: Option<Settings>,
+    /// How the identification ended.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub solver: Option<Solver>,
+    /// Whether the result is a calibration; required on reading ([`KNOWN_STATUSES`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub status: Option<StatusValue>,
+    /// The estimates' covariance.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub uncertainty: Option<Uncertainty>,
+    /// Any further keys (from a newer robocal, or another tool).
     #[serde(flatten)]
     pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+/// What a result can be: its `status`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// [`STATUS_CALIBRATED`].
+    Calibrated,
+    /// [`STATUS_PARTIAL`].
+    Partial,
+    /// [`STATUS_IMPLAUSIBLE`].
+    Implausible,
+}
+
+impl Status {
+    /// The JSON value: one of [`KNOWN_STATUSES`].
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Calibrated => STATUS_CALIBRATED,
+            Status::Partial => STATUS_PARTIAL,
+            Status::Implausible => STATUS_IMPLAUSIBLE,
+        }
+    }
+}
+
+/// A `status` as read: one robocal writes, or anything else (refused by
+/// [`CalibrationResult::parse`] with a message naming it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum StatusValue {
+    /// A status robocal writes.
+    Known(Status),
+    /// Any other JSON value.
+    Other(serde_json::Value),
 }
 
 impl CalibrationResult {
@@ -331,7 +434,7 @@ impl CalibrationResult {
     pub fn parse(text: &str, path: &Path) -> Result<CalibrationResult> {
         let r: CalibrationResult = crate::io::input::parse_json(text, path, "robocal result")?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        check_status(r.extra.get("status"), text, path)?;
+        check_status(r.status.as_ref(), text, path)?;
         check_parameters(&r.parameters, text, path)?;
         check_frame(&r.tracker_frame, "tracker_frame", text, path)?;
         r.robot.nominal_robot(path, Some(text))?;
@@ -371,23 +474,13 @@ impl CalibrationResult {
     /// converge (`solver.converged` = false). `None` for a calibration, and for files without
     /// these keys.
     pub fn partial_reason(&self) -> Option<String> {
-        let status = self.extra.get("status").and_then(|s| s.as_str());
-        let converged = self
-            .extra
-            .get("solver")
-            .and_then(|s| s.get("converged"))
-            .and_then(|c| c.as_bool());
-        if status != Some(STATUS_PARTIAL) && converged != Some(false) {
+        let converged = self.solver.as_ref().map(|s| s.converged);
+        if self.status() != Some(Status::Partial) && converged != Some(false) {
             return None;
         }
-        let reason = self.extra.get("partial_reason").and_then(|r| r.as_str());
-        let termination = self
-            .extra
-            .get("solver")
-            .and_then(|s| s.get("termination"))
-            .and_then(|t| t.as_str());
-        Some(match (reason, converged, termination) {
-            (Some(r), _, _) => r.to_owned(),
+        let termination = self.solver.as_ref().map(|s| s.termination.as_str());
+        Some(match (&self.partial_reason, converged, termination) {
+            (Some(r), _, _) => r.clone(),
             (None, Some(false), Some(t)) => format!("the solver {t}"),
             (None, Some(false), None) => "the solver did not converge".to_owned(),
             _ => format!("marked \"status\": \"{STATUS_PARTIAL}\""),
@@ -398,19 +491,50 @@ impl CalibrationResult {
     /// [`STATUS_IMPLAUSIBLE`] (`calibrate` wrote it on explicit request); `implausible_reason`
     /// lists the failed checks.
     pub fn implausible_reason(&self) -> Option<String> {
-        let status = self.extra.get("status").and_then(|s| s.as_str());
-        if status != Some(STATUS_IMPLAUSIBLE) {
+        if self.status() != Some(Status::Implausible) {
             return None;
         }
         Some(
-            self.extra
-                .get("implausible_reason")
-                .and_then(|r| r.as_str())
-                .map_or_else(
-                    || "it failed the plausibility gate".to_owned(),
-                    |r| r.to_owned(),
-                ),
+            self.implausible_reason
+                .clone()
+                .unwrap_or_else(|| "it failed the plausibility gate".to_owned()),
         )
+    }
+
+    /// The `status`, when it is one robocal writes.
+    pub fn status(&self) -> Option<Status> {
+        match self.status {
+            Some(StatusValue::Known(s)) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// A result of the contract keys alone (no further sections), with `status`.
+    pub fn new(
+        robot: RobotInfo,
+        parameters: IndexMap<String, ParamEntry>,
+        tracker_frame: FrameVec,
+        errors: ErrorTables,
+        status: Status,
+    ) -> CalibrationResult {
+        CalibrationResult {
+            robot,
+            parameters,
+            tracker_frame,
+            errors,
+            downweighted_points: None,
+            identifiability: None,
+            implausible_reason: None,
+            partial_reason: None,
+            plausibility: None,
+            points: None,
+            registration: None,
+            settings: None,
+            solver: None,
+            status: Some(StatusValue::Known(status)),
+            uncertainty: None,
+            extra: serde_json::Map::new(),
+        }
     }
 
     /// Why this result is not a calibration to use, if it is not: partial
@@ -588,10 +712,10 @@ pub(crate) fn check_frame(f: &FrameVec, field: &str, text: &str, path: &Path) ->
 }
 
 /// Checks a result's `status`: present, and one robocal writes.
-fn check_status(status: Option<&serde_json::Value>, text: &str, path: &Path) -> Result<()> {
+fn check_status(status: Option<&StatusValue>, text: &str, path: &Path) -> Result<()> {
     let known = KNOWN_STATUSES.join(", ");
     let msg = match status {
-        Some(serde_json::Value::String(s)) if KNOWN_STATUSES.contains(&s.as_str()) => return Ok(()),
+        Some(StatusValue::Known(_)) => return Ok(()),
         None => {
             return Err(Error::parse(
                 path,
@@ -603,10 +727,12 @@ fn check_status(status: Option<&serde_json::Value>, text: &str, path: &Path) -> 
                 ),
             ))
         }
-        Some(serde_json::Value::String(s)) => {
+        Some(StatusValue::Other(serde_json::Value::String(s))) => {
             format!("`{s}` is not a status robocal writes ({known})")
         }
-        Some(other) => format!("{other} is not a status robocal writes ({known})"),
+        Some(StatusValue::Other(other)) => {
+            format!("{other} is not a status robocal writes ({known})")
+        }
     };
     let line = crate::io::json_keys::line_of_key(text, "status");
     Err(Error::parse(path, line, Some("status"), msg))
@@ -620,13 +746,11 @@ mod tests {
     fn good() -> Value {
         let nom = crate::model::presets::preset("kuka-kr480-r3330").unwrap();
         let s = ErrorStats::from_norms(&[1.0, 2.0]);
-        let mut extra = serde_json::Map::new();
-        extra.insert("status".into(), json!(STATUS_CALIBRATED));
-        let r = CalibrationResult {
-            robot: RobotInfo::of(&nom),
-            parameters: CalibrationResult::parameter_entries(&nom, &nom),
-            tracker_frame: FrameVec::from_frame(&Frame::identity()),
-            errors: ErrorTables {
+        let r = CalibrationResult::new(
+            RobotInfo::of(&nom),
+            CalibrationResult::parameter_entries(&nom, &nom),
+            FrameVec::from_frame(&Frame::identity()),
+            ErrorTables {
                 calibration: BeforeAfter {
                     before: s,
                     after: s,
@@ -636,8 +760,8 @@ mod tests {
                     after: s,
                 }),
             },
-            extra,
-        };
+            Status::Calibrated,
+        );
         serde_json::to_value(&r).unwrap()
     }
 

@@ -157,6 +157,22 @@ pub struct Settings {
     pub other: serde_json::Map<String, serde_json::Value>,
 }
 
+impl Settings {
+    /// Sets the keys of `keys` (the typed ones by their JSON names, e.g. `data`; any other
+    /// into [`Settings::other`]); an error if a typed key's value has the wrong type.
+    pub fn merge(
+        &mut self,
+        keys: serde_json::Map<String, serde_json::Value>,
+    ) -> serde_json::Result<()> {
+        let serde_json::Value::Object(mut all) = serde_json::to_value(&*self)? else {
+            unreachable!("settings serialize as an object");
+        };
+        all.extend(keys);
+        *self = serde_json::from_value(serde_json::Value::Object(all))?;
+        Ok(())
+    }
+}
+
 /// How the registration started (`registration.initial`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "source")]
@@ -188,6 +204,16 @@ pub enum RegistrationObjectiveName {
     SumOfNorms,
     /// Sum of squared errors.
     LeastSquares,
+}
+
+impl RegistrationObjectiveName {
+    /// `"sum-of-norms"` or `"least-squares"`, as the result writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            RegistrationObjectiveName::SumOfNorms => "sum-of-norms",
+            RegistrationObjectiveName::LeastSquares => "least-squares",
+        }
+    }
 }
 
 /// The paper's affine Tr (eq. 8-11), when fitted (`registration.affine`).
