@@ -13,9 +13,9 @@ use robocal_core::identification::{
     DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
 };
 use robocal_core::io::joint_limits::OutsideLimits;
+use robocal_core::io::result_sections::RowsOutside;
 use robocal_core::io::{read_measurements, Positions};
 use robocal_core::{ErrorStats, Param, Robot};
-use robocal_core::io::result_sections::RowsOutside;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]

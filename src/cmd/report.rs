@@ -116,11 +116,8 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         }
     };
     let robot = a.robot.as_deref().or(recorded_robot.as_deref());
-    let (nominal, calibrated, result) =
-        common::nominal_and_result(robot, &a.result, "RESULT").with_context(|| match (
-            &a.robot,
-            &recorded_robot,
-        ) {
+    let (nominal, calibrated, result) = common::nominal_and_result(robot, &a.result, "RESULT")
+        .with_context(|| match (&a.robot, &recorded_robot) {
             (None, Some(r)) => {
                 format!("the robot `{r}` recorded in the result (give --robot to choose another)")
             }

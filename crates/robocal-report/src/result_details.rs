@@ -134,7 +134,10 @@ mod tests {
             let raw = serde_json::to_value(o).unwrap();
             let phrase = o.phrase();
             assert_ne!(raw.as_str().unwrap(), phrase);
-            assert!(phrase.contains("loss") || phrase.contains("error"), "{phrase}");
+            assert!(
+                phrase.contains("loss") || phrase.contains("error"),
+                "{phrase}"
+            );
         }
         assert!(ObjectiveName::RobustCauchy.phrase().contains("Cauchy"));
         assert!(ObjectiveName::RobustHuber.phrase().contains("Huber"));

@@ -236,11 +236,7 @@ impl Calibration {
                 None,
             )
         } else if self.plausibility.implausible() {
-            (
-                Status::Implausible,
-                None,
-                Some(self.plausibility.summary()),
-            )
+            (Status::Implausible, None, Some(self.plausibility.summary()))
         } else {
             (Status::Calibrated, None, None)
         };

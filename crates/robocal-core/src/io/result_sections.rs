@@ -15,7 +15,9 @@ use std::collections::BTreeMap;
 /// Writes `v` with the keys of every object in alphabetical order.
 pub(crate) fn sorted<T: Serialize, S: Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
     use serde::ser::Error;
-    serde_json::to_value(v).map_err(S::Error::custom)?.serialize(s)
+    serde_json::to_value(v)
+        .map_err(S::Error::custom)?
+        .serialize(s)
 }
 
 /// `Option<T>` written with [`sorted`] (`None` fields are skipped by the caller).

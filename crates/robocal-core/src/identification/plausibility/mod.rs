@@ -26,12 +26,12 @@ mod tests;
 
 use crate::identification::solver::SolverReport;
 use crate::identification::Observations;
+use crate::io::result_sections::{CauseEntry, CheckEntry, PlausibilitySection};
 use crate::model::{Param, Robot, Unit};
 use crate::registration::Registration;
 use crate::stats::ErrorStats;
 use causes::Causes;
 use diagnosis::{explain, sig, unit_of_scale, Explanation};
-use crate::io::result_sections::{CauseEntry, CheckEntry, PlausibilitySection};
 use similarity::{fit_similarity, Handedness};
 
 // The margins quoted below were measured with the release build on 148 good fits — the demo

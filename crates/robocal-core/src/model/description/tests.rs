@@ -54,7 +54,13 @@ fn assert_same(a: &Robot, b: &Robot) {
 fn every_robot_round_trips_exactly_through_json_and_toml() {
     let robots = all_robots();
     let names: Vec<&str> = robots.iter().map(|r| r.name()).collect();
-    for want in ["kr480-track", "fanuc-like", "ur5", "barrett-wam", "kuka-kr480-r3330-table3"] {
+    for want in [
+        "kr480-track",
+        "fanuc-like",
+        "ur5",
+        "barrett-wam",
+        "kuka-kr480-r3330-table3",
+    ] {
         assert!(names.contains(&want), "{want} missing from {names:?}");
     }
     let path = Path::new("r.json");
@@ -152,12 +158,14 @@ fn nominal_difference_names_the_first_difference() {
     let c = fanuc.controller().unwrap();
     uncoupled
         .set_controller(Some(
-            crate::model::Controller::new(c.sign().to_vec(), c.offset().to_vec(), vec![])
-                .unwrap(),
+            crate::model::Controller::new(c.sign().to_vec(), c.offset().to_vec(), vec![]).unwrap(),
         ))
         .unwrap();
     let d = nominal_difference(&fanuc, &uncoupled).unwrap();
-    assert_eq!(d, "controller coupling of joint 3 with axis 2 is -1 against 0");
+    assert_eq!(
+        d,
+        "controller coupling of joint 3 with axis 2 is -1 against 0"
+    );
     // Shape.
     let track = examples()
         .into_iter()
