@@ -144,9 +144,9 @@ impl RobotInfo {
     }
 
     /// The nominal robot the result embeds, if it does (`Ok(None)` for results written before
-    /// results embedded their robot). The description is checked as a robot file would be and
-    /// against the result's own `dof`, `convention` and `joint_types`; errors name `path`, the
-    /// field under `robot` and, given the JSON `text`, the line of that field.
+    /// results embedded their robot). The description is checked as a robot file would be;
+    /// errors name `path`, the field under `robot` and, given the JSON `text`, the line of that
+    /// field.
     pub fn nominal_robot(&self, path: &Path, text: Option<&str>) -> Result<Option<Robot>> {
         let line = |field: &str| text.and_then(|t| crate::io::json_keys::line_of_key(t, field));
         let bad = |field: &str, msg: String| Error::parse(path, line(field), Some(field), msg);
@@ -162,19 +162,8 @@ impl RobotInfo {
                 ),
             ));
         };
-        if d.joints.len() != self.dof {
-            return Err(bad(
-                "robot.joints",
-                format!("{} joints for `dof` {}", d.joints.len(), self.dof),
-            ));
-        }
-        let types: Vec<JointType> = d.joints.iter().map(|j| j.kind).collect();
-        if !self.joint_types.is_empty() && self.joint_types != types {
-            return Err(bad(
-                "robot.joint_types",
-                "the list disagrees with the types of `robot.joints`".to_owned(),
-            ));
-        }
+        // `dof` and `joint_types` are checked against the robot used, this one included, by
+        // `calibrated_robot`.
         let robot = d.to_robot(path).map_err(|e| match e {
             Error::Parse {
                 path,
