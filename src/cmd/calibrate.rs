@@ -13,9 +13,9 @@ use robocal_core::identification::{
     DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
 };
 use robocal_core::io::joint_limits::OutsideLimits;
+use robocal_core::io::result_sections::RowsOutside;
 use robocal_core::io::{read_measurements, Positions};
 use robocal_core::{ErrorStats, Param, Robot};
-use serde_json::json;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -387,21 +387,23 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
              {rank_tolerance:e} given explicitly)"
         );
     }
-    let mut extra = serde_json::Map::new();
-    extra.insert("robot_arg".into(), json!(s.robot_arg));
-    extra.insert("data".into(), json!(s.data.display().to_string()));
-    if let Some(v) = &s.validate {
-        extra.insert("validate".into(), json!(v.display().to_string()));
+    let mut res = cal.to_result();
+    if let Some(rs) = &mut res.settings {
+        rs.robot_arg = Some(s.robot_arg.clone());
+        rs.data = Some(s.data.display().to_string());
+        rs.validate = s.validate.as_ref().map(|v| v.display().to_string());
+        rs.nominal_limits = Some(s.nominal_limits);
+        rs.rows_outside_limits = (!outside.is_empty()).then(|| {
+            outside
+                .iter()
+                .map(|o| RowsOutside {
+                    file: o.path().display().to_string(),
+                    rows: o.count(),
+                    lines: o.lines().to_vec(),
+                })
+                .collect()
+        });
     }
-    extra.insert("nominal_limits".into(), json!(s.nominal_limits));
-    if !outside.is_empty() {
-        let rows: Vec<_> = outside
-            .iter()
-            .map(|o| json!({"file": o.path().display().to_string(), "rows": o.count(), "lines": o.lines()}))
-            .collect();
-        extra.insert("rows_outside_limits".into(), json!(rows));
-    }
-    let mut res = cal.to_result(extra);
     let failed_gate = if implausible {
         format!(
             "\nThe fit also FAILED the plausibility gate:\n{}",
@@ -451,7 +453,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         s.calibration.solver.max_iterations
     );
     if s.keep_partial {
-        res.extra.insert("partial_reason".into(), json!(why));
+        res.partial_reason = Some(why.clone());
         res.write(&s.out)?;
         Err(exit::numerical(format!(
             "{why}: the parameters above are a partial result, not a calibration; written to {} \

@@ -26,22 +26,66 @@ impl Model {
     }
 }
 
-/// Loads `--robot` and optional `--params`.
-pub fn model(robot_arg: &str, params: Option<&Path>) -> anyhow::Result<Model> {
-    let nominal = robot(robot_arg)?;
-    let calibrated = match params {
-        None => None,
-        Some(p) => {
-            let res = CalibrationResult::read(p)?;
-            let cal = res.calibrated_robot(&nominal, p)?;
-            robocal_core::evaluation::check_result_nominal(&res, &nominal, p)?;
-            Some((cal, res))
-        }
+/// Loads the nominal robot and, with `--params RESULT.json`, the calibrated one and its result.
+/// See [`nominal_and_result`] for where the nominal robot comes from.
+pub fn model(robot_arg: Option<&str>, params: Option<&Path>) -> anyhow::Result<Model> {
+    let Some(p) = params else {
+        let Some(arg) = robot_arg else {
+            return Err(crate::exit::usage(
+                "give --robot NAME|FILE, or --params RESULT.json with a result that embeds its \
+                 robot",
+            ));
+        };
+        return Ok(Model {
+            nominal: robot(arg)?,
+            calibrated: None,
+        });
     };
+    let (nominal, cal, res) = nominal_and_result(robot_arg, p, "--params")?;
     Ok(Model {
         nominal,
-        calibrated,
+        calibrated: Some((cal, res)),
     })
+}
+
+/// The nominal robot, the calibrated one and the result of `result` (named `flag` in
+/// messages), checked to belong together. The nominal robot is `--robot` when given, else the
+/// one the result embeds; given both, they must agree (joints, convention, nominal parameters,
+/// controller map; exit code 3 naming the first difference). A result without an embedded
+/// robot (from an older robocal) needs `--robot` (exit code 2 without it).
+pub fn nominal_and_result(
+    robot_arg: Option<&str>,
+    result: &Path,
+    flag: &str,
+) -> anyhow::Result<(Robot, Robot, CalibrationResult)> {
+    let res = CalibrationResult::read(result)?;
+    let embedded = res.robot.nominal_robot(result, None)?;
+    let nominal = match (robot_arg, &embedded) {
+        (Some(arg), _) => robot(arg)?,
+        (None, Some(r)) => r.clone(),
+        (None, None) => {
+            return Err(crate::exit::usage(format!(
+                "{flag} {}: the result does not embed its robot (written by an older robocal): \
+                 give --robot NAME|FILE",
+                result.display()
+            )))
+        }
+    };
+    let cal = res.calibrated_robot(&nominal, result)?;
+    robocal_core::evaluation::check_result_nominal(&res, &nominal, result)?;
+    if let (Some(arg), Some(emb)) = (robot_arg, &embedded) {
+        if let Some(diff) = robocal_core::model::description::nominal_difference(emb, &nominal) {
+            return Err(crate::exit::input(format!(
+                "the robot embedded in {flag} {} (`{}`) and --robot {arg} (`{}`) disagree: \
+                 {diff} (result against --robot); leave out --robot to use the result's own \
+                 robot",
+                result.display(),
+                emb.name(),
+                nominal.name()
+            )));
+        }
+    }
+    Ok((nominal, cal, res))
 }
 
 /// Parses `--joints q1,...,qn` (model joint values: degrees, or mm for a prismatic joint) into

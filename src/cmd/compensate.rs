@@ -15,9 +15,10 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct CompensateArgs {
-    /// The nominal robot (what the controller believes): a preset name or a TOML robot file.
+    /// The nominal robot (what the controller believes): a preset name or a TOML robot file
+    /// [default: the robot embedded in the result; when given, it must agree with that one].
     #[arg(long)]
-    robot: String,
+    robot: Option<String>,
     /// The calibration result (`robocal calibrate --out`).
     #[arg(long)]
     params: PathBuf,
@@ -96,14 +97,14 @@ impl TryFrom<&CompensateArgs> for Settings {
             "mm",
         )?;
         let outputs = IoPlan::new()
-            .robot("--robot", &a.robot)
+            .robot_opt("--robot", a.robot.as_deref())
             .input("--params", &a.params)
             .recorded_in("--params", &a.params)
             .input_opt("--joints", a.joints.as_deref())
             .input_opt("--targets", a.targets.as_deref())
             .output_or_stdout("--out", &a.out)
             .check()?;
-        let (nominal, calibrated, res) = calibrated_model(&a.robot, &a.params)?;
+        let (nominal, calibrated, res) = calibrated_model(a.robot.as_deref(), &a.params)?;
         if let Some(why) = res.partial_reason() {
             return Err(exit::input(format!(
                 "--params {}: a partial result, not a calibration ({why}); compensation refuses \

@@ -6,7 +6,7 @@ use super::common;
 use super::io_plan::{self, IoPlan};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use robocal_core::evaluation::{self, Against, Evaluator, PerPointWriter, Reference};
+use robocal_core::evaluation::{Against, Evaluator, PerPointWriter, Reference};
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::{
     CalibrationResult, Measurement, MeasurementReader, MeasurementSet, Positions,
@@ -17,9 +17,10 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct EvaluateArgs {
-    /// The nominal robot: a preset name or a TOML robot file.
+    /// The nominal robot: a preset name or a TOML robot file [default: the robot embedded in
+    /// the result; when given, it must agree with that one].
     #[arg(long)]
-    robot: String,
+    robot: Option<String>,
     /// The calibration result (`robocal calibrate --out`): calibrated model and tracker frame.
     #[arg(long)]
     params: PathBuf,
@@ -55,15 +56,13 @@ enum AgainstArg {
     Desired,
 }
 
-/// The nominal robot, the calibrated one and the result, checked to belong together.
+/// The nominal robot, the calibrated one and the result of `--params`, checked to belong
+/// together (see [`common::nominal_and_result`]).
 pub(super) fn calibrated_model(
-    robot: &str,
+    robot: Option<&str>,
     params: &Path,
 ) -> anyhow::Result<(Robot, Robot, CalibrationResult)> {
-    let m = common::model(robot, Some(params))?;
-    let (cal, res) = m.calibrated.expect("--params given");
-    evaluation::check_result_nominal(&res, &m.nominal, params)?;
-    Ok((m.nominal, cal, res))
+    common::nominal_and_result(robot, params, "--params")
 }
 
 /// Everything `evaluate` needs, checked completely before any work: flag combinations, the
@@ -93,7 +92,7 @@ impl TryFrom<&EvaluateArgs> for Settings {
             ));
         }
         let mut plan = IoPlan::new();
-        plan.robot("--robot", &a.robot)
+        plan.robot_opt("--robot", a.robot.as_deref())
             .input("--params", &a.params)
             .recorded_in("--params", &a.params)
             .input("--data", &a.data);
@@ -101,7 +100,7 @@ impl TryFrom<&EvaluateArgs> for Settings {
             plan.output_or_stdout("--per-point", p);
         }
         let outputs = plan.check()?;
-        let (nominal, calibrated, result) = calibrated_model(&a.robot, &a.params)?;
+        let (nominal, calibrated, result) = calibrated_model(a.robot.as_deref(), &a.params)?;
         common::warn_not_calibrated(&result, &a.params);
         let against = match a.against {
             AgainstArg::Auto => Against::Auto,

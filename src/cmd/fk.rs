@@ -6,9 +6,10 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct FkArgs {
-    /// A preset name or a TOML robot file.
+    /// A preset name or a TOML robot file [with --params, default: the robot embedded in the
+    /// result; when given, it must agree with that one].
     #[arg(long)]
-    robot: String,
+    robot: Option<String>,
     /// Joint values q1,...,qn: model joint values in degrees (mm for a prismatic joint).
     #[arg(long, allow_hyphen_values = true)]
     joints: String,
@@ -32,7 +33,7 @@ impl TryFrom<&FkArgs> for Settings {
     type Error = anyhow::Error;
 
     fn try_from(a: &FkArgs) -> anyhow::Result<Settings> {
-        let model = common::model(&a.robot, a.params.as_deref())?;
+        let model = common::model(a.robot.as_deref(), a.params.as_deref())?;
         if let (Some((_, res)), Some(p)) = (&model.calibrated, &a.params) {
             common::warn_not_calibrated(res, p);
         }

@@ -102,6 +102,14 @@ impl IoPlan {
         self
     }
 
+    /// An optional robot argument.
+    pub fn robot_opt(&mut self, flag: &str, arg: Option<&str>) -> &mut Self {
+        if let Some(a) = arg {
+            self.robot(flag, a);
+        }
+        self
+    }
+
     /// The files a calibration result records (its measurement files and robot file, as
     /// `robocal calibrate` was given them), which later commands read by default: they are
     /// protected like inputs. A result that cannot be read records nothing here (reading it
@@ -109,7 +117,7 @@ impl IoPlan {
     pub fn recorded_in(&mut self, flag: &str, result: &Path) -> &mut Self {
         #[derive(serde::Deserialize)]
         struct Recorded {
-            settings: Option<std::collections::HashMap<String, serde_json::Value>>,
+            settings: Option<robocal_core::io::result_sections::Settings>,
         }
         let Some(settings) = std::fs::read_to_string(result)
             .ok()
@@ -118,19 +126,18 @@ impl IoPlan {
         else {
             return self;
         };
-        let name = |key: &str| settings.get(key).and_then(|v| v.as_str());
-        for (key, what) in [
-            ("data", "the calibration data"),
-            ("validate", "the validation data"),
+        for (file, what) in [
+            (&settings.data, "the calibration data"),
+            (&settings.validate, "the validation data"),
         ] {
-            if let Some(p) = name(key) {
+            if let Some(p) = file {
                 self.inputs.push(Input {
                     path: PathBuf::from(p),
                     described: format!("{p}, {what} recorded in {flag} {}", result.display()),
                 });
             }
         }
-        if let Some(p) = name("robot_arg").and_then(robot_file) {
+        if let Some(p) = settings.robot_arg.as_deref().and_then(robot_file) {
             self.inputs.push(Input {
                 path: p.to_owned(),
                 described: format!(

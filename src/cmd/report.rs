@@ -1,11 +1,12 @@
 //! `robocal report`: the HTML report of any calibration result, with the per-point errors of its
 //! measurement files when they are at hand.
 
-use super::evaluate::calibrated_model;
+use super::common;
 use super::io_plan::IoPlan;
 use crate::exit;
 use anyhow::Context;
 use clap::Args;
+use robocal_core::io::result_sections::Settings as RecordedSettings;
 use robocal_core::io::{read_measurements, CalibrationResult, MeasurementSet, Positions};
 use robocal_core::JointSpace;
 use robocal_report::{write_report, ReportData, RunData, HISTOGRAM_FILE, HTML_FILE};
@@ -16,7 +17,9 @@ pub struct ReportArgs {
     /// The calibration result (`robocal calibrate --out`).
     #[arg(value_name = "RESULT.json")]
     result: PathBuf,
-    /// The nominal robot (preset or TOML file) [default: the `--robot` recorded in the result].
+    /// The nominal robot (preset or TOML file) [default: the robot embedded in the result, or
+    /// for older results the `--robot` recorded in it; when given, it must agree with the
+    /// embedded one].
     #[arg(long)]
     robot: Option<String>,
     /// The calibration measurements, for each point's error against its reach [default: the
@@ -39,16 +42,20 @@ pub struct ReportArgs {
     out: PathBuf,
 }
 
-/// A string setting recorded in the result by `robocal calibrate`.
-fn recorded<'a>(result: &'a CalibrationResult, key: &str) -> Option<&'a str> {
-    result.extra.get("settings")?.get(key)?.as_str()
+/// A file setting recorded in the result by `robocal calibrate` (`robot_arg`, `data`,
+/// `validate`).
+fn recorded(
+    result: &CalibrationResult,
+    key: fn(&RecordedSettings) -> &Option<String>,
+) -> Option<&str> {
+    result.settings.as_ref().and_then(|s| key(s).as_deref())
 }
 
 /// The file given, or the one the result recorded if it still exists (with a note if not).
 fn file_arg(
     given: &Option<PathBuf>,
     result: &CalibrationResult,
-    key: &str,
+    key: fn(&RecordedSettings) -> &Option<String>,
     flag: &str,
 ) -> Option<PathBuf> {
     if let Some(p) = given {
@@ -115,26 +122,35 @@ impl TryFrom<&ReportArgs> for Settings {
         }
         plan.check()?;
         let result = CalibrationResult::read(&a.result)?;
-        let robot = match (&a.robot, recorded(&result, "robot_arg")) {
-            (Some(r), _) => r.clone(),
-            (None, Some(r)) => r.to_owned(),
-            (None, None) => {
-                return Err(exit::usage(format!(
-                    "{} does not record its robot: give --robot NAME|FILE",
-                    a.result.display()
-                )))
+        // The robot: --robot, else the one the result embeds, else (older results) the --robot
+        // recorded in the result's settings.
+        let recorded_robot = if a.robot.is_some() || !result.robot.joints.is_empty() {
+            None
+        } else {
+            match recorded(&result, |s| &s.robot_arg) {
+                Some(r) => Some(r.to_owned()),
+                None => {
+                    return Err(exit::usage(format!(
+                        "{} neither embeds nor records its robot: give --robot NAME|FILE",
+                        a.result.display()
+                    )))
+                }
             }
         };
-        let (nominal, calibrated, result) = calibrated_model(&robot, &a.result).with_context(|| {
-            if a.robot.is_none() {
-                format!("the robot `{robot}` recorded in the result (give --robot to choose another)")
-            } else {
-                format!("--robot {robot}")
-            }
-        })?;
+        let robot = a.robot.as_deref().or(recorded_robot.as_deref());
+        let (nominal, calibrated, result) = common::nominal_and_result(robot, &a.result, "RESULT")
+            .with_context(|| match (&a.robot, &recorded_robot) {
+                (None, Some(r)) => {
+                    format!(
+                        "the robot `{r}` recorded in the result (give --robot to choose another)"
+                    )
+                }
+                (Some(r), _) => format!("--robot {r}"),
+                (None, None) => format!("the robot embedded in {}", a.result.display()),
+            })?;
         super::common::warn_not_calibrated(&result, &a.result);
-        let data_path = file_arg(&a.data, &result, "data", "--data");
-        let val_path = file_arg(&a.validate, &result, "validate", "--validate");
+        let data_path = file_arg(&a.data, &result, |s| &s.data, "--data");
+        let val_path = file_arg(&a.validate, &result, |s| &s.validate, "--validate");
         Ok(Settings {
             result_path: a.result.clone(),
             result,

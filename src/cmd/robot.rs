@@ -30,7 +30,7 @@ impl TryFrom<&ShowArgs> for ShowSettings {
     type Error = anyhow::Error;
 
     fn try_from(a: &ShowArgs) -> anyhow::Result<ShowSettings> {
-        let model = common::model(&a.robot, a.params.as_deref())?;
+        let model = common::model(Some(&a.robot), a.params.as_deref())?;
         if let (Some((_, res)), Some(p)) = (&model.calibrated, &a.params) {
             common::warn_not_calibrated(res, p);
         }

@@ -7,7 +7,6 @@ use robocal_core::evaluation::{evaluate, Against, Evaluation};
 use robocal_core::io::result::BeforeAfter;
 use robocal_core::io::{CalibrationResult, MeasurementSet, SetLabel};
 use robocal_core::{ErrorStats, Result, Robot};
-use serde_json::Value;
 
 /// Name of the calibration point set.
 pub const CALIBRATION: &str = "Calibration";
@@ -101,15 +100,19 @@ fn evaluated(run: &RunData, set: &MeasurementSet, against: Against) -> Result<Ev
 
 /// The per-point errors the result file itself lists (`points.<set>`, written by `robocal
 /// calibrate`), without reach.
-fn result_points(result: &CalibrationResult, key: &str) -> Option<Vec<PointError>> {
-    let list = result.extra.get("points")?.get(key)?.as_array()?;
-    let num = |v: &Value, k: &str| v.get(k).and_then(Value::as_f64).unwrap_or(f64::NAN);
+fn result_points(result: &CalibrationResult, validation: bool) -> Option<Vec<PointError>> {
+    let points = result.points.as_ref()?;
+    let list = if validation {
+        points.validation.as_ref()?
+    } else {
+        &points.calibration
+    };
     Some(
         list.iter()
             .map(|p| PointError {
                 reach_mm: f64::NAN,
-                before_mm: num(p, "before_mm"),
-                after_mm: num(p, "after_mm"),
+                before_mm: p.before_mm,
+                after_mm: p.after_mm,
             })
             .collect(),
     )
@@ -142,7 +145,7 @@ impl ReportData {
                 }
             }
             None => {
-                if let Some(points) = result_points(result, "calibration") {
+                if let Some(points) = result_points(result, false) {
                     sets.push(PointSet {
                         name: CALIBRATION.into(),
                         points,
@@ -186,7 +189,7 @@ impl ReportData {
                 });
             }
             None => {
-                if let Some(points) = result_points(result, "validation") {
+                if let Some(points) = result_points(result, true) {
                     sets.push(PointSet {
                         name: VALIDATION.into(),
                         points,

@@ -370,7 +370,9 @@ mod runs {
         assert!(r.html.contains("cannot place the points"));
         assert!(!r.html.contains("Paper: Samak"));
         assert!(data.identifiability.as_ref().unwrap().fixed.len() == 10);
-        let iterations = e.result.extra["solver"]["iterations"].as_u64().unwrap() as usize;
+        let iterations = serde_json::to_value(&e.result).unwrap()["solver"]["iterations"]
+            .as_u64()
+            .unwrap() as usize;
         assert!(iterations > 0);
         assert_eq!(data.solver.as_ref().unwrap().iterations, Some(iterations));
     }
@@ -390,7 +392,7 @@ mod runs {
             &(),
         )
         .unwrap();
-        let result = cal.to_result(Default::default());
+        let result = cal.to_result();
         assert!(result.errors.validation.is_none());
         let data = ReportData::from_run(&RunData {
             result: &result,

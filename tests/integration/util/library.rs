@@ -21,30 +21,20 @@ pub fn tracker(noise: bool) -> Tracker {
 /// with the given tracker frame.
 pub fn result_for(nominal: &Robot, calibrated: &Robot, frame: &TrackerFrame) -> CalibrationResult {
     let s = ErrorStats::from_norms(&[1.0, 2.0]);
-    CalibrationResult {
-        robot: RobotInfo {
-            name: nominal.name().into(),
-            dof: nominal.dof(),
-            convention: nominal.convention().as_str().into(),
-            joint_types: nominal.joint_types().to_vec(),
-        },
-        parameters: CalibrationResult::parameter_entries(nominal, calibrated),
-        tracker_frame: FrameVec::from_tracker_frame(frame),
-        errors: ErrorTables {
+    // Every result robocal writes has a status (readers refuse one without).
+    CalibrationResult::new(
+        RobotInfo::of(nominal),
+        CalibrationResult::parameter_entries(nominal, calibrated),
+        FrameVec::from_tracker_frame(frame),
+        ErrorTables {
             calibration: BeforeAfter {
                 before: s,
                 after: s,
             },
             validation: None,
         },
-        // Every result robocal writes has a status (readers refuse one without).
-        extra: [(
-            "status".to_owned(),
-            robocal_core::io::result::STATUS_CALIBRATED.into(),
-        )]
-        .into_iter()
-        .collect(),
-    }
+        robocal_core::io::result::Status::Calibrated,
+    )
 }
 
 /// Writes the standard result: nominal Table I, "calibrated" = Table III (the simulation's truth).

@@ -272,23 +272,23 @@ fn per_point_file_carries_lines_and_extra_columns() {
 fn results_of_another_robot_are_rejected() {
     let nom = preset("kuka-kr480-r3330").unwrap();
     let table3 = preset("kuka-kr480-r3330-table3").unwrap();
-    let result = |n: &Robot, c: &Robot| CalibrationResult {
-        robot: crate::io::result::RobotInfo {
-            name: n.name().into(),
-            dof: n.dof(),
-            convention: n.convention().as_str().into(),
-            joint_types: vec![],
-        },
-        parameters: CalibrationResult::parameter_entries(n, c),
-        tracker_frame: crate::io::result::FrameVec::from_tracker_frame(&TrackerFrame::identity()),
-        errors: crate::io::result::ErrorTables {
-            calibration: crate::io::result::BeforeAfter {
-                before: ErrorStats::from_norms(&[1.0]),
-                after: ErrorStats::from_norms(&[0.1]),
+    let result = |n: &Robot, c: &Robot| {
+        CalibrationResult::new(
+            crate::io::result::RobotInfo {
+                joint_types: vec![],
+                ..crate::io::result::RobotInfo::shape_of(n)
             },
-            validation: None,
-        },
-        extra: Default::default(),
+            CalibrationResult::parameter_entries(n, c),
+            crate::io::result::FrameVec::from_tracker_frame(&TrackerFrame::identity()),
+            crate::io::result::ErrorTables {
+                calibration: crate::io::result::BeforeAfter {
+                    before: ErrorStats::from_norms(&[1.0]),
+                    after: ErrorStats::from_norms(&[0.1]),
+                },
+                validation: None,
+            },
+            crate::io::result::Status::Calibrated,
+        )
     };
     let p = Path::new("r.json");
     assert!(check_result_nominal(&result(&nom, &table3), &nom, p).is_ok());

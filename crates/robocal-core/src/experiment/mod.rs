@@ -312,14 +312,17 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
             calibration.plausibility.summary()
         )));
     }
-    let mut extra = serde_json::Map::new();
-    extra.insert("robot_arg".into(), nominal.name().into());
-    extra.insert("data".into(), files::CELL.into());
-    extra.insert("validate".into(), files::VALIDATION.into());
-    // Simulated poses are within the limits: the joint limits are enforced, as by default.
-    extra.insert("nominal_limits".into(), false.into());
-    extra.extend(config.result_settings.clone());
-    let mut result_json = serde_json::to_string_pretty(&calibration.to_result(extra))
+    let mut result = calibration.to_result();
+    if let Some(s) = &mut result.settings {
+        s.robot_arg = Some(nominal.name().to_owned());
+        s.data = Some(files::CELL.to_owned());
+        s.validate = Some(files::VALIDATION.to_owned());
+        // Simulated poses are within the limits: the joint limits are enforced, as by default.
+        s.nominal_limits = Some(false);
+        s.merge(config.result_settings.clone())
+            .map_err(|e| Error::invalid("result settings", e.to_string()))?;
+    }
+    let mut result_json = serde_json::to_string_pretty(&result)
         .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
     result_json.push('\n');
     let result = CalibrationResult::parse(&result_json, Path::new(files::RESULT))?;

@@ -4,16 +4,21 @@
 //! `tracker_frame` (the registration frame F; the calibrated base frame B is among the
 //! parameters) and `errors`. Further keys: `settings`, `registration`, `identifiability`,
 //! `solver`, `uncertainty`, `downweighted_points`, `points` (per-point errors), `plausibility`
-//! (the gate's checks) and `status` (with `partial_reason` or `implausible_reason`).
+//! (the gate's checks) and `status` (with `partial_reason` or `implausible_reason`), each a
+//! typed section of [`crate::io::result_sections`].
 
 use crate::identification::identifiability::FixReason;
 use crate::identification::objective::Loss;
 use crate::identification::pipeline::{Calibration, SetErrors};
-use crate::io::result::{BeforeAfter, ErrorTables, FrameVec, RobotInfo};
+use crate::io::result::{BeforeAfter, ErrorTables, FrameVec, RobotInfo, Status};
+use crate::io::result_sections::{
+    AffineEntry, CorrelationEntry, DownweightedEntry, DuplicateEntry, FixKind, FixedEntry,
+    Identifiability, IdentifiedEntry, InitialFrameEntry, LossEntry, ObjectiveName, PointEntry,
+    Points, Registration, RegistrationObjectiveName, Settings, Solver, StageEntry, Uncertainty,
+};
 use crate::io::CalibrationResult;
 use crate::model::{Param, Unit};
 use crate::registration::{InitialFrame, RegistrationObjective};
-use serde_json::{json, Map, Value};
 
 /// Display-unit factor of a parameter (1 for mm, degrees per radian for angles).
 fn unit_factor(p: Param) -> f64 {
@@ -23,27 +28,31 @@ fn unit_factor(p: Param) -> f64 {
     }
 }
 
-fn loss_json(l: &Loss) -> Value {
+fn loss_entry(l: &Loss) -> LossEntry {
     match *l {
-        Loss::SumOfNorms { delta } => json!({"loss": "sum-of-norms", "smoothing_mm": delta}),
-        Loss::Squared => json!({"loss": "least-squares"}),
-        Loss::Huber { k } => json!({"loss": "huber", "scale_mm": k}),
-        Loss::Cauchy { c } => json!({"loss": "cauchy", "scale_mm": c}),
+        Loss::SumOfNorms { delta } => LossEntry::SumOfNorms {
+            smoothing_mm: delta,
+        },
+        Loss::Squared => LossEntry::LeastSquares,
+        Loss::Huber { k } => LossEntry::Huber { scale_mm: k },
+        Loss::Cauchy { c } => LossEntry::Cauchy { scale_mm: c },
     }
 }
 
-fn points_json(s: &SetErrors) -> Value {
-    Value::Array(
-        (0..s.before.len())
-            .map(|i| json!({"line": s.lines[i], "before_mm": s.before[i], "after_mm": s.after[i]}))
-            .collect(),
-    )
+fn point_entries(s: &SetErrors) -> Vec<PointEntry> {
+    (0..s.before.len())
+        .map(|i| PointEntry {
+            line: s.lines[i],
+            before_mm: s.before[i],
+            after_mm: s.after[i],
+        })
+        .collect()
 }
 
 impl Calibration {
-    /// The result file's content. `extra_settings` (e.g. the CLI's file names) are merged into
-    /// the `settings` object.
-    pub fn to_result(&self, extra_settings: Map<String, Value>) -> CalibrationResult {
+    /// The result file's content. The `settings` record the calibration's own settings; the
+    /// caller adds its file names (`robot_arg`, `data`, `validate`, ...) to them.
+    pub fn to_result(&self) -> CalibrationResult {
         let mut parameters = CalibrationResult::parameter_entries(&self.nominal, &self.calibrated);
         for (name, e) in parameters.iter_mut() {
             let p = self
@@ -85,45 +94,46 @@ impl Calibration {
                 .find(|(q, _)| *q == p)
                 .map_or(f64::NAN, |(_, v)| *v / unit_factor(p))
         };
-        let identified: Vec<Value> = id
+        let identified = id
             .identified
             .iter()
             .zip(&id.independence)
-            .map(|(p, ind)| {
-                json!({
-                    "name": p.name(),
-                    "independence": ind,
-                    "rms_effect_mm_per_unit": rms(*p),
-                    "unit": p.unit().as_str(),
-                })
+            .map(|(p, ind)| IdentifiedEntry {
+                name: p.name(),
+                independence: *ind,
+                rms_effect_mm_per_unit: rms(*p),
+                unit: p.unit(),
             })
             .collect();
-        let fixed: Vec<Value> = id
+        let fixed = id
             .fixed
             .iter()
             .map(|f| {
-                let mut o = json!({"name": f.param.name(), "reason": f.describe()});
-                match &f.reason {
-                    FixReason::User => o["kind"] = json!("user"),
+                let (kind, independence, duplicates) = match &f.reason {
+                    FixReason::User => (FixKind::User, None, None),
                     FixReason::NoEffect | FixReason::Unseen { .. } => {
-                        o["kind"] = json!("no_effect")
+                        (FixKind::NoEffect, None, None)
                     }
-                    FixReason::Duplicate { of, independence } => {
-                        o["kind"] = json!("duplicate");
-                        o["independence"] = json!(independence);
-                        o["duplicates"] = Value::Array(
+                    FixReason::Duplicate { of, independence } => (
+                        FixKind::Duplicate,
+                        Some(*independence),
+                        Some(
                             of.iter()
-                                .map(|(q, c)| {
-                                    json!({
-                                        "name": q.name(),
-                                        "coefficient": c * unit_factor(*q) / unit_factor(f.param),
-                                    })
+                                .map(|(q, c)| DuplicateEntry {
+                                    name: q.name(),
+                                    coefficient: c * unit_factor(*q) / unit_factor(f.param),
                                 })
                                 .collect(),
-                        );
-                    }
+                        ),
+                    ),
+                };
+                FixedEntry {
+                    name: f.param.name(),
+                    reason: f.describe(),
+                    kind,
+                    independence,
+                    duplicates,
                 }
-                o
             })
             .collect();
         let reg = &self.registration;
@@ -133,170 +143,155 @@ impl Calibration {
                 tilt_deg,
                 frame,
                 max_error_mm,
-            } => json!({
-                "source": "plane points",
-                "points": n,
-                "plane_tilt_deg": tilt_deg,
-                "frame": FrameVec::from_tracker_frame(&frame),
-                "max_error_mm": max_error_mm,
-            }),
-            InitialFrame::LeastSquares => json!({"source": "least-squares fit"}),
-        };
-        let mut registration = json!({
-            "objective": match reg.objective {
-                RegistrationObjective::SumOfNorms => "sum-of-norms",
-                RegistrationObjective::LeastSquares => "least-squares",
+            } => InitialFrameEntry::Plane {
+                points: n,
+                plane_tilt_deg: tilt_deg,
+                frame: FrameVec::from_tracker_frame(&frame),
+                max_error_mm,
             },
-            "initial": initial,
-            "iterations": reg.iterations,
-            "frame": FrameVec::from_tracker_frame(&reg.frame),
-            "stats": reg.stats,
-        });
-        if let Some(a) = &reg.affine {
-            registration["affine"] = json!({
-                "t": a.tr.parameters(),
-                "singular_values": a.tr.singular_values(),
-                "iterations": a.iterations,
-                "stats": a.stats,
-            });
-        }
-        let stages: Vec<Value> = self
+            InitialFrame::LeastSquares => InitialFrameEntry::LeastSquares,
+        };
+        let registration = Registration {
+            objective: match reg.objective {
+                RegistrationObjective::SumOfNorms => RegistrationObjectiveName::SumOfNorms,
+                RegistrationObjective::LeastSquares => RegistrationObjectiveName::LeastSquares,
+            },
+            initial,
+            iterations: reg.iterations,
+            frame: FrameVec::from_tracker_frame(&reg.frame),
+            stats: reg.stats,
+            affine: reg.affine.as_ref().map(|a| AffineEntry {
+                t: a.tr.parameters().to_vec(),
+                singular_values: a.tr.singular_values().to_vec(),
+                iterations: a.iterations,
+                stats: a.stats,
+            }),
+        };
+        let stages = self
             .stages
             .iter()
             .map(|s| {
-                let mut o = loss_json(&s.loss);
                 let r = &s.report;
-                o["termination"] = json!(r.termination.describe());
-                o["converged"] = json!(r.termination.converged());
-                o["iterations"] = json!(r.iterations);
-                o["evaluations"] = json!(r.evaluations);
-                o["initial_objective"] = json!(r.initial_objective);
-                o["final_objective"] = json!(r.final_objective);
-                o["final_gradient"] = json!(r.final_gradient);
-                o["last_step_mm"] = json!(r.last_step_mm);
-                o
+                StageEntry {
+                    loss: loss_entry(&s.loss),
+                    termination: r.termination.describe(),
+                    converged: r.termination.converged(),
+                    iterations: r.iterations,
+                    evaluations: r.evaluations,
+                    initial_objective: r.initial_objective,
+                    final_objective: r.final_objective,
+                    final_gradient: r.final_gradient,
+                    last_step_mm: r.last_step_mm,
+                }
             })
             .collect();
         let last = self.solver();
         let s = &self.settings;
-        let mut settings = json!({
-            "objective": s.objective.name(),
-            "robust_scale_mm": self.robust_scale_mm,
-            "affine_registration": s.affine_registration,
-            "rank_tolerance": s.identifiability.rank_tolerance,
-            "fix": s.identifiability.fix.iter().map(|p| p.name()).collect::<Vec<_>>(),
-            "free": s.identifiability.free.iter().map(|p| p.name()).collect::<Vec<_>>(),
-            "max_iterations": s.solver.max_iterations,
-            "step_tolerance_mm": s.solver.step_tolerance_mm,
-            "gradient_tolerance": s.solver.gradient_tolerance,
-            "objective_tolerance": s.solver.objective_tolerance,
-            "beta": (0..self.nominal.dof())
+        let objective = ObjectiveName::of(&s.objective);
+        let settings = Settings {
+            objective,
+            robust_scale_mm: self.robust_scale_mm,
+            affine_registration: s.affine_registration,
+            rank_tolerance: s.identifiability.rank_tolerance,
+            fix: s.identifiability.fix.iter().map(|p| p.name()).collect(),
+            free: s.identifiability.free.iter().map(|p| p.name()).collect(),
+            max_iterations: s.solver.max_iterations,
+            step_tolerance_mm: s.solver.step_tolerance_mm,
+            gradient_tolerance: s.solver.gradient_tolerance,
+            objective_tolerance: s.solver.objective_tolerance,
+            beta: (0..self.nominal.dof())
                 .filter(|&i| self.nominal.beta_enabled(i))
                 .map(|i| format!("beta{}", i + 1))
-                .collect::<Vec<_>>(),
-        });
-        if let Value::Object(o) = &mut settings {
-            o.extend(extra_settings);
-        }
-        let correlations: Vec<Value> = self
+                .collect(),
+            robot_arg: None,
+            data: None,
+            validate: None,
+            nominal_limits: None,
+            rows_outside_limits: None,
+            other: Default::default(),
+        };
+        let most_correlated = self
             .covariance
             .most_correlated(10)
             .into_iter()
-            .map(|c| json!({"a": c.a.name(), "b": c.b.name(), "rho": c.rho}))
+            .map(|c| CorrelationEntry {
+                a: c.a.name(),
+                b: c.b.name(),
+                rho: c.rho,
+            })
             .collect();
-        let stds: Map<String, Value> = self
+        let std = self
             .covariance
             .params
             .iter()
             .zip(self.covariance.std())
-            .map(|(p, sd)| {
-                let v = if sd.is_finite() {
-                    json!(p.unit().from_internal(sd))
-                } else {
-                    Value::Null
-                };
-                (p.name(), v)
-            })
+            .map(|(p, sd)| (p.name(), sd.is_finite().then(|| p.unit().from_internal(sd))))
             .collect();
-        let mut extra = Map::new();
-        extra.insert("settings".into(), settings);
-        extra.insert("registration".into(), registration);
-        extra.insert(
-            "identifiability".into(),
-            json!({
-                "rank_tolerance": id.rank_tolerance,
-                "condition_number": id.condition_number,
-                "condition_limit": crate::identification::MAX_CONDITION_NUMBER,
-                "ill_conditioned": id.ill_conditioned(),
-                "n_identified": id.identified.len(),
-                "n_fixed": id.fixed.len(),
-                "identified": identified,
-                "fixed": fixed,
-            }),
-        );
-        extra.insert(
-            "solver".into(),
-            json!({
-                "objective": s.objective.name(),
-                "termination": last.termination.describe(),
-                "converged": last.termination.converged(),
-                "iterations": self.stages.iter().map(|s| s.report.iterations).sum::<usize>(),
-                "final_objective": last.final_objective,
-                "stages": stages,
-            }),
-        );
-        let mut uncertainty = json!({
-            "sigma_mm": self.covariance.sigma_mm,
-            "std": stds,
-            "most_correlated": correlations,
-        });
-        if let Some(why) = &self.covariance.unavailable {
-            uncertainty["std_unavailable"] = json!(why);
-        }
-        extra.insert("uncertainty".into(), uncertainty);
-        extra.insert(
-            "downweighted_points".into(),
-            Value::Array(
-                self.downweighted
-                    .iter()
-                    .map(|d| json!({"line": d.line, "error_mm": d.error_mm, "weight": d.weight}))
-                    .collect(),
-            ),
-        );
-        let mut points = json!({"calibration": points_json(&self.calibration)});
-        if let Some(v) = &self.validation {
-            points["validation"] = points_json(v);
-        }
-        extra.insert("points".into(), points);
         // A result is a calibration only when the solver converged and the fit passed the
         // plausibility gate; otherwise it is marked partial or implausible so that no reader
         // takes it for one.
-        let termination = &self.solver().termination;
-        extra.insert("plausibility".into(), self.plausibility.to_json());
-        if !termination.converged() {
-            extra.insert("status".into(), json!(crate::io::result::STATUS_PARTIAL));
-            extra.insert(
-                "partial_reason".into(),
-                json!(format!("the solver {}", termination.describe())),
-            );
+        let termination = &last.termination;
+        let (status, partial_reason, implausible_reason) = if !termination.converged() {
+            (
+                Status::Partial,
+                Some(format!("the solver {}", termination.describe())),
+                None,
+            )
         } else if self.plausibility.implausible() {
-            extra.insert(
-                "status".into(),
-                json!(crate::io::result::STATUS_IMPLAUSIBLE),
-            );
-            extra.insert(
-                "implausible_reason".into(),
-                json!(self.plausibility.summary()),
-            );
+            (Status::Implausible, None, Some(self.plausibility.summary()))
         } else {
-            extra.insert("status".into(), json!(crate::io::result::STATUS_CALIBRATED));
-        }
-        CalibrationResult {
-            robot: RobotInfo::of(&self.nominal),
+            (Status::Calibrated, None, None)
+        };
+        let mut result = CalibrationResult::new(
+            RobotInfo::of(&self.nominal),
             parameters,
-            tracker_frame: FrameVec::from_tracker_frame(&self.registration.frame),
+            FrameVec::from_tracker_frame(&self.registration.frame),
             errors,
-            extra,
-        }
+            status,
+        );
+        result.partial_reason = partial_reason;
+        result.implausible_reason = implausible_reason;
+        result.settings = Some(settings);
+        result.registration = Some(registration);
+        result.identifiability = Some(Identifiability {
+            rank_tolerance: id.rank_tolerance,
+            condition_number: id.condition_number,
+            condition_limit: crate::identification::MAX_CONDITION_NUMBER,
+            ill_conditioned: id.ill_conditioned(),
+            n_identified: id.identified.len(),
+            n_fixed: id.fixed.len(),
+            identified,
+            fixed,
+        });
+        result.solver = Some(Solver {
+            objective,
+            termination: last.termination.describe(),
+            converged: last.termination.converged(),
+            iterations: self.stages.iter().map(|s| s.report.iterations).sum(),
+            final_objective: last.final_objective,
+            stages,
+        });
+        result.uncertainty = Some(Uncertainty {
+            sigma_mm: self.covariance.sigma_mm,
+            std,
+            most_correlated,
+            std_unavailable: self.covariance.unavailable.clone(),
+        });
+        result.downweighted_points = Some(
+            self.downweighted
+                .iter()
+                .map(|d| DownweightedEntry {
+                    line: d.line,
+                    error_mm: d.error_mm,
+                    weight: d.weight,
+                })
+                .collect(),
+        );
+        result.points = Some(Points {
+            calibration: point_entries(&self.calibration),
+            validation: self.validation.as_ref().map(point_entries),
+        });
+        result.plausibility = Some(self.plausibility.to_section());
+        result
     }
 }

@@ -6,7 +6,12 @@
 
 use crate::error::{Error, Result};
 use crate::frame::TrackerFrame;
-use crate::model::{JointType, Param, Robot, Unit};
+use crate::io::result_sections::{
+    sorted_opt, DownweightedEntry, Identifiability, PlausibilitySection, Points, Registration,
+    Settings, Solver, Uncertainty,
+};
+use crate::model::description::{ControllerDescription, JointDescription, RobotDescription};
+use crate::model::{Convention, JointType, Param, Robot, Unit};
 use crate::stats::ErrorStats;
 use indexmap::IndexMap;
 use serde::{Deserialize, Serialize};
@@ -50,7 +55,10 @@ impl NotCalibrated {
     }
 }
 
-/// Which robot a result belongs to.
+/// Which robot a result belongs to (the `robot` key): its name, shape and, in results written
+/// since results became self-contained, its whole nominal description (DESIGN.md "Result JSON
+/// additions"): the robot file's keys `base`, `tool`, `tool_correction`, `joints` and
+/// `controller` (see [`RobotDescription`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RobotInfo {
     /// The robot's name.
@@ -63,17 +71,119 @@ pub struct RobotInfo {
     /// joint types existed: all revolute.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub joint_types: Vec<JointType>,
+    /// The base frame vector B (mm, deg).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base: Option<[f64; 6]>,
+    /// The nominal tool vector T0 (mm, deg).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool: Option<[f64; 6]>,
+    /// The nominal model's tool correction T (mm, deg), when not zero.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool_correction: Option<[f64; 6]>,
+    /// The joints as the robot file gives them; empty (absent) in results that do not embed
+    /// their robot.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub joints: Vec<JointDescription>,
+    /// The controller's axis map, if the robot has one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub controller: Option<ControllerDescription>,
 }
 
 impl RobotInfo {
-    /// The description of `robot`.
-    pub fn of(robot: &Robot) -> RobotInfo {
+    /// The name and shape of `robot` without its description (what a simulation's truth file
+    /// records).
+    pub fn shape_of(robot: &Robot) -> RobotInfo {
         RobotInfo {
             name: robot.name().to_owned(),
             dof: robot.dof(),
             convention: robot.convention().as_str().to_owned(),
             joint_types: robot.joint_types().to_vec(),
+            base: None,
+            tool: None,
+            tool_correction: None,
+            joints: Vec::new(),
+            controller: None,
         }
+    }
+
+    /// The description of `robot`, embedded whole.
+    pub fn of(robot: &Robot) -> RobotInfo {
+        let d = RobotDescription::of(robot);
+        RobotInfo {
+            name: d.name,
+            dof: robot.dof(),
+            convention: d.convention.as_str().to_owned(),
+            joint_types: robot.joint_types().to_vec(),
+            base: Some(d.base),
+            tool: Some(d.tool),
+            tool_correction: d.tool_correction,
+            joints: d.joints,
+            controller: d.controller,
+        }
+    }
+
+    /// The embedded robot description, if the result has one (`joints` present).
+    pub fn description(&self) -> Option<RobotDescription> {
+        if self.joints.is_empty() {
+            return None;
+        }
+        let convention = match self.convention.as_str() {
+            "mdh" => Convention::Mdh,
+            "dh" => Convention::Dh,
+            _ => return None,
+        };
+        Some(RobotDescription {
+            name: self.name.clone(),
+            convention,
+            base: self.base.unwrap_or_default(),
+            tool: self.tool.unwrap_or_default(),
+            tool_correction: self.tool_correction,
+            joints: self.joints.clone(),
+            controller: self.controller.clone(),
+        })
+    }
+
+    /// The nominal robot the result embeds, if it does (`Ok(None)` for results written before
+    /// results embedded their robot). The description is checked as a robot file would be;
+    /// errors name `path`, the field under `robot` and, given the JSON `text`, the line of that
+    /// field.
+    pub fn nominal_robot(&self, path: &Path, text: Option<&str>) -> Result<Option<Robot>> {
+        let line = |field: &str| text.and_then(|t| crate::io::json_keys::line_of_key(t, field));
+        let bad = |field: &str, msg: String| Error::parse(path, line(field), Some(field), msg);
+        if self.joints.is_empty() {
+            return Ok(None);
+        }
+        let Some(d) = self.description() else {
+            return Err(bad(
+                "robot.convention",
+                format!(
+                    "`{}` is not a convention: use \"mdh\" or \"dh\"",
+                    self.convention
+                ),
+            ));
+        };
+        // `dof` and `joint_types` are checked against the robot used, this one included, by
+        // `calibrated_robot`.
+        let robot = d.to_robot(path).map_err(|e| match e {
+            Error::Parse {
+                path,
+                field,
+                message,
+                ..
+            } => {
+                let field = field.map_or("robot".to_owned(), |f| format!("robot.{f}"));
+                // The robot file's 1-based joint and row numbers are 0-based in the key path.
+                let line = line(&zero_based(&field)).or_else(|| line("robot"));
+                Error::Parse {
+                    path,
+                    line,
+                    field: Some(field),
+                    message,
+                }
+            }
+            other => other,
+        })?;
+        Ok(Some(robot))
     }
 
     /// Checks that the joint types match `robot`'s (an absent list means all revolute); `what`
@@ -195,9 +305,108 @@ pub struct CalibrationResult {
     pub tracker_frame: FrameVec,
     /// Error tables.
     pub errors: ErrorTables,
-    /// Any further keys (identifiability, solver report, settings, ...).
+    /// Points the robust loss down-weighted.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub downweighted_points: Option<Vec<DownweightedEntry>>,
+    /// Which parameters the data identify.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub identifiability: Option<Identifiability>,
+    /// Why the fit failed the plausibility gate (with `status` implausible).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub implausible_reason: Option<String>,
+    /// Why the result is partial (with `status` partial).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub partial_reason: Option<String>,
+    /// The plausibility gate's checks.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub plausibility: Option<PlausibilitySection>,
+    /// Per-point errors.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub points: Option<Points>,
+    /// The measurement frame fit.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub registration: Option<Registration>,
+    /// How the calibration was run.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub settings: Option<Settings>,
+    /// How the identification ended.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub solver: Option<Solver>,
+    /// Whether the result is a calibration; required on reading ([`KNOWN_STATUSES`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub status: Option<StatusValue>,
+    /// The estimates' covariance.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub uncertainty: Option<Uncertainty>,
+    /// Any further keys (from a newer robocal, or another tool).
     #[serde(flatten)]
     pub extra: serde_json::Map<String, serde_json::Value>,
+}
+
+/// What a result can be: its `status`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// [`STATUS_CALIBRATED`].
+    Calibrated,
+    /// [`STATUS_PARTIAL`].
+    Partial,
+    /// [`STATUS_IMPLAUSIBLE`].
+    Implausible,
+}
+
+impl Status {
+    /// The JSON value: one of [`KNOWN_STATUSES`].
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Status::Calibrated => STATUS_CALIBRATED,
+            Status::Partial => STATUS_PARTIAL,
+            Status::Implausible => STATUS_IMPLAUSIBLE,
+        }
+    }
+}
+
+/// A `status` as read: one robocal writes, or anything else (refused by
+/// [`CalibrationResult::parse`] with a message naming it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum StatusValue {
+    /// A status robocal writes.
+    Known(Status),
+    /// Any other JSON value.
+    Other(serde_json::Value),
 }
 
 impl CalibrationResult {
@@ -213,9 +422,10 @@ impl CalibrationResult {
     pub fn parse(text: &str, path: &Path) -> Result<CalibrationResult> {
         let r: CalibrationResult = crate::io::input::parse_json(text, path, "robocal result")?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        check_status(r.extra.get("status"), text, path)?;
+        check_status(r.status.as_ref(), text, path)?;
         check_parameters(&r.parameters, text, path)?;
         check_frame(&r.tracker_frame, "tracker_frame", text, path)?;
+        r.robot.nominal_robot(path, Some(text))?;
         let e = &r.errors;
         let tables = [
             ("calibration", Some(&e.calibration)),
@@ -252,23 +462,13 @@ impl CalibrationResult {
     /// converge (`solver.converged` = false). `None` for a calibration, and for files without
     /// these keys.
     pub fn partial_reason(&self) -> Option<String> {
-        let status = self.extra.get("status").and_then(|s| s.as_str());
-        let converged = self
-            .extra
-            .get("solver")
-            .and_then(|s| s.get("converged"))
-            .and_then(|c| c.as_bool());
-        if status != Some(STATUS_PARTIAL) && converged != Some(false) {
+        let converged = self.solver.as_ref().map(|s| s.converged);
+        if self.status() != Some(Status::Partial) && converged != Some(false) {
             return None;
         }
-        let reason = self.extra.get("partial_reason").and_then(|r| r.as_str());
-        let termination = self
-            .extra
-            .get("solver")
-            .and_then(|s| s.get("termination"))
-            .and_then(|t| t.as_str());
-        Some(match (reason, converged, termination) {
-            (Some(r), _, _) => r.to_owned(),
+        let termination = self.solver.as_ref().map(|s| s.termination.as_str());
+        Some(match (&self.partial_reason, converged, termination) {
+            (Some(r), _, _) => r.clone(),
             (None, Some(false), Some(t)) => format!("the solver {t}"),
             (None, Some(false), None) => "the solver did not converge".to_owned(),
             _ => format!("marked \"status\": \"{STATUS_PARTIAL}\""),
@@ -279,19 +479,50 @@ impl CalibrationResult {
     /// [`STATUS_IMPLAUSIBLE`] (`calibrate` wrote it on explicit request); `implausible_reason`
     /// lists the failed checks.
     pub fn implausible_reason(&self) -> Option<String> {
-        let status = self.extra.get("status").and_then(|s| s.as_str());
-        if status != Some(STATUS_IMPLAUSIBLE) {
+        if self.status() != Some(Status::Implausible) {
             return None;
         }
         Some(
-            self.extra
-                .get("implausible_reason")
-                .and_then(|r| r.as_str())
-                .map_or_else(
-                    || "it failed the plausibility gate".to_owned(),
-                    |r| r.to_owned(),
-                ),
+            self.implausible_reason
+                .clone()
+                .unwrap_or_else(|| "it failed the plausibility gate".to_owned()),
         )
+    }
+
+    /// The `status`, when it is one robocal writes.
+    pub fn status(&self) -> Option<Status> {
+        match self.status {
+            Some(StatusValue::Known(s)) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// A result of the contract keys alone (no further sections), with `status`.
+    pub fn new(
+        robot: RobotInfo,
+        parameters: IndexMap<String, ParamEntry>,
+        tracker_frame: FrameVec,
+        errors: ErrorTables,
+        status: Status,
+    ) -> CalibrationResult {
+        CalibrationResult {
+            robot,
+            parameters,
+            tracker_frame,
+            errors,
+            downweighted_points: None,
+            identifiability: None,
+            implausible_reason: None,
+            partial_reason: None,
+            plausibility: None,
+            points: None,
+            registration: None,
+            settings: None,
+            solver: None,
+            status: Some(StatusValue::Known(status)),
+            uncertainty: None,
+            extra: serde_json::Map::new(),
+        }
     }
 
     /// Why this result is not a calibration to use, if it is not: partial
@@ -390,6 +621,32 @@ impl CalibrationResult {
     }
 }
 
+/// A robot-file field (`robot.joints[2].alpha`, `robot.controller.sign[1]`) as a JSON key path
+/// (`robot.joints[1].alpha`): the robot file counts joints and entries from 1, except in the
+/// frame vectors (`base[3]`).
+fn zero_based(field: &str) -> String {
+    if field.starts_with("robot.base[")
+        || field.starts_with("robot.tool[")
+        || field.starts_with("robot.tool_correction[")
+    {
+        return field.to_owned();
+    }
+    let mut out = String::with_capacity(field.len());
+    let mut rest = field;
+    while let Some(open) = rest.find('[') {
+        out.push_str(&rest[..=open]);
+        rest = &rest[open + 1..];
+        let close = rest.find(']').unwrap_or(rest.len());
+        match rest[..close].parse::<usize>() {
+            Ok(n) if n > 0 => out.push_str(&(n - 1).to_string()),
+            _ => out.push_str(&rest[..close]),
+        }
+        rest = &rest[close..];
+    }
+    out.push_str(rest);
+    out
+}
+
 /// Checks `v` against `range`; the error names the file, the field and its line in `text`.
 pub(crate) fn check_value(
     text: &str,
@@ -442,10 +699,10 @@ pub(crate) fn check_frame(f: &FrameVec, field: &str, text: &str, path: &Path) ->
 }
 
 /// Checks a result's `status`: present, and one robocal writes.
-fn check_status(status: Option<&serde_json::Value>, text: &str, path: &Path) -> Result<()> {
+fn check_status(status: Option<&StatusValue>, text: &str, path: &Path) -> Result<()> {
     let known = KNOWN_STATUSES.join(", ");
     let msg = match status {
-        Some(serde_json::Value::String(s)) if KNOWN_STATUSES.contains(&s.as_str()) => return Ok(()),
+        Some(StatusValue::Known(_)) => return Ok(()),
         None => {
             return Err(Error::parse(
                 path,
@@ -457,10 +714,12 @@ fn check_status(status: Option<&serde_json::Value>, text: &str, path: &Path) -> 
                 ),
             ))
         }
-        Some(serde_json::Value::String(s)) => {
+        Some(StatusValue::Other(serde_json::Value::String(s))) => {
             format!("`{s}` is not a status robocal writes ({known})")
         }
-        Some(other) => format!("{other} is not a status robocal writes ({known})"),
+        Some(StatusValue::Other(other)) => {
+            format!("{other} is not a status robocal writes ({known})")
+        }
     };
     let line = crate::io::json_keys::line_of_key(text, "status");
     Err(Error::parse(path, line, Some("status"), msg))
@@ -474,13 +733,11 @@ mod tests {
     fn good() -> Value {
         let nom = crate::model::presets::preset("kuka-kr480-r3330").unwrap();
         let s = ErrorStats::from_norms(&[1.0, 2.0]);
-        let mut extra = serde_json::Map::new();
-        extra.insert("status".into(), json!(STATUS_CALIBRATED));
-        let r = CalibrationResult {
-            robot: RobotInfo::of(&nom),
-            parameters: CalibrationResult::parameter_entries(&nom, &nom),
-            tracker_frame: FrameVec::from_tracker_frame(&TrackerFrame::identity()),
-            errors: ErrorTables {
+        let r = CalibrationResult::new(
+            RobotInfo::of(&nom),
+            CalibrationResult::parameter_entries(&nom, &nom),
+            FrameVec::from_tracker_frame(&TrackerFrame::identity()),
+            ErrorTables {
                 calibration: BeforeAfter {
                     before: s,
                     after: s,
@@ -490,8 +747,8 @@ mod tests {
                     after: s,
                 }),
             },
-            extra,
-        };
+            Status::Calibrated,
+        );
         serde_json::to_value(&r).unwrap()
     }
 

@@ -10,6 +10,7 @@
 //! `sin_cos` per joint; every mutation goes through [`Robot::set`] which keeps the cache valid.
 
 pub mod controller;
+pub mod description;
 pub mod family;
 mod joints;
 mod params;

@@ -6,6 +6,8 @@
 //! convention = "dh"            # "mdh" (Craig, the paper's Table I) or "dh" (standard)
 //! base = [0, 0, 0, 0, 0, 0]    # optional frame vector x, y, z (mm), A, B, C (deg)
 //! tool = [0, 0, 31, 0, 0, 0]   # nominal tool vector T0, same units (optional, default zero)
+//! tool_correction = [0, 0, 0, 0, 0, 0]  # the tool correction T already in the nominal model
+//!                              # (optional, default zero; what a result's embedded robot carries)
 //!
 //! [[joints]]                   # one table per joint, base to tip
 //! type = "revolute"            # or "prismatic" (optional, default revolute)
@@ -25,7 +27,7 @@
 //! ```
 
 use super::controller::{Controller, Coupling};
-use super::{Convention, JointLimit, JointType, Link, Robot};
+use super::{Convention, JointLimit, JointType, Link, Param, Robot};
 use crate::error::{Error, Result};
 use crate::ranges;
 use serde::Deserialize;
@@ -39,6 +41,7 @@ struct RobotFile {
     convention: Spanned<String>,
     base: Option<Spanned<Vec<Spanned<f64>>>>,
     tool: Option<Spanned<Vec<Spanned<f64>>>>,
+    tool_correction: Option<Spanned<Vec<Spanned<f64>>>>,
     joints: Vec<JointEntry>,
     controller: Option<Spanned<ControllerEntry>>,
 }
@@ -169,6 +172,7 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
     };
     let base = frame_vec(&file.base, "base")?;
     let tool0 = frame_vec(&file.tool, "tool")?;
+    let tool_correction = frame_vec(&file.tool_correction, "tool_correction")?;
     let mut links = Vec::with_capacity(file.joints.len());
     let mut limits = Vec::with_capacity(file.joints.len());
     let mut types = Vec::with_capacity(file.joints.len());
@@ -272,6 +276,9 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
         .map_err(|e| Error::parse(path, None, None, e.to_string()))?;
     for i in betas {
         robot.enable_beta(i)?;
+    }
+    for (k, v) in tool_correction.into_iter().enumerate() {
+        robot.set(Param::tool(k), v);
     }
     Ok(robot)
 }

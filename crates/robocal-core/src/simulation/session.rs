@@ -345,7 +345,7 @@ impl Simulation {
             .collect();
         TruthFile {
             generator: format!("robocal-core {}", env!("CARGO_PKG_VERSION")),
-            robot: RobotInfo::of(truth),
+            robot: RobotInfo::shape_of(truth),
             nominal: nominal.name().to_owned(),
             truth: self.truth_label.clone(),
             parameters: TruthFile::parameter_entries(nominal, truth),

@@ -25,13 +25,13 @@ pub mod similarity;
 mod tests;
 
 use crate::identification::solver::SolverReport;
+use crate::io::result_sections::{CauseEntry, CheckEntry, PlausibilitySection};
 use crate::model::{Param, Robot, Unit};
 use crate::observations::Observations;
 use crate::registration::Registration;
 use crate::stats::ErrorStats;
 use causes::Causes;
 use diagnosis::{explain, sig, unit_of_scale, Explanation};
-use serde_json::{json, Value};
 use similarity::{fit_similarity, Handedness};
 
 // The margins quoted below were measured with the release build on 148 good fits — the demo
@@ -469,49 +469,39 @@ impl Plausibility {
         lines.join("\n")
     }
 
-    /// The `plausibility` object of the result JSON.
-    pub fn to_json(&self) -> Value {
-        let num = |v: f64| if v.is_finite() { json!(v) } else { Value::Null };
-        let checks: Vec<Value> = self
+    /// The `plausibility` section of the result JSON.
+    pub fn to_section(&self) -> PlausibilitySection {
+        let checks = self
             .checks
             .iter()
-            .map(|c| {
-                let mut o = json!({
-                    "name": c.kind.name(),
-                    "measured": num(c.measured),
-                    "limit": c.limit,
-                    "unit": c.unit,
-                    "passed": c.passed,
-                    "detail": c.detail,
-                });
-                if let Some(cause) = &c.cause {
-                    o["cause"] = json!(cause);
-                }
-                o
+            .map(|c| CheckEntry {
+                name: c.kind.name().to_owned(),
+                measured: c.measured,
+                limit: c.limit,
+                unit: c.unit.to_owned(),
+                passed: c.passed,
+                detail: c.detail.clone(),
+                cause: c.cause.clone(),
             })
             .collect();
-        let mut o = json!({
-            "passed": self.passed(),
-            "reach_mm": self.reach_mm,
-            "checks": checks,
+        let likely_causes = (!self.explanations.is_empty()).then(|| {
+            self.explanations
+                .iter()
+                .map(|e| CauseEntry {
+                    cause: e.describe(),
+                    fit_rms_mm: e.rms_mm,
+                    scale: e.scale,
+                    mirrored: e.mirrored,
+                    unit: e.unit.map(|(u, _)| u.to_owned()),
+                    joints: e.joints.map(|j| j.describe()),
+                })
+                .collect()
         });
-        if !self.explanations.is_empty() {
-            o["likely_causes"] = Value::Array(
-                self.explanations
-                    .iter()
-                    .map(|e| {
-                        json!({
-                            "cause": e.describe(),
-                            "fit_rms_mm": e.rms_mm,
-                            "scale": e.scale,
-                            "mirrored": e.mirrored,
-                            "unit": e.unit.map(|(u, _)| u),
-                            "joints": e.joints.map(|j| j.describe()),
-                        })
-                    })
-                    .collect(),
-            );
+        PlausibilitySection {
+            passed: self.passed(),
+            reach_mm: self.reach_mm,
+            checks,
+            likely_causes,
         }
-        o
     }
 }

@@ -253,7 +253,7 @@ fn calibration_identifies_a_family_it_does_not_know() {
     }
     let worst = cal.calibration.after.iter().cloned().fold(0.0, f64::max);
     assert!(worst < 1e-6, "largest error after {worst} mm");
-    let result = cal.to_result(Default::default());
+    let result = cal.to_result();
     let entry = &result.parameters["qoffset4"];
     assert!(!entry.fixed && (entry.calibrated - deg[3]).abs() < 1e-6);
     assert_eq!(entry.unit, Unit::Deg);
