@@ -67,8 +67,7 @@ impl ParameterFamily for Beta {
         mut dw: Option<&mut [Vector3<f64>]>,
     ) {
         let n = robot.dof();
-        let mut k = 0;
-        for i in (0..n).filter(|&i| robot.beta_enabled(i)) {
+        for (k, i) in (0..n).filter(|&i| robot.beta_enabled(i)).enumerate() {
             // Rotation about the y axis after Rx(alpha) Tx(a), through that frame's origin.
             let f = match robot.convention() {
                 // M_i = F_{i-1} Rx Tx Ry: its y axis is unchanged by Ry; its origin is the pivot.
@@ -82,7 +81,6 @@ impl ParameterFamily for Beta {
             let (v, w) = pose.rotation_screw(y, f.translation.vector);
             dp[k] = v;
             put(&mut dw, k, w);
-            k += 1;
         }
     }
 }

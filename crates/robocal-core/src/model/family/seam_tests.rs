@@ -224,7 +224,7 @@ fn calibration_identifies_a_family_it_does_not_know() {
         plane: None,
         validation: None,
     };
-    let cal = calibrate(&nominal, data, &settings, &mut |_, _, _| {}).unwrap();
+    let cal = calibrate(&nominal, data, &settings, &()).unwrap();
     let qoffset = |i: usize| nominal.param_by_name(&format!("qoffset{i}")).unwrap();
     for i in [1, 6] {
         let why = cal.identifiability.fixed_reason(qoffset(i)).expect("fixed");
