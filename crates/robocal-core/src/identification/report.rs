@@ -8,7 +8,7 @@
 //! typed section of [`crate::io::result_sections`].
 
 use crate::identification::identifiability::FixReason;
-use crate::identification::objective::Loss;
+use crate::identification::objective::{Loss, Objective, RobustLoss};
 use crate::identification::pipeline::{Calibration, SetErrors};
 use crate::io::result::{BeforeAfter, ErrorTables, FrameVec, RobotInfo, Status};
 use crate::io::result_sections::{
@@ -39,6 +39,16 @@ fn loss_entry(l: &Loss) -> LossEntry {
     }
 }
 
+/// The result file's name of an objective.
+fn objective_name(objective: &Objective) -> ObjectiveName {
+    match objective {
+        Objective::SumOfNorms => ObjectiveName::SumOfNorms,
+        Objective::LeastSquares => ObjectiveName::LeastSquares,
+        Objective::Robust(RobustLoss::Cauchy) => ObjectiveName::RobustCauchy,
+        Objective::Robust(RobustLoss::Huber) => ObjectiveName::RobustHuber,
+    }
+}
+
 fn point_entries(s: &SetErrors) -> Vec<PointEntry> {
     (0..s.before.len())
         .map(|i| PointEntry {
@@ -54,27 +64,22 @@ impl Calibration {
     /// caller adds its file names (`robot_arg`, `data`, `validate`, ...) to them.
     pub fn to_result(&self) -> CalibrationResult {
         let mut parameters = CalibrationResult::parameter_entries(&self.nominal, &self.calibrated);
+        let pv = self.param_vector();
         for (name, e) in parameters.iter_mut() {
-            let p = self
-                .calibrated
-                .param_by_name(name)
-                .expect("names come from the robot");
-            if self.covariance.identifies(p) {
-                e.fixed = false;
-                e.std = self
-                    .covariance
-                    .std_of(p)
-                    .map(|sd| p.unit().from_internal(sd));
-                if let Some(why) = &self.covariance.unavailable {
-                    e.reason = Some(format!("identified; standard deviation unavailable: {why}"));
+            let entry = pv.by_name(name).expect("names come from the robot");
+            match &entry.fixed {
+                None => {
+                    e.fixed = false;
+                    e.std = entry.std.map(|sd| entry.display(sd));
+                    if let Some(why) = &self.covariance.unavailable {
+                        e.reason =
+                            Some(format!("identified; standard deviation unavailable: {why}"));
+                    }
                 }
-            } else {
-                e.fixed = true;
-                e.reason = Some(
-                    self.identifiability
-                        .fixed_reason(p)
-                        .map_or("fixed".to_string(), |f| f.describe()),
-                );
+                Some(f) => {
+                    e.fixed = true;
+                    e.reason = Some(f.describe());
+                }
             }
         }
         let errors = ErrorTables {
@@ -89,10 +94,9 @@ impl Calibration {
         };
         let id = &self.identifiability;
         let rms = |p: Param| {
-            id.column_rms
-                .iter()
-                .find(|(q, _)| *q == p)
-                .map_or(f64::NAN, |(_, v)| *v / unit_factor(p))
+            pv.get(p)
+                .and_then(|e| e.rms_effect)
+                .map_or(f64::NAN, |v| v / unit_factor(p))
         };
         let identified = id
             .identified
@@ -187,7 +191,7 @@ impl Calibration {
             .collect();
         let last = self.solver();
         let s = &self.settings;
-        let objective = ObjectiveName::of(&s.objective);
+        let objective = objective_name(&s.objective);
         let settings = Settings {
             objective,
             robust_scale_mm: self.robust_scale_mm,

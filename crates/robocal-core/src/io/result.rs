@@ -236,43 +236,7 @@ pub struct ParamEntry {
     pub reason: Option<String>,
 }
 
-/// A tracker frame's vector in mm and degrees, as a JSON object (the form of a
-/// [`TrackerFrame`] in files).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct FrameVec {
-    /// x (mm).
-    pub x: f64,
-    /// y (mm).
-    pub y: f64,
-    /// z (mm).
-    pub z: f64,
-    /// A, rotation about z (deg).
-    pub a: f64,
-    /// B, rotation about y (deg).
-    pub b: f64,
-    /// C, rotation about x (deg).
-    pub c: f64,
-}
-
-impl FrameVec {
-    /// The frame vector of a tracker frame.
-    pub fn from_tracker_frame(f: &TrackerFrame) -> FrameVec {
-        let v = f.vector_deg();
-        FrameVec {
-            x: v[0],
-            y: v[1],
-            z: v[2],
-            a: v[3],
-            b: v[4],
-            c: v[5],
-        }
-    }
-
-    /// The tracker frame this vector describes.
-    pub fn to_tracker_frame(&self) -> TrackerFrame {
-        TrackerFrame::from_vector_deg(&[self.x, self.y, self.z, self.a, self.b, self.c])
-    }
-}
+pub use super::result_sections::FrameVec;
 
 /// Error statistics before (nominal model, fitted frame) and after calibration.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -6,7 +6,7 @@
 //! alphabetically, as results have always been written. A non-finite number is written as `null`
 //! (JSON has no NaN) and read back as NaN ([`nullable`]).
 
-use crate::io::result::FrameVec;
+use crate::frame::TrackerFrame;
 use crate::stats::ErrorStats;
 use crate::unit::Unit;
 use serde::{Deserialize, Serialize, Serializer};
@@ -68,17 +68,6 @@ pub enum ObjectiveName {
 }
 
 impl ObjectiveName {
-    /// The name of `objective`.
-    pub fn of(objective: &crate::identification::objective::Objective) -> ObjectiveName {
-        use crate::identification::objective::{Objective, RobustLoss};
-        match objective {
-            Objective::SumOfNorms => ObjectiveName::SumOfNorms,
-            Objective::LeastSquares => ObjectiveName::LeastSquares,
-            Objective::Robust(RobustLoss::Cauchy) => ObjectiveName::RobustCauchy,
-            Objective::Robust(RobustLoss::Huber) => ObjectiveName::RobustHuber,
-        }
-    }
-
     /// The objective as a phrase, with the paper's equation where it has one.
     pub fn phrase(self) -> &'static str {
         match self {
@@ -520,4 +509,42 @@ pub struct PlausibilitySection {
     /// Likely causes of a failure.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub likely_causes: Option<Vec<CauseEntry>>,
+}
+
+/// A tracker frame's vector in mm and degrees, as a JSON object (the form of a
+/// [`TrackerFrame`] in files).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FrameVec {
+    /// x (mm).
+    pub x: f64,
+    /// y (mm).
+    pub y: f64,
+    /// z (mm).
+    pub z: f64,
+    /// A, rotation about z (deg).
+    pub a: f64,
+    /// B, rotation about y (deg).
+    pub b: f64,
+    /// C, rotation about x (deg).
+    pub c: f64,
+}
+
+impl FrameVec {
+    /// The frame vector of a tracker frame.
+    pub fn from_tracker_frame(f: &TrackerFrame) -> FrameVec {
+        let v = f.vector_deg();
+        FrameVec {
+            x: v[0],
+            y: v[1],
+            z: v[2],
+            a: v[3],
+            b: v[4],
+            c: v[5],
+        }
+    }
+
+    /// The tracker frame this vector describes.
+    pub fn to_tracker_frame(&self) -> TrackerFrame {
+        TrackerFrame::from_vector_deg(&[self.x, self.y, self.z, self.a, self.b, self.c])
+    }
 }

@@ -5,7 +5,7 @@
 //! frame the link's constant part starts from, a translates along that axis, d translates along
 //! the joint axis and phi turns about it (for a revolute joint, phi's column is the joint's).
 
-use super::{priority, put, FamilyId, ParameterFamily, PoseFrames};
+use super::{priority, FamilyId, ParameterFamily, PoseFrames};
 use crate::model::{Convention, Param, Robot, Unit};
 use nalgebra::Vector3;
 
@@ -90,31 +90,40 @@ impl ParameterFamily for Link {
         robot: &Robot,
         pose: &PoseFrames,
         dp: &mut [Vector3<f64>],
-        mut dw: Option<&mut [Vector3<f64>]>,
+        dw: Option<&mut [Vector3<f64>]>,
     ) {
         let n = robot.dof();
         let p = pose.point;
-        let x = |i: usize| -> Vector3<f64> { pose.link[i].rotation.matrix().column(0).into() };
-        let z = |i: usize| -> Vector3<f64> { pose.axis[i].rotation.matrix().column(2).into() };
+        let (alpha, rest) = dp.split_at_mut(n);
+        let (d, rest) = rest.split_at_mut(n);
+        let (a, phi) = rest.split_at_mut(n);
         for i in 0..n {
-            // alpha_i: rotation about the x axis of the link frame the constant part starts from,
-            // through its origin (MDH: Rx comes first) or that origin moved by a (DH: Tx(a) Rx).
             let f = &pose.link[i];
+            let x: Vector3<f64> = f.rotation.matrix().column(0).into();
+            // alpha_i: rotation about the x axis of the link frame the constant part starts
+            // from, through its origin (MDH: Rx comes first) or that origin moved by a (DH:
+            // Tx(a) Rx).
             let o = match robot.convention() {
                 Convention::Mdh => f.translation.vector,
-                Convention::Dh => f.translation.vector + x(i) * robot.links[i].a,
+                Convention::Dh => f.translation.vector + x * robot.links[i].a,
             };
-            dp[i] = x(i).cross(&(p - o));
-            put(&mut dw, i, x(i));
-            // d_i: translation along the joint axis.
-            dp[n + i] = z(i);
-            put(&mut dw, n + i, Vector3::zeros());
+            alpha[i] = x.cross(&(p - o));
             // a_i: translation along the x axis of the link frame.
-            dp[2 * n + i] = x(i);
-            put(&mut dw, 2 * n + i, Vector3::zeros());
+            a[i] = x;
+            let g = &pose.axis[i];
+            let z: Vector3<f64> = g.rotation.matrix().column(2).into();
+            // d_i: translation along the joint axis.
+            d[i] = z;
             // phi_i: rotation about the joint axis.
-            dp[3 * n + i] = z(i).cross(&(p - pose.axis[i].translation.vector));
-            put(&mut dw, 3 * n + i, z(i));
+            phi[i] = z.cross(&(p - g.translation.vector));
+        }
+        if let Some(dw) = dw {
+            for i in 0..n {
+                dw[i] = pose.link[i].rotation.matrix().column(0).into();
+                dw[n + i] = Vector3::zeros();
+                dw[2 * n + i] = Vector3::zeros();
+                dw[3 * n + i] = pose.axis[i].rotation.matrix().column(2).into();
+            }
         }
     }
 }
