@@ -21,6 +21,14 @@
 //! Errors about settings name the setting, never a command-line flag: the field of the settings
 //! struct (`noise_mm`, `gravity.payload_kg`, `identifiability.fix`), as the `field` of
 //! [`Error::Invalid`] or in backticks inside a message. A front end maps them to its own words.
+//!
+//! The model is open at two seams. A parameter family ([`ParameterFamily`], `model/family/`: the
+//! link table, Hayati tilts, base and tool today) contributes named, unit-carrying parameters and
+//! their Jacobian columns as screws at the tool; a measurement kind ([`MeasurementKind`],
+//! `observations/kinds/`: one reflector's point today) turns those screws into its residual
+//! rows. Problem assembly, identifiability, the solver, the covariance, the result
+//! ([`ParamVector`]) and the tables use both without knowing which they are: adding a family or
+//! a kind is adding a file and a registry line.
 #![warn(missing_docs)]
 
 pub mod compensation;
@@ -45,13 +53,17 @@ mod messages_tests;
 
 pub use compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
 pub use error::{Error, Result};
-pub use frame::{frame_vector, pose, Frame};
+pub use frame::{frame_vector, pose, Frame, TrackerFrame};
+pub use identification::{ParamEntry, ParamVector};
 pub use io::robot::{load_robot, load_robot_file};
 pub use kinematics::poe::{Poe, Twist};
 pub use model::presets::{preset, PRESETS};
 pub use model::robot_file::parse_robot_toml;
 pub use model::{
-    Controller, Convention, JointLimit, JointSpace, JointType, Link, Param, Robot, Unit, MAX_JOINTS,
+    Controller, Convention, FamilyId, JointLimit, JointSpace, JointType, Link, Param,
+    ParameterFamily, PoseFrames, Robot, Unit, MAX_JOINTS,
 };
+pub use observations::kinds::{Measurability, MeasurementKind};
+pub use observations::Observations;
 pub use progress::{Observer, Stage};
 pub use stats::ErrorStats;

@@ -4,7 +4,7 @@
 //! `x,y,z` (mm, tracker frame); other columns (`id`, `set`, ...) are carried through.
 //!
 //! The same reader serves joint-only files (desired or commanded joints) with
-//! [`Positions::Forbidden`] or [`Positions::Optional`]. CRLF line endings and a UTF-8 byte-order
+//! [`Positions::Ignored`] or [`Positions::Optional`]. CRLF line endings and a UTF-8 byte-order
 //! mark are accepted. Every rejection names the file, the line and the column; joint values and
 //! positions must be within their plausible ranges ([`crate::ranges`]).
 

@@ -2,7 +2,7 @@
 //! writes ([`crate::identification::pipeline::Calibration::to_result`]) and every reader (the
 //! CLI, the report) reads. Readers see exactly the schema the writer uses.
 //!
-//! The result writes each section through [`sorted`], which orders the keys of every object
+//! The result writes each section through `sorted`, which orders the keys of every object
 //! alphabetically, as results have always been written. A non-finite number is written as `null`
 //! (JSON has no NaN) and read back as NaN ([`nullable`]).
 

@@ -1,6 +1,6 @@
 //! The best similarity transform between two point sets (Umeyama, 1991), with a rotation or a
 //! reflection: the measure behind the unit and handedness checks. It is the registration's
-//! Procrustes fit ([`crate::registration::procrustes`]) with a free scale, and its RMS.
+//! Procrustes fit (`registration::procrustes`) with a free scale, and its RMS.
 
 use crate::registration::procrustes::{fit_procrustes, Scale};
 use nalgebra::Vector3;
