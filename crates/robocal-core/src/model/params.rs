@@ -89,7 +89,8 @@ impl Param {
 
     /// The DESIGN.md name: `alpha1`, `d3`, `base_x`, `tool_c`, ...
     pub fn name(self) -> String {
-        family::instantiate(self.family().templates()[self.template()], self.index())
+        let template = self.family().templates().get(self.template()).copied();
+        family::instantiate(template.unwrap_or("?{j}"), self.index())
     }
 
     /// Parses a name (the inverse of [`Param::name`]) against every family's templates; `None` if
