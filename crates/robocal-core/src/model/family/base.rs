@@ -30,11 +30,7 @@ impl ParameterFamily for Base {
     }
 
     fn unit(&self, p: Param) -> Unit {
-        if p.index() < 3 {
-            Unit::Mm
-        } else {
-            Unit::Deg
-        }
+        super::axis_unit(p.index())
     }
 
     fn params(&self, _robot: &Robot, out: &mut Vec<Param>) {

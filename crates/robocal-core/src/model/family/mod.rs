@@ -162,6 +162,16 @@ static REGISTRY: [&dyn ParameterFamily; 5] = [
 /// Frame-vector component names, the `{axis}` placeholder's values.
 pub const AXES: [&str; 6] = ["x", "y", "z", "a", "b", "c"];
 
+/// The unit of frame-vector component `index` (`x, y, z` in mm, `a, b, c` in degrees): the
+/// unit of every `{axis}` template.
+pub fn axis_unit(index: usize) -> Unit {
+    if index < 3 {
+        Unit::Mm
+    } else {
+        Unit::Deg
+    }
+}
+
 /// A template's name at `index`: `{j}` becomes `index + 1`, `{axis}` the component name.
 pub fn instantiate(template: &str, index: usize) -> String {
     if template.contains("{j}") {

@@ -31,11 +31,7 @@ impl ParameterFamily for Tool {
     }
 
     fn unit(&self, p: Param) -> Unit {
-        if p.index() < 3 {
-            Unit::Mm
-        } else {
-            Unit::Deg
-        }
+        super::axis_unit(p.index())
     }
 
     fn params(&self, _robot: &Robot, out: &mut Vec<Param>) {
