@@ -367,16 +367,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         &bar,
     );
     bar.finish();
-    let cal = result
-        .map_err(|e| match e {
-            robocal_core::Error::Numerical(m) if m.contains("rank tolerance") => {
-                robocal_core::Error::Numerical(
-                    m.replace("rank tolerance", "rank tolerance (--rank-tol)"),
-                )
-            }
-            e => e,
-        })
-        .with_context(|| format!("calibrating from {}", s.data.display()))?;
+    let cal = result.with_context(|| format!("calibrating from {}", s.data.display()))?;
     let converged = cal.solver().termination.converged();
     let implausible = cal.plausibility.implausible();
     print_report(&cal, converged, implausible);

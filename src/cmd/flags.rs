@@ -43,7 +43,10 @@ pub fn flag_for(setting: &str) -> Option<&'static str> {
 
 /// Phrases the library uses for a setting that is no field of its settings structs, and the flag
 /// that sets it.
-const PHRASES: &[(&str, &str)] = &[("wrong nominal robot", "wrong --robot")];
+const PHRASES: &[(&str, &str)] = &[
+    ("wrong nominal robot", "wrong --robot"),
+    ("rank tolerance", "rank tolerance (--rank-tol)"),
+];
 
 /// `text` with every setting named in backticks (`` `noise_mm` ``) replaced by its flag.
 pub fn with_flags(text: &str) -> String {
@@ -84,6 +87,19 @@ pub fn cli_text(e: &(dyn std::error::Error + 'static)) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The identifiability's numerical failures speak of the rank tolerance in prose; the user
+    /// learns its flag.
+    #[test]
+    fn the_rank_tolerance_is_named_with_its_flag() {
+        let e = robocal_core::Error::Numerical(
+            "the least independent is d3 (2.0e-9, rank tolerance 1e-6). Raise the rank tolerance \
+             above 2.0e-9 to fix it"
+                .into(),
+        );
+        let t = cli_text(&e);
+        assert_eq!(t.matches("rank tolerance (--rank-tol)").count(), 2, "{t}");
+    }
 
     #[test]
     fn setting_errors_name_the_flag() {

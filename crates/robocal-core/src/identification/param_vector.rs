@@ -91,17 +91,22 @@ impl ParamVector {
                     .binary_search_by_key(&p, |(q, _)| *q)
                     .ok()
                     .map(|k| cov_pos[k].1);
+                // The analysis gives every parameter a verdict: identified (then the covariance
+                // has it) or fixed with a reason. A parameter it never saw can only have been
+                // held back by the caller, which is what `User` says.
                 let fixed_why = match cov_j {
                     Some(_) => None,
                     None => Some(
                         fixed
                             .binary_search_by_key(&p, |f| f.param)
                             .ok()
-                            .map(|k| fixed[k].clone())
-                            .unwrap_or(FixedParam {
-                                param: p,
-                                reason: crate::identification::FixReason::User,
-                            }),
+                            .map_or_else(
+                                || FixedParam {
+                                    param: p,
+                                    reason: crate::identification::FixReason::User,
+                                },
+                                |k| fixed[k].clone(),
+                            ),
                     ),
                 };
                 ParamEntry {
