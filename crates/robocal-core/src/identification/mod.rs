@@ -5,8 +5,9 @@
 //!   ([`crate::observations`]): calibration, validation and plane points;
 //! - [`objective`]: sum of norms (eq. 4), least squares and robust losses;
 //! - [`identifiability`]: which parameters are identifiable, and why the others are fixed;
-//! - [`kinds`]: measurement kinds, the rows each observation contributes;
-//! - [`system`]: the per-point accumulation of the normal equations (the hot loop);
+//! - [`system`]: the per-observation accumulation of the normal equations (the hot loop), from
+//!   the rows of the observations' measurement kind ([`kinds`], kept beside
+//!   [`crate::observations`]) and the parameter families' screws ([`crate::model::family`]);
 //! - [`solver`]: Levenberg–Marquardt with reweighting and a termination report;
 //! - [`param_vector`]: every parameter with its name, unit, family, values and verdicts;
 //! - [`covariance`]: standard deviations and correlations of the estimates;
