@@ -15,6 +15,7 @@ use robocal_core::identification::{
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::result_sections::RowsOutside;
 use robocal_core::io::{read_measurements, Positions};
+use robocal_core::observations::{TrackerSigma, Weighting};
 use robocal_core::{ErrorStats, Param, Robot};
 use std::path::{Path, PathBuf};
 
@@ -82,6 +83,25 @@ pub struct CalibrateArgs {
     /// unless given --accept-implausible too.
     #[arg(long)]
     accept_implausible: bool,
+    /// Weighted fitting with a tracker uncertainty model: 1 sigma per axis = FIXED_MM +
+    /// PER_M_MM per metre of distance from the tracker. Rows with a `sigma_mm` column keep their
+    /// own. Without either, every point weighs the same.
+    #[arg(
+        long,
+        value_name = "FIXED_MM,PER_M_MM",
+        value_delimiter = ',',
+        num_args = 2
+    )]
+    tracker_sigma: Vec<f64>,
+    /// 6-DoF data (a,b,c columns): how many mm of position error one degree of orientation
+    /// error counts as in the fit [default: 3, a 6-DoF probe's typical 0.03 mm against 0.01 deg].
+    #[arg(long, value_name = "MM_PER_DEG")]
+    orientation_weight: Option<f64>,
+    /// The validation points were measured after the tracker moved (another station): fit
+    /// them a rigid frame of their own. Their errors then show the calibrated model's shape
+    /// accuracy, not the tracker's move. Without it, such a set is an error (exit 3).
+    #[arg(long)]
+    validate_refit_frame: bool,
     /// Where to write the result JSON.
     #[arg(long)]
     out: PathBuf,
@@ -103,6 +123,31 @@ enum RobustArg {
     Cauchy,
     /// Huber: bounded influence.
     Huber,
+}
+
+/// The weighting of `--tracker-sigma` and `--orientation-weight`.
+pub(crate) fn weighting(
+    tracker_sigma: &[f64],
+    orientation_weight: Option<f64>,
+) -> anyhow::Result<Weighting> {
+    let mut w = Weighting::default();
+    if let [fixed, per_m] = tracker_sigma {
+        w.tracker = Some(TrackerSigma::new(*fixed, *per_m).map_err(|_| {
+            exit::usage(format!(
+                "--tracker-sigma {fixed},{per_m}: expected FIXED_MM,PER_M_MM, both non-negative \
+                 and at most 1000, not both zero (e.g. 0.0075,0.003)"
+            ))
+        })?);
+    }
+    if let Some(m) = orientation_weight {
+        if !(m > 0.0 && m.is_finite() && m <= 1e6) {
+            return Err(exit::usage(format!(
+                "--orientation-weight {m}: expected a positive number of mm per degree"
+            )));
+        }
+        w.mm_per_deg = m;
+    }
+    Ok(w)
 }
 
 /// Parses a list of parameter names, naming every unknown one at once.
@@ -291,6 +336,8 @@ impl TryFrom<&CalibrateArgs> for Settings {
                 max_iterations: a.max_iterations,
                 ..Default::default()
             },
+            weighting: weighting(&a.tracker_sigma, a.orientation_weight)?,
+            validation_refit_frame: a.validate_refit_frame,
         };
         Ok(Settings {
             robot_arg: a.robot.clone(),

@@ -31,6 +31,9 @@ const FLAGS: &[(&str, &str)] = &[
     ("identifiability.free", "--free"),
     ("identifiability.rank_tolerance", "--rank-tol"),
     ("robust_scale_mm", "--robust-scale"),
+    ("weighting.tracker", "--tracker-sigma"),
+    ("validation_refit_frame", "--validate-refit-frame"),
+    ("orientation_mm_per_deg", "--orientation-weight"),
     // compensation::DampedLeastSquares
     ("tolerance_mm", "--tolerance-mm"),
     ("max_iterations", "--max-iterations"),

@@ -111,7 +111,7 @@ fn verification_reduces_measured_errors_5x_and_matches_the_prediction() {
     )
     .unwrap();
     let cal = calibration.calibrated.clone();
-    let frame = calibration.registration.frame;
+    let frame = *calibration.tracker_frame();
     assert_eq!(calibration.identifiability.identified.len(), 26);
     let ev_before = evaluate(&nom, &cal, &frame, &before, Against::Model).unwrap();
     let uncompensated = ev_before.series[0].stats;

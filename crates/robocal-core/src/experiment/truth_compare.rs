@@ -52,7 +52,7 @@ pub fn compare_with_truth(
             exact.push(obs.q(i), tracker.to_tracker(&p), obs.line(i))?;
         }
     }
-    let frame = &calibration.registration.frame;
+    let frame = calibration.tracker_frame();
     let problem = Problem::new(
         nominal,
         &calibration.identifiability.identified,

@@ -17,7 +17,8 @@
 //! `--free d3` keeps d3 and fixes d2); parameters in `--fix` are left out.
 
 use crate::error::{Error, Result};
-use crate::identification::kinds::ToolState;
+use crate::frame::TrackerFrame;
+use crate::identification::system::Problem;
 use crate::identification::Observations;
 use crate::model::{Param, Robot};
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -96,6 +97,15 @@ pub enum FixReason {
         /// The column's independence (below the rank tolerance).
         independence: f64,
     },
+    /// Independent in principle, but the data cannot pin it: its standard deviation predicted
+    /// at the start of the identification exceeds a third of the largest move a calibration may
+    /// plausibly make ([`crate::identification::precision`]).
+    Undetermined {
+        /// The predicted standard deviation (display unit).
+        std: f64,
+        /// The limit it exceeds (display unit).
+        limit: f64,
+    },
 }
 
 /// A parameter held at its nominal value, with the reason.
@@ -114,6 +124,13 @@ impl FixedParam {
             FixReason::User => "fixed on request".to_string(),
             FixReason::NoEffect => "no effect on the tool point".to_string(),
             FixReason::Unseen { what } => format!("no effect on the tool point ({what})"),
+            FixReason::Undetermined { std, limit } => {
+                let u = self.param.unit().as_str();
+                format!(
+                    "not determined by these data: predicted std {std:.3} {u}, above {limit:.3} \
+                     {u} (a third of the largest plausible move)"
+                )
+            }
             FixReason::Duplicate { of, .. } => {
                 let names: Vec<String> = of.iter().map(|(p, _)| p.name()).collect();
                 match names.len() {
@@ -202,8 +219,8 @@ pub fn jacobian_r(robot: &Robot, obs: &Observations) -> Reduced {
     let n = robot.param_count();
     let kind = obs.kind();
     let rows = kind.rows();
-    let sees_w = kind.measurability().orientation;
-    let cols: Vec<usize> = (0..n).collect();
+    let all = robot.param_list();
+    let problem = Problem::new(robot, all, obs, &TrackerFrame::identity());
     let idx: Vec<usize> = (0..obs.len()).collect();
     let r_of = |points: &[usize]| -> (DMatrix<f64>, Vec<f64>) {
         let mut r = DMatrix::<f64>::zeros(0, n);
@@ -216,13 +233,7 @@ pub fn jacobian_r(robot: &Robot, obs: &Observations) -> Reduced {
             let mut m = DMatrix::<f64>::zeros(top + rows * block.len(), n);
             m.view_mut((0, 0), (top, n)).copy_from(&r);
             for (b, &i) in block.iter().enumerate() {
-                let q = obs.q(i);
-                let point = robot.tool_screw_jacobians(q, None, Some(&mut jp), Some(&mut jw));
-                let tool = ToolState {
-                    point,
-                    rotation: sees_w.then(|| *robot.tool_pose(q).rotation.matrix()),
-                };
-                kind.jacobian_rows(&tool, &jp, sees_w.then_some(&jw[..]), &cols, &mut jr);
+                problem.model_rows(robot, i, &mut jp, &mut jw, &mut jr);
                 for a in 0..rows {
                     for c in 0..n {
                         m[(top + rows * b + a, c)] = jr[a * n + c];

@@ -22,6 +22,7 @@ pub mod objective;
 pub mod param_vector;
 pub mod pipeline;
 pub mod plausibility;
+pub mod precision;
 pub mod report;
 pub mod solver;
 pub mod split;
@@ -29,6 +30,8 @@ pub mod system;
 
 #[cfg(test)]
 mod conditioning_tests;
+#[cfg(test)]
+mod targets_tests;
 #[cfg(test)]
 mod tests;
 

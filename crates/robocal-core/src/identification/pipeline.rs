@@ -12,19 +12,24 @@
 use crate::error::{Error, Result};
 use crate::identification::covariance::Covariance;
 use crate::identification::identifiability::{
-    analyze, Identifiability, IdentifiabilityOptions, MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
+    analyze, FixReason, Identifiability, IdentifiabilityOptions, MAX_CONDITION_NUMBER,
+    MIN_RANK_TOLERANCE,
 };
 use crate::identification::objective::{
     Loss, Objective, RobustLoss, CHI3_MEDIAN, ROBUST_SCALE_SIGMAS, SUM_OF_NORMS_SMOOTHING_MM,
 };
 use crate::identification::param_vector::ParamVector;
 use crate::identification::plausibility::{self, Plausibility};
+use crate::identification::precision;
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
 use crate::observations::Observations;
+use crate::observations::Weighting;
 use crate::progress::{self, Observer};
-use crate::registration::{register, Registration, RegistrationObjective, RegistrationOptions};
+use crate::registration::{
+    fit_tools, register, Registration, RegistrationObjective, RegistrationOptions, ToolFit,
+};
 use crate::stats::{percentile, ErrorStats};
 
 /// Everything that steers a calibration.
@@ -40,6 +45,11 @@ pub struct CalibrationSettings {
     pub identifiability: IdentifiabilityOptions,
     /// Solver settings.
     pub solver: SolverOptions,
+    /// How observations are weighted (uncertainties, tracker model, orientation rows).
+    pub weighting: Weighting,
+    /// The validation points were measured from another tracker station: fit them a frame of
+    /// their own (the errors then show the model's shape, not where the tracker stood).
+    pub validation_refit_frame: bool,
 }
 
 impl Default for CalibrationSettings {
@@ -50,6 +60,8 @@ impl Default for CalibrationSettings {
             affine_registration: false,
             identifiability: IdentifiabilityOptions::default(),
             solver: SolverOptions::default(),
+            weighting: Weighting::default(),
+            validation_refit_frame: false,
         }
     }
 }
@@ -65,8 +77,9 @@ pub struct CalibrationData<'a> {
     pub validation: Option<&'a Observations>,
 }
 
-/// Error norms of one set of points under the nominal and the calibrated model (mm), both with
-/// the fitted tracker frame.
+/// Error norms of one set of points under the nominal and the calibrated model (mm): the
+/// nominal model with the registration's frame (Table II), the calibrated one with the frame
+/// the identification held.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SetErrors {
     /// CSV line of each point.
@@ -75,16 +88,53 @@ pub struct SetErrors {
     pub before: Vec<f64>,
     /// Calibrated model (Table IV).
     pub after: Vec<f64>,
+    /// Orientation errors (deg) before and after, for 6-DoF data.
+    pub orientation_deg: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl SetErrors {
-    fn new(obs: &Observations, reg: &Registration, nominal: &Robot, cal: &Robot) -> SetErrors {
-        let p = Problem::new(nominal, &[], obs, &reg.frame);
+    fn new(
+        obs: &Observations,
+        reg: &Registration,
+        nominal: &Robot,
+        frame: &crate::frame::TrackerFrame,
+        cal: &Robot,
+    ) -> SetErrors {
+        let before = Problem::new(nominal, &[], obs, &reg.frame);
+        let after = Problem::new(nominal, &[], obs, frame);
         SetErrors {
             lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
-            before: p.error_norms(nominal),
-            after: p.error_norms(cal),
+            before: before.error_norms(nominal),
+            after: after.error_norms(cal),
+            orientation_deg: before
+                .orientation_errors_deg(nominal)
+                .zip(after.orientation_errors_deg(cal)),
         }
+    }
+
+    /// The errors of `obs` with a frame of their own for each model: the nominal model with the
+    /// rigid frame fitted to it, the calibrated one with the frame fitted to it (data measured
+    /// from another tracker station). Returns the errors and the calibrated model's frame.
+    fn refit(
+        obs: &Observations,
+        nominal: &Robot,
+        cal: &Robot,
+    ) -> Result<(SetErrors, crate::frame::TrackerFrame)> {
+        let fb = crate::registration::refit_frame(nominal, obs)?;
+        let fa = crate::registration::refit_frame(cal, obs)?;
+        let before = Problem::new(nominal, &[], obs, &fb);
+        let after = Problem::new(nominal, &[], obs, &fa);
+        Ok((
+            SetErrors {
+                lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
+                before: before.error_norms(nominal),
+                after: after.error_norms(cal),
+                orientation_deg: before
+                    .orientation_errors_deg(nominal)
+                    .zip(after.orientation_errors_deg(cal)),
+            },
+            fa,
+        ))
     }
 
     /// Statistics before calibration.
@@ -129,6 +179,10 @@ pub struct Calibration {
     pub calibrated: Robot,
     /// The fitted measurement frame and Table II.
     pub registration: Registration,
+    /// The frame and tool points fitted to the nominal geometry before identification (Table
+    /// II with the fitted tool); its frame is the one the identification holds, the result's
+    /// tracker frame.
+    pub tool_fit: ToolFit,
     /// Which parameters were identified, which fixed and why.
     pub identifiability: Identifiability,
     /// The solver runs, in order (robust objectives start from a sum-of-norms fit).
@@ -139,6 +193,9 @@ pub struct Calibration {
     pub calibration: SetErrors,
     /// Errors on the validation points.
     pub validation: Option<SetErrors>,
+    /// The frame fitted to the validation points of their own, when they come from another
+    /// tracker station ([`CalibrationSettings::validation_refit_frame`]).
+    pub validation_frame: Option<crate::frame::TrackerFrame>,
     /// The robust loss's scale (mm), for robust objectives.
     pub robust_scale_mm: Option<f64>,
     /// Points whose error exceeds the robust scale (Cauchy weight below 1/2, Huber weight below
@@ -152,6 +209,12 @@ pub struct Calibration {
 }
 
 impl Calibration {
+    /// The tracker frame of the calibrated model (the frame the identification held): a
+    /// measured point m maps to `tracker_frame().to_base(m)`.
+    pub fn tracker_frame(&self) -> &crate::frame::TrackerFrame {
+        &self.tool_fit.frame
+    }
+
     /// The last solver run.
     pub fn solver(&self) -> &SolverReport {
         &self.stages.last().expect("at least one stage").report
@@ -195,7 +258,15 @@ pub fn calibrate(
     if cal.is_empty() {
         return Err(Error::invalid("calibration data", "no calibration points"));
     }
+    for obs in [Some(cal), data.plane, data.validation]
+        .into_iter()
+        .flatten()
+    {
+        obs.check_targets(nominal)?;
+    }
     cal.check_no_duplicate_poses()?;
+    let weighted = settings.weighting.apply(cal)?;
+    let cal = &weighted;
     let idopts = &settings.identifiability;
     if let Some(p) = idopts.fix.iter().find(|p| idopts.free.contains(p)) {
         return Err(Error::invalid(
@@ -237,9 +308,34 @@ pub fn calibrate(
         ..Default::default()
     };
     let registration = register(nominal, cal, data.plane, &reg_opts)?;
+    let tool_fit = fit_tools(nominal, cal, &registration.frame)?;
+    // The identification starts from the nominal geometry with the fitted tools, in the frame
+    // fitted with them: neither it nor the identifiability depends on the nominal tool's guess.
+    let start = tool_fit.apply(nominal);
 
     observer.progress(progress::Stage::Identifiability, 0, 1);
-    let ident = analyze(nominal, cal, idopts)?;
+    let mut ident = analyze(&start, cal, idopts)?;
+    // Parameters independent in principle that these data cannot pin (precision.rs).
+    let sigma0 = tool_fit.stats.rms_mm / 3f64.sqrt();
+    let undetermined = precision::undetermined(
+        &start,
+        &Problem::new(&start, &ident.identified, cal, &tool_fit.frame),
+        sigma0,
+        &idopts.free,
+    );
+    if !undetermined.is_empty() {
+        let mut opts = idopts.clone();
+        opts.fix.extend(undetermined.iter().map(|u| u.param));
+        ident = analyze(&start, cal, &opts)?;
+        for f in &mut ident.fixed {
+            if let Some(u) = undetermined.iter().find(|u| u.param == f.param) {
+                f.reason = FixReason::Undetermined {
+                    std: u.std,
+                    limit: u.limit,
+                };
+            }
+        }
+    }
     let k = ident.identified.len();
     let ill_conditioned = ident.ill_conditioned().then(|| {
         let (p, ind) = ident
@@ -279,8 +375,8 @@ pub fn calibrate(
         )));
     }
 
-    let problem = Problem::new(nominal, &ident.identified, cal, &registration.frame);
-    let mut robot = nominal.clone();
+    let problem = Problem::new(&start, &ident.identified, cal, &tool_fit.frame);
+    let mut robot = start.clone();
     let mut stages = Vec::new();
     let run = |robot: &mut Robot, loss: Loss, stages: &mut Vec<Stage>| -> Result<()> {
         let name = loss.name();
@@ -314,7 +410,7 @@ pub fn calibrate(
                 RobustLoss::Huber => Loss::Huber { k: c },
             };
             let scale_of = |r: &Robot| {
-                let med = percentile(&problem.error_norms(r), 0.5);
+                let med = percentile(&problem.fit_norms(r), 0.5);
                 (ROBUST_SCALE_SIGMAS * med / CHI3_MEDIAN).max(SUM_OF_NORMS_SMOOTHING_MM)
             };
             let mut c = settings.robust_scale_mm.unwrap_or_else(|| scale_of(&robot));
@@ -343,11 +439,22 @@ pub fn calibrate(
         covariance.mark_unavailable(why);
     }
 
-    let calibration = SetErrors::new(cal, &registration, nominal, &robot);
-    let validation = data
-        .validation
-        .filter(|v| !v.is_empty())
-        .map(|v| SetErrors::new(v, &registration, nominal, &robot));
+    let frame = &tool_fit.frame;
+    let calibration = SetErrors::new(cal, &registration, nominal, frame, &robot);
+    let mut validation_frame = None;
+    let validation = match data.validation.filter(|v| !v.is_empty()) {
+        None => None,
+        Some(v) if settings.validation_refit_frame => {
+            let (e, f) = SetErrors::refit(v, nominal, &robot)?;
+            validation_frame = Some(f);
+            Some(e)
+        }
+        Some(v) => {
+            let e = SetErrors::new(v, &registration, nominal, frame, &robot);
+            check_same_station(v, &e, nominal, &robot)?;
+            Some(e)
+        }
+    };
     let mut downweighted = Vec::new();
     if let Some(c) = robust_scale {
         for (i, &r) in calibration.after.iter().enumerate() {
@@ -365,6 +472,7 @@ pub fn calibrate(
     observer.progress(progress::Stage::Plausibility, 0, 1);
     let plausibility = plausibility::assess(&plausibility::Fit {
         nominal,
+        start: &start,
         calibrated: &robot,
         identified: &ident.identified,
         calibration: cal,
@@ -377,14 +485,51 @@ pub fn calibrate(
         nominal: nominal.clone(),
         calibrated: robot,
         registration,
+        tool_fit,
         identifiability: ident,
         stages,
         covariance,
         calibration,
         validation,
+        validation_frame,
         robust_scale_mm: robust_scale,
         downweighted,
         plausibility,
         settings: settings.clone(),
     })
+}
+
+/// How much better a frame of their own must explain validation points, and by how much (mm),
+/// before they are taken for data from another tracker station.
+pub const STATION_FACTOR: f64 = 10.0;
+/// See [`STATION_FACTOR`].
+pub const STATION_MIN_MM: f64 = 1.0;
+
+/// Fails when the validation points `v` were clearly measured from another tracker station: a
+/// rigid frame of their own brings the calibrated model's mean error down by [`STATION_FACTOR`]
+/// and by more than [`STATION_MIN_MM`]. Their errors in the calibration's frame would then be the
+/// tracker's move, not the robot's accuracy.
+fn check_same_station(v: &Observations, e: &SetErrors, nominal: &Robot, cal: &Robot) -> Result<()> {
+    let here = e.after_stats().mean_mm;
+    if here <= STATION_MIN_MM || v.len() < 3 {
+        return Ok(());
+    }
+    let Ok((own, _)) = SetErrors::refit(v, nominal, cal) else {
+        return Ok(());
+    };
+    let there = own.after_stats().mean_mm;
+    if here > STATION_FACTOR * there && here - there > STATION_MIN_MM {
+        return Err(Error::invalid(
+            v.source()
+                .map_or("validation data".into(), |p| p.display().to_string()),
+            format!(
+                "the validation points look measured from another tracker station: in the \
+                 calibration's tracker frame the calibrated model is off by {here:.3} mm on \
+                 average, with a frame of their own by {there:.3} mm. If the tracker moved, \
+                 let the validation fit its own frame (`validation_refit_frame`); otherwise \
+                 check that the file belongs to this calibration"
+            ),
+        ));
+    }
+    Ok(())
 }

@@ -118,6 +118,7 @@ impl Calibration {
                     FixReason::NoEffect | FixReason::Unseen { .. } => {
                         (FixKind::NoEffect, None, None)
                     }
+                    FixReason::Undetermined { .. } => (FixKind::Undetermined, None, None),
                     FixReason::Duplicate { of, independence } => (
                         FixKind::Duplicate,
                         Some(*independence),
@@ -170,6 +171,22 @@ impl Calibration {
                 iterations: a.iterations,
                 stats: a.stats,
             }),
+            tool_fit: Some(crate::io::result_cell::ToolFitEntry {
+                frame: FrameVec::from_tracker_frame(&self.tool_fit.frame),
+                tools: self
+                    .tool_fit
+                    .tools
+                    .iter()
+                    .map(crate::frame::vec_rad_to_deg)
+                    .collect(),
+                iterations: self.tool_fit.iterations,
+                converged: self.tool_fit.converged,
+                stats: self.tool_fit.stats,
+            }),
+            validation_frame: self
+                .validation_frame
+                .as_ref()
+                .map(FrameVec::from_tracker_frame),
         };
         let stages = self
             .stages
@@ -249,7 +266,7 @@ impl Calibration {
         let mut result = CalibrationResult::new(
             RobotInfo::of(&self.nominal),
             parameters,
-            FrameVec::from_tracker_frame(&self.registration.frame),
+            FrameVec::from_tracker_frame(self.tracker_frame()),
             errors,
             status,
         );
@@ -296,6 +313,21 @@ impl Calibration {
             validation: self.validation.as_ref().map(point_entries),
         });
         result.plausibility = Some(self.plausibility.to_section());
+        result.orientation_errors = self.calibration.orientation_deg.as_ref().map(|(b, a)| {
+            use crate::io::result_cell::{AngleBeforeAfter, AngleStats, OrientationErrors};
+            let pair = |b: &[f64], a: &[f64]| AngleBeforeAfter {
+                before: AngleStats::of(b),
+                after: AngleStats::of(a),
+            };
+            OrientationErrors {
+                calibration: pair(b, a),
+                validation: self
+                    .validation
+                    .as_ref()
+                    .and_then(|v| v.orientation_deg.as_ref())
+                    .map(|(b, a)| pair(b, a)),
+            }
+        });
         result
     }
 }

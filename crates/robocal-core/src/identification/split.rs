@@ -2,6 +2,7 @@
 //! and the paper's plane points.
 
 use crate::error::{Error, Result};
+use crate::io::row_extras::ExtrasLayout;
 use crate::io::{MeasurementSet, SetLabel};
 use crate::observations::Observations;
 
@@ -29,6 +30,7 @@ pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
         plane: mk(),
     };
     let labels = set.set_labels()?;
+    let extras = ExtrasLayout::of(set)?;
     for (r, label) in set.rows.iter().zip(labels) {
         let Some(p) = r.p else {
             return Err(Error::parse(
@@ -43,7 +45,7 @@ pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
             SetLabel::Validation => &mut out.validation,
             SetLabel::Calibration => &mut out.calibration,
         };
-        target.push(&r.q, p, r.line)?;
+        target.push_with(&r.q, p, extras.read(set, r)?, r.line)?;
     }
     Ok(out)
 }

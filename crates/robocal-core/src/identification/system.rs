@@ -36,6 +36,8 @@ pub struct Problem<'a> {
     kind: &'static dyn MeasurementKind,
     /// The kind's targets, `target_len` numbers per observation (for points, `pose(F) m_i`).
     targets: Vec<f64>,
+    /// Whether the kind needs the tool frame's angular screws and rotation.
+    angular: bool,
 }
 
 impl std::fmt::Debug for Problem<'_> {
@@ -142,26 +144,20 @@ impl Acc {
         self
     }
 
-    /// Adds observation `i`: its residual rows and Jacobian rows from the kind, then
-    /// `w J^T J`, `w J^T e` (upper triangles) and what the level adds.
+    /// Adds observation `i`: its (weighted) residual rows and Jacobian rows
+    /// ([`Problem::observation_rows`]), then `w J^T J`, `w J^T e` (upper triangles) and what the
+    /// level adds.
     #[inline]
     fn add_observation(&mut self, p: &Problem, robot: &Robot, loss: &Loss, i: usize) {
         let rows = p.kind.rows();
-        let angular = !self.jw.is_empty();
-        let point = robot.tool_screw_jacobians(
-            p.obs.q(i),
-            None,
-            Some(&mut self.jp),
-            angular.then_some(&mut self.jw[..]),
-        );
-        let tool = p.tool_state(robot, i, point);
         let mut e = [0.0; kinds::MAX_ROWS];
-        p.kind.residual(p.target(i), &tool, &mut e[..rows]);
-        p.kind.jacobian_rows(
-            &tool,
-            &self.jp,
-            angular.then_some(&self.jw[..]),
-            &p.index,
+        let angular = !self.jw.is_empty();
+        p.observation_rows(
+            robot,
+            i,
+            &mut self.jp,
+            angular.then_some(&mut self.jw[..]),
+            &mut e[..rows],
             &mut self.jr,
         );
         // Point measurements (3 rows) take a copy of the loop the compiler unrolls.
@@ -285,6 +281,85 @@ impl<'a> Problem<'a> {
             obs,
             kind,
             targets,
+            angular: kind.measurability().orientation,
+        }
+    }
+
+    /// Observation `i`'s residual rows `e` (measured minus model) and the model's Jacobian rows
+    /// `jr` (row-major, `rows x params`), each row weighted as the fit weights it
+    /// ([`Observations::weight`], orientation rows also by [`Observations::mm_per_rad`]). `jp`
+    /// (and `jw` when the kind sees orientation) are scratch of `robot.param_count()` screws.
+    #[inline]
+    pub(crate) fn observation_rows(
+        &self,
+        robot: &Robot,
+        i: usize,
+        jp: &mut [Vector3<f64>],
+        mut jw: Option<&mut [Vector3<f64>]>,
+        e: &mut [f64],
+        jr: &mut [f64],
+    ) {
+        let rows = self.kind.rows();
+        let t = self.obs.target(i);
+        let (point, flange) =
+            robot.target_screws(self.obs.q(i), t, None, Some(&mut *jp), jw.as_deref_mut());
+        let tool = self.tool_state(robot, t, point, &flange);
+        let target = self.target(i);
+        self.kind.residual(target, &tool, &mut e[..rows]);
+        self.kind
+            .jacobian_rows(target, &tool, jp, jw.as_deref(), &self.index, jr);
+        self.weigh(i, &mut e[..rows], &mut jr[..rows * self.index.len()]);
+    }
+
+    /// Observation `i`'s weighted Jacobian rows linearized at zero residual (the kind's
+    /// [`MeasurementKind::model_target`]), as the identifiability analysis needs them; `jw` must
+    /// be given (its screws are also returned there).
+    pub(crate) fn model_rows(
+        &self,
+        robot: &Robot,
+        i: usize,
+        jp: &mut [Vector3<f64>],
+        jw: &mut [Vector3<f64>],
+        jr: &mut [f64],
+    ) {
+        let rows = self.kind.rows();
+        let t = self.obs.target(i);
+        let (point, flange) =
+            robot.target_screws(self.obs.q(i), t, None, Some(&mut *jp), Some(&mut *jw));
+        let rotation =
+            Some(flange.rotation.matrix() * robot.target_tool_frame(t).rotation.matrix());
+        let tool = ToolState { point, rotation };
+        let mut target = [0.0; 2 * kinds::MAX_ROWS];
+        let target = &mut target[..self.kind.target_len()];
+        self.kind.model_target(&tool, target);
+        self.kind
+            .jacobian_rows(target, &tool, jp, Some(jw), &self.index, jr);
+        let mut e = [0.0; kinds::MAX_ROWS];
+        self.weigh(i, &mut e[..rows], &mut jr[..rows * self.index.len()]);
+    }
+
+    /// Applies observation `i`'s row weights to its residual and Jacobian rows.
+    #[inline]
+    fn weigh(&self, i: usize, e: &mut [f64], jr: &mut [f64]) {
+        let w = self.obs.weight(i);
+        let rows = e.len();
+        let ang = self.kind.orientation_rows();
+        if w == 1.0 && ang == 0 {
+            return;
+        }
+        let k = self.index.len();
+        for r in 0..rows {
+            let wr = if r >= rows - ang {
+                w * self.obs.mm_per_rad()
+            } else {
+                w
+            };
+            e[r] *= wr;
+            if let Some(row) = jr.get_mut(r * k..(r + 1) * k) {
+                for v in row {
+                    *v *= wr;
+                }
+            }
         }
     }
 
@@ -318,28 +393,72 @@ impl<'a> Problem<'a> {
         &self.targets[i * tl..(i + 1) * tl]
     }
 
-    /// The model's tool at observation i, given its tool point.
-    fn tool_state(&self, robot: &Robot, i: usize, point: Vector3<f64>) -> ToolState {
+    /// The model's tool for target `t`, given its point and the flange frame.
+    #[inline]
+    fn tool_state(
+        &self,
+        robot: &Robot,
+        t: usize,
+        point: Vector3<f64>,
+        flange: &crate::frame::Frame,
+    ) -> ToolState {
         let rotation = self
-            .kind
-            .measurability()
-            .orientation
-            .then(|| *robot.tool_pose(self.obs.q(i)).rotation.matrix());
+            .angular
+            .then(|| flange.rotation.matrix() * robot.target_tool_frame(t).rotation.matrix());
         ToolState { point, rotation }
     }
 
-    /// Observation i's residual norm `|e_i|` (mm; forward kinematics only).
-    fn error_norm(&self, robot: &Robot, i: usize) -> f64 {
+    /// Observation i's unweighted residual rows (forward kinematics only), written to `e`.
+    fn residual(&self, robot: &Robot, i: usize, e: &mut [f64]) {
+        let t = self.obs.target(i);
+        let (tool, point) = if self.angular {
+            let f = robot.target_pose(self.obs.q(i), t);
+            (Some(*f.rotation.matrix()), f.translation.vector)
+        } else {
+            (None, robot.target_position(self.obs.q(i), t))
+        };
+        let tool = ToolState {
+            point,
+            rotation: tool,
+        };
+        self.kind.residual(self.target(i), &tool, e);
+    }
+
+    /// Observation i's residual norm as the fit sees it (weighted; forward kinematics only).
+    fn fit_norm(&self, robot: &Robot, i: usize) -> f64 {
         let rows = self.kind.rows();
-        let point = robot.tool_position(self.obs.q(i));
-        let tool = self.tool_state(robot, i, point);
         let mut e = [0.0; kinds::MAX_ROWS];
-        self.kind.residual(self.target(i), &tool, &mut e[..rows]);
-        let mut r2 = 0.0;
-        for v in &e[..rows] {
-            r2 += v * v;
+        self.residual(robot, i, &mut e[..rows]);
+        self.weigh(i, &mut e[..rows], &mut []);
+        e[..rows].iter().map(|v| v * v).sum::<f64>().sqrt()
+    }
+
+    /// Observation i's position error `|E_i|` (mm, eq. 3; unweighted).
+    fn position_error(&self, robot: &Robot, i: usize) -> f64 {
+        let rows = self.kind.rows();
+        let mut e = [0.0; kinds::MAX_ROWS];
+        self.residual(robot, i, &mut e[..rows]);
+        let pos = rows - self.kind.orientation_rows();
+        e[..pos].iter().map(|v| v * v).sum::<f64>().sqrt()
+    }
+
+    /// Observation i's orientation error (deg), for kinds that see orientation.
+    fn orientation_error_deg(&self, robot: &Robot, i: usize) -> Option<f64> {
+        let ang = self.kind.orientation_rows();
+        if ang == 0 {
+            return None;
         }
-        r2.sqrt()
+        let rows = self.kind.rows();
+        let mut e = [0.0; kinds::MAX_ROWS];
+        self.residual(robot, i, &mut e[..rows]);
+        Some(
+            e[rows - ang..rows]
+                .iter()
+                .map(|v| v * v)
+                .sum::<f64>()
+                .sqrt()
+                .to_degrees(),
+        )
     }
 
     /// The identified parameters' current values (internal units).
@@ -354,14 +473,31 @@ impl<'a> Problem<'a> {
         }
     }
 
-    /// The residual norms `|e_i|` (mm), one per observation.
+    /// The position errors `|E_i|` (mm, eq. 3), one per observation: what tables report.
     pub fn error_norms(&self, robot: &Robot) -> Vec<f64> {
-        (0..self.len()).map(|i| self.error_norm(robot, i)).collect()
+        (0..self.len())
+            .map(|i| self.position_error(robot, i))
+            .collect()
+    }
+
+    /// The orientation errors (deg), one per observation, for kinds that see orientation.
+    pub fn orientation_errors_deg(&self, robot: &Robot) -> Option<Vec<f64>> {
+        (self.kind.orientation_rows() > 0).then(|| {
+            (0..self.len())
+                .map(|i| self.orientation_error_deg(robot, i).unwrap_or(f64::NAN))
+                .collect()
+        })
+    }
+
+    /// The residual norms the loss sees (weighted, see [`Observations::weight`]; mm of a
+    /// typical point), one per observation.
+    pub fn fit_norms(&self, robot: &Robot) -> Vec<f64> {
+        (0..self.len()).map(|i| self.fit_norm(robot, i)).collect()
     }
 
     /// The objective `sum l(|e_i|)` (forward kinematics only).
     pub fn objective(&self, robot: &Robot, loss: &Loss) -> f64 {
-        let f = |i: usize| loss.value(self.error_norm(robot, i));
+        let f = |i: usize| loss.value(self.fit_norm(robot, i));
         if self.len() >= PARALLEL_MIN_POINTS {
             (0..self.len())
                 .into_par_iter()
@@ -379,7 +515,7 @@ impl<'a> Problem<'a> {
         let k = self.params.len();
         let np = robot.param_count();
         let rows = self.kind.rows();
-        let angular = self.kind.measurability().orientation;
+        let angular = self.angular;
         let new = || Acc::new(k, rows, np, angular, level);
         let acc = if self.len() >= PARALLEL_MIN_POINTS {
             (0..self.len())

@@ -210,7 +210,7 @@ fn noise_free_table3_is_reproduced_exactly() {
         assert!(vafter.rms_mm < 1e-6, "{obj:?}: validation {vafter:?}");
         assert!(c.solver().termination.converged(), "{:?}", c.solver());
         // The tracker frame comes out rigid and consistent with the calibrated base.
-        let tf = c.registration.frame;
+        let tf = c.tracker_frame();
         let m = *cal.m(0);
         let p = c.calibrated.tool_position(cal.q(0));
         assert!((tf.to_base(&m) - p).norm() < 1e-5);
@@ -325,7 +325,7 @@ fn sum_of_norms_solution_is_a_true_minimum() {
     let c = run(&nominal(), &cal, None, &CalibrationSettings::default());
     assert!(c.solver().termination.converged(), "{:?}", c.solver());
     let ps = c.identifiability.identified.clone();
-    let problem = Problem::new(&c.nominal, &ps, &cal, &c.registration.frame);
+    let problem = Problem::new(&c.nominal, &ps, &cal, c.tracker_frame());
     let tde = |r: &Robot| problem.error_norms(r).iter().sum::<f64>();
     let best = tde(&c.calibrated);
     let x0 = problem.values(&c.calibrated);
@@ -424,7 +424,7 @@ fn standard_deviations_match_the_monte_carlo_spread() {
             // in the true ACS, `F_true F^-1 pose(B)`.
             let b = crate::frame::frame_vector(
                 &(tr.frame.pose()
-                    * c.registration.frame.pose().inverse()
+                    * c.tracker_frame().pose().inverse()
                     * *c.calibrated.base_frame()),
             );
             est.push(

@@ -135,6 +135,9 @@ pub struct CalibrationResult {
         serialize_with = "sorted_opt"
     )]
     pub plausibility: Option<PlausibilitySection>,
+    /// Orientation errors of 6-DoF data (deg).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation_errors: Option<super::result_cell::OrientationErrors>,
     /// Per-point errors.
     #[serde(
         default,
@@ -320,6 +323,7 @@ impl CalibrationResult {
             plausibility: None,
             points: None,
             registration: None,
+            orientation_errors: None,
             settings: None,
             solver: None,
             status: Some(StatusValue::Known(status)),

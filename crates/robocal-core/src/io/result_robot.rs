@@ -33,6 +33,9 @@ pub struct RobotInfo {
     /// The nominal model's tool correction T (mm, deg), when not zero.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool_correction: Option<[f64; 6]>,
+    /// The nominal tool vectors of every target (mm, deg), when the robot carries several.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tools: Option<Vec<[f64; 6]>>,
     /// The joints as the robot file gives them; empty (absent) in results that do not embed
     /// their robot.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -54,6 +57,7 @@ impl RobotInfo {
             base: None,
             tool: None,
             tool_correction: None,
+            tools: None,
             joints: Vec::new(),
             controller: None,
         }
@@ -70,6 +74,7 @@ impl RobotInfo {
             base: Some(d.base),
             tool: Some(d.tool),
             tool_correction: d.tool_correction,
+            tools: d.tools,
             joints: d.joints,
             controller: d.controller,
         }
@@ -91,6 +96,7 @@ impl RobotInfo {
             base: self.base.unwrap_or_default(),
             tool: self.tool.unwrap_or_default(),
             tool_correction: self.tool_correction,
+            tools: self.tools.clone(),
             joints: self.joints.clone(),
             controller: self.controller.clone(),
         })

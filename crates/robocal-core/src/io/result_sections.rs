@@ -238,6 +238,12 @@ pub struct Registration {
     /// The affine fit, if asked for.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub affine: Option<AffineEntry>,
+    /// The frame and tools fitted to the nominal geometry before identification.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tool_fit: Option<super::result_cell::ToolFitEntry>,
+    /// The frame the validation points were given of their own (another tracker station).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub validation_frame: Option<FrameVec>,
 }
 
 /// An identified parameter (`identifiability.identified`).
@@ -265,6 +271,8 @@ pub enum FixKind {
     NoEffect,
     /// Its effect is that of others.
     Duplicate,
+    /// The data cannot pin it (predicted std above a third of the plausible move).
+    Undetermined,
 }
 
 /// A parameter whose effect another one duplicates, with the coefficient.

@@ -59,6 +59,18 @@ impl Robot {
         self.flange_pose(q) * self.tool_frame()
     }
 
+    /// Target `t`'s tool frame `flange * pose(T0_t + T_t)` (0-based target; see
+    /// [`Robot::target_count`]).
+    pub fn target_pose(&self, q: &[f64], t: usize) -> Frame {
+        self.flange_pose(q) * self.target_tool_frame(t)
+    }
+
+    /// Target `t`'s tool point (mm, ACS; 0-based target).
+    pub fn target_position(&self, q: &[f64], t: usize) -> Vector3<f64> {
+        let f = self.flange_pose(q);
+        f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector
+    }
+
     /// The tool point (mm, base frame = ACS) at joint values `q` (rad): the paper's P_nom (eq. 1)
     /// for the nominal model.
     pub fn tool_position(&self, q: &[f64]) -> Vector3<f64> {
@@ -90,6 +102,11 @@ impl Robot {
     /// The frames of one forward pass at joint values `q` (deflected, see
     /// [`Robot::deflected`]), with the tool point.
     pub fn pose_frames(&self, q: &[f64]) -> PoseFrames {
+        self.pose_frames_target(q, 0)
+    }
+
+    /// [`Robot::pose_frames`] with the point of target `t` (0-based) as the tool point.
+    pub fn pose_frames_target(&self, q: &[f64], t: usize) -> PoseFrames {
         let mut buf = [0.0; MAX_JOINTS];
         let q = self.deflected(q, &mut buf);
         let mut ch = if self.joint_space().any_prismatic() {
@@ -98,7 +115,8 @@ impl Robot {
             self.chain_with::<false>(q)
         };
         let f = &ch.flange;
-        ch.point = f.rotation * self.tool_frame().translation.vector + f.translation.vector;
+        ch.point = f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
+        ch.target = t;
         ch
     }
 
@@ -110,6 +128,7 @@ impl Robot {
             link: [Frame::identity(); MAX_JOINTS],
             flange: *self.base_frame(),
             point: Vector3::zeros(),
+            target: 0,
         };
         let mut f = *self.base_frame();
         let types = self.joint_types();
@@ -166,10 +185,24 @@ impl Robot {
         q: &[f64],
         jq: Option<&mut [Vector3<f64>]>,
         jp: Option<&mut [Vector3<f64>]>,
-        mut jw: Option<&mut [Vector3<f64>]>,
+        jw: Option<&mut [Vector3<f64>]>,
     ) -> Vector3<f64> {
+        self.target_screws(q, 0, jq, jp, jw).0
+    }
+
+    /// [`Robot::tool_screw_jacobians`] for target `t` (0-based, see [`Robot::target_count`]):
+    /// the target's point and the flange frame, with the screws at that point. Parameters of
+    /// another target's tool have zero columns.
+    pub fn target_screws(
+        &self,
+        q: &[f64],
+        t: usize,
+        jq: Option<&mut [Vector3<f64>]>,
+        jp: Option<&mut [Vector3<f64>]>,
+        mut jw: Option<&mut [Vector3<f64>]>,
+    ) -> (Vector3<f64>, Frame) {
         let n = self.dof();
-        let pose = self.pose_frames(q);
+        let pose = self.pose_frames_target(q, t);
         let p = pose.point;
         if let Some(jq) = jq {
             assert_eq!(jq.len(), n, "joint Jacobian length");
@@ -185,7 +218,9 @@ impl Robot {
                 }
             }
         }
-        let Some(jp) = jp else { return p };
+        let Some(jp) = jp else {
+            return (p, pose.flange);
+        };
         assert_eq!(jp.len(), self.param_count(), "parameter Jacobian length");
         if let Some(jw) = jw.as_deref() {
             assert_eq!(jw.len(), jp.len(), "angular Jacobian length");
@@ -198,7 +233,7 @@ impl Robot {
                 jw.as_deref_mut().map(|w| &mut w[span.clone()]),
             );
         }
-        p
+        (p, pose.flange)
     }
 
     /// Each joint's axis in the ACS at joint values `q` (rad or mm): its unit direction and the

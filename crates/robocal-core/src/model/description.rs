@@ -66,6 +66,10 @@ pub struct RobotDescription {
     /// The tool correction T (mm, deg), when not zero.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool_correction: Option<[f64; 6]>,
+    /// The nominal tool vectors of every target (mm, deg; the first is `tool`), when the robot
+    /// carries several.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tools: Option<Vec<[f64; 6]>>,
     /// The joints, base to tip.
     pub joints: Vec<JointDescription>,
     /// The controller's axis map, if the robot has one.
@@ -148,6 +152,8 @@ impl RobotDescription {
                 .iter()
                 .any(|v| *v != 0.0)
                 .then(|| frame_degrees(correction)),
+            tools: (robot.target_count() > 1)
+                .then(|| robot.target_tools0().iter().map(frame_degrees).collect()),
             joints,
             controller: robot.controller().map(|c| ControllerDescription {
                 sign: c.sign().to_vec(),
@@ -226,14 +232,31 @@ pub fn nominal_difference(a: &Robot, b: &Robot) -> Option<String> {
             return Some(format!("nominal {} = {x} {u} against {y} {u}", p.name()));
         }
     }
-    let (ta, tb) = (frame_degrees(a.tool0()), frame_degrees(b.tool0()));
-    for (k, axis) in ["x", "y", "z", "a", "b", "c"].iter().enumerate() {
-        if !close(ta[k], tb[k]) {
-            let u = Param::tool(k).unit().as_str();
-            return Some(format!(
-                "nominal tool T0 {axis} = {} {u} against {} {u}",
-                ta[k], tb[k]
-            ));
+    if a.target_count() != b.target_count() {
+        return Some(format!(
+            "{} targets (tool vectors) against {}",
+            a.target_count(),
+            b.target_count()
+        ));
+    }
+    for t in 0..a.target_count() {
+        let (ta, tb) = (
+            frame_degrees(a.target_tool0(t)),
+            frame_degrees(b.target_tool0(t)),
+        );
+        for (k, axis) in ["x", "y", "z", "a", "b", "c"].iter().enumerate() {
+            if !close(ta[k], tb[k]) {
+                let u = Param::tool(k).unit().as_str();
+                let which = if t == 0 {
+                    "tool T0".to_string()
+                } else {
+                    format!("tool of target {}", t + 1)
+                };
+                return Some(format!(
+                    "nominal {which} {axis} = {} {u} against {} {u}",
+                    ta[k], tb[k]
+                ));
+            }
         }
     }
     let map = |r: &Robot| {

@@ -16,6 +16,7 @@ mod joints;
 mod params;
 pub mod presets;
 pub mod robot_file;
+mod targets;
 
 pub use controller::{Controller, Coupling};
 pub use family::{FamilyId, ParameterFamily, PoseFrames};
@@ -104,6 +105,8 @@ pub struct Robot {
     base: [f64; 6],
     tool0: [f64; 6],
     tool: [f64; 6],
+    /// Targets 2..k (further reflectors on the flange), see [`Robot::set_target_tools`].
+    targets: Vec<targets::TargetTool>,
     /// Values of the parameter families that are not part of the link table, by family key.
     family_store: std::collections::BTreeMap<String, Vec<f64>>,
     // Caches derived from the above (kept valid by every mutator).
@@ -176,6 +179,7 @@ impl Robot {
             base,
             tool0,
             tool: [0.0; 6],
+            targets: Vec::new(),
             family_store: Default::default(),
             link_const: Vec::new(),
             base_frame: Frame::identity(),

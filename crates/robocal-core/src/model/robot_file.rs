@@ -8,6 +8,9 @@
 //! tool = [0, 0, 31, 0, 0, 0]   # nominal tool vector T0, same units (optional, default zero)
 //! tool_correction = [0, 0, 0, 0, 0, 0]  # the tool correction T already in the nominal model
 //!                              # (optional, default zero; what a result's embedded robot carries)
+//! tools = [[0, 0, 31, 0, 0, 0], [40, 0, 25, 0, 0, 0]]  # several targets (reflectors): one
+//!                              # nominal tool vector per `target` of the data (optional; the
+//!                              # first is `tool`, which may then be left out)
 //!
 //! [[joints]]                   # one table per joint, base to tip
 //! type = "revolute"            # or "prismatic" (optional, default revolute)
@@ -34,6 +37,9 @@ use serde::Deserialize;
 use std::path::Path;
 use toml::Spanned;
 
+/// A frame vector as written, with the spans of the vector and of each number.
+type FrameEntry = Spanned<Vec<Spanned<f64>>>;
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RobotFile {
@@ -42,6 +48,7 @@ struct RobotFile {
     base: Option<Spanned<Vec<Spanned<f64>>>>,
     tool: Option<Spanned<Vec<Spanned<f64>>>>,
     tool_correction: Option<Spanned<Vec<Spanned<f64>>>>,
+    tools: Option<Spanned<Vec<FrameEntry>>>,
     joints: Vec<JointEntry>,
     controller: Option<Spanned<ControllerEntry>>,
 }
@@ -171,7 +178,34 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
         Ok(crate::frame::vec_deg_to_rad(&out))
     };
     let base = frame_vec(&file.base, "base")?;
-    let tool0 = frame_vec(&file.tool, "tool")?;
+    let mut tool0 = frame_vec(&file.tool, "tool")?;
+    let mut tools = Vec::new();
+    if let Some(list) = &file.tools {
+        if list.get_ref().is_empty() || list.get_ref().len() > crate::observations::MAX_TARGETS {
+            return Err(err(
+                list.span(),
+                "tools".into(),
+                format!(
+                    "expected 1 to {} tool vectors, got {}",
+                    crate::observations::MAX_TARGETS,
+                    list.get_ref().len()
+                ),
+            ));
+        }
+        for (k, v) in list.get_ref().iter().enumerate() {
+            tools.push(frame_vec(&Some(v.clone()), &format!("tools[{k}]"))?);
+        }
+        if file.tool.is_some() && tools[0] != tool0 {
+            return Err(err(
+                list.span(),
+                "tools".into(),
+                "the first of `tools` is the tool of target 1 and must equal `tool` (or leave \
+                 `tool` out)"
+                    .into(),
+            ));
+        }
+        tool0 = tools[0];
+    }
     let tool_correction = frame_vec(&file.tool_correction, "tool_correction")?;
     let mut links = Vec::with_capacity(file.joints.len());
     let mut limits = Vec::with_capacity(file.joints.len());
@@ -276,6 +310,9 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
         .map_err(|e| Error::parse(path, None, None, e.to_string()))?;
     for i in betas {
         robot.enable_beta(i)?;
+    }
+    if tools.len() > 1 {
+        robot.set_target_tools(&tools)?;
     }
     for (k, v) in tool_correction.into_iter().enumerate() {
         robot.set(Param::tool(k), v);

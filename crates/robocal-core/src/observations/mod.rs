@@ -1,11 +1,16 @@
 //! Measured tool points in the form the registration and the solvers use: joint vectors and
-//! measured points (tracker frame), each with the CSV line it came from.
+//! measured points (tracker frame), each with the CSV line it came from, and what a real cell
+//! adds (DESIGN.md, "Measurement CSV additions"): which target (reflector) a row measures, the
+//! measured frame's orientation of 6-DoF data, and each point's uncertainty.
 
 pub mod kinds;
+mod weighting;
+
+pub use weighting::{TrackerSigma, Weighting, DEFAULT_MM_PER_DEG};
 
 use crate::error::{Error, Result};
 use crate::model::Robot;
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 use std::path::{Path, PathBuf};
 
 /// Largest accepted measured coordinate (mm): the bound of every length ([`crate::ranges::LENGTH`],
@@ -15,36 +20,76 @@ pub const MAX_COORDINATE_MM: f64 = crate::ranges::LENGTH.max;
 
 /// A set of measured tool points: joint values (model values, rad, stored flat) and the measured
 /// position of the tool in the tracker frame (mm), with the 1-based CSV line of each point.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Observations {
     dof: usize,
     q: Vec<f64>,
     m: Vec<Vector3<f64>>,
     lines: Vec<usize>,
     source: Option<PathBuf>,
+    /// 0-based target of each observation (empty while every target is 0).
+    target: Vec<u16>,
+    /// Measured orientation of each observation (tracker frame), for 6-DoF data.
+    rotation: Option<Vec<Matrix3<f64>>>,
+    /// Each observation's 1-sigma uncertainty per axis (mm), when known.
+    sigma: Option<Vec<f64>>,
+    /// Weight of orientation rows: mm of position error one radian of orientation error
+    /// counts as (see [`Weighting`]).
+    mm_per_rad: f64,
 }
+
+impl Default for Observations {
+    fn default() -> Self {
+        Observations::new(0)
+    }
+}
+
+/// What a measurement row may carry beside its joints and point.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RowExtras {
+    /// 0-based target (reflector) the row measures.
+    pub target: usize,
+    /// The measured frame's orientation in the tracker frame (6-DoF data).
+    pub rotation: Option<Matrix3<f64>>,
+    /// The point's 1-sigma uncertainty per axis (mm).
+    pub sigma_mm: Option<f64>,
+}
+
+/// Most targets one set of observations may use.
+pub const MAX_TARGETS: usize = 64;
 
 impl Observations {
     /// An empty set for a robot with `dof` joints.
     pub fn new(dof: usize) -> Self {
         Observations {
             dof,
-            ..Default::default()
+            q: Vec::new(),
+            m: Vec::new(),
+            lines: Vec::new(),
+            source: None,
+            target: Vec::new(),
+            rotation: None,
+            sigma: None,
+            mm_per_rad: DEFAULT_MM_PER_DEG.to_degrees(),
         }
     }
 
     /// An empty set whose points come from `path` (used in messages).
     pub fn with_source(dof: usize, path: &Path) -> Self {
         Observations {
-            dof,
             source: Some(path.to_owned()),
-            ..Default::default()
+            ..Observations::new(dof)
         }
     }
 
-    /// The measurement kind of these observations (one reflector's point).
+    /// The measurement kind of these observations: a point per target, or a 6-DoF pose when
+    /// the observations carry orientations.
     pub fn kind(&self) -> &'static dyn kinds::MeasurementKind {
-        &kinds::Point
+        if self.rotation.is_some() {
+            &kinds::Pose6
+        } else {
+            &kinds::Point
+        }
     }
 
     /// Adds a point: joint values (rad), measured position (mm, tracker frame), CSV line (0 when
@@ -83,7 +128,175 @@ impl Observations {
         self.q.extend_from_slice(q);
         self.m.push(m);
         self.lines.push(line);
+        if !self.target.is_empty() {
+            self.target.push(0);
+        }
+        if let Some(r) = &mut self.rotation {
+            r.push(Matrix3::identity());
+        }
+        if let Some(s) = &mut self.sigma {
+            s.push(f64::NAN);
+        }
         Ok(())
+    }
+
+    /// Adds a point with what a real cell's row carries beside it (see [`RowExtras`]). Every
+    /// observation of a set has an orientation or none has; the same for the uncertainty.
+    pub fn push_with(
+        &mut self,
+        q: &[f64],
+        m: Vector3<f64>,
+        extras: RowExtras,
+        line: usize,
+    ) -> Result<()> {
+        let at = self.describe(line);
+        let first = self.is_empty();
+        if extras.target >= MAX_TARGETS {
+            return Err(Error::invalid(
+                format!("{at}: target"),
+                format!("{} is more targets than {MAX_TARGETS}", extras.target + 1),
+            ));
+        }
+        if !first && extras.rotation.is_some() != self.rotation.is_some() {
+            return Err(Error::invalid(
+                format!("{at}: a"),
+                "every row of a set is a 6-DoF measurement (a,b,c) or none is",
+            ));
+        }
+        if !first && extras.sigma_mm.is_some() != self.sigma.is_some() {
+            return Err(Error::invalid(
+                format!("{at}: sigma_mm"),
+                "every row of a set has an uncertainty or none has",
+            ));
+        }
+        if let Some(s) = extras.sigma_mm {
+            if !(s > 0.0 && s.is_finite()) {
+                return Err(Error::invalid(
+                    format!("{at}: sigma_mm"),
+                    format!("{s} is not a positive length (mm)"),
+                ));
+            }
+        }
+        if let Some(r) = &extras.rotation {
+            let orthonormal = (r.transpose() * r - Matrix3::identity()).amax() < 1e-6
+                && (r.determinant() - 1.0).abs() < 1e-6;
+            if !orthonormal {
+                return Err(Error::invalid(
+                    format!("{at}: a"),
+                    "the orientation is not a rotation",
+                ));
+            }
+        }
+        self.push(q, m, line)?;
+        let i = self.len() - 1;
+        if extras.target != 0 && self.target.is_empty() {
+            self.target = vec![0; self.len()];
+        }
+        if !self.target.is_empty() {
+            self.target[i] = extras.target as u16;
+        }
+        // `push` appended placeholders to columns the set already has; the first row creates
+        // them.
+        if let Some(r) = extras.rotation {
+            match &mut self.rotation {
+                Some(v) => v[i] = r,
+                None => self.rotation = Some(vec![r]),
+            }
+        }
+        if let Some(s) = extras.sigma_mm {
+            match &mut self.sigma {
+                Some(v) => v[i] = s,
+                None => self.sigma = Some(vec![s]),
+            }
+        }
+        Ok(())
+    }
+
+    /// The 0-based target (reflector) observation `i` measures.
+    #[inline]
+    pub fn target(&self, i: usize) -> usize {
+        self.target.get(i).map_or(0, |t| *t as usize)
+    }
+
+    /// Number of targets the observations use (the largest target plus one; 1 for plain data).
+    pub fn target_count(&self) -> usize {
+        self.target.iter().max().map_or(1, |t| *t as usize + 1)
+    }
+
+    /// The measured orientation of observation `i` (tracker frame), for 6-DoF data.
+    #[inline]
+    pub fn rotation(&self, i: usize) -> Option<&Matrix3<f64>> {
+        self.rotation.as_ref().map(|r| &r[i])
+    }
+
+    /// Whether the observations are 6-DoF measurements.
+    pub fn has_orientation(&self) -> bool {
+        self.rotation.is_some()
+    }
+
+    /// Observation `i`'s 1-sigma uncertainty per axis (mm), when known.
+    #[inline]
+    pub fn sigma_mm(&self, i: usize) -> Option<f64> {
+        self.sigma.as_ref().map(|s| s[i])
+    }
+
+    /// Whether every observation has an uncertainty.
+    pub fn has_sigma(&self) -> bool {
+        self.sigma.is_some()
+    }
+
+    /// Sets every observation's uncertainty (mm; one per observation, positive and finite).
+    pub fn set_sigmas(&mut self, sigma: Option<Vec<f64>>) -> Result<()> {
+        if let Some(s) = &sigma {
+            if s.len() != self.len() {
+                return Err(Error::invalid(
+                    "sigma_mm",
+                    format!("{} uncertainties for {} points", s.len(), self.len()),
+                ));
+            }
+            if let Some(i) = s.iter().position(|v| !(*v > 0.0 && v.is_finite())) {
+                return Err(Error::invalid(
+                    format!("{}: sigma_mm", self.describe(self.line(i))),
+                    format!("{} is not a positive length (mm)", s[i]),
+                ));
+            }
+        }
+        self.sigma = sigma;
+        Ok(())
+    }
+
+    /// How many mm of position error one radian of orientation error counts as in a fit.
+    pub fn mm_per_rad(&self) -> f64 {
+        self.mm_per_rad
+    }
+
+    /// Sets the orientation rows' weight (mm per degree, positive and finite).
+    pub fn set_mm_per_deg(&mut self, w: f64) -> Result<()> {
+        if !(w > 0.0 && w.is_finite()) {
+            return Err(Error::invalid(
+                "orientation_mm_per_deg",
+                format!("{w} is not a positive weight (mm per degree)"),
+            ));
+        }
+        self.mm_per_rad = w.to_degrees();
+        Ok(())
+    }
+
+    /// The relative weight of observation `i`'s rows in a fit: `sigma_mean / sigma_i` (1 when
+    /// uncertainties are unknown), so that weighted residuals stay in mm of a typical point.
+    #[inline]
+    pub fn weight(&self, i: usize) -> f64 {
+        match &self.sigma {
+            Some(s) => self.sigma_mean() / s[i],
+            None => 1.0,
+        }
+    }
+
+    fn sigma_mean(&self) -> f64 {
+        match &self.sigma {
+            Some(s) if !s.is_empty() => s.iter().sum::<f64>() / s.len() as f64,
+            _ => 1.0,
+        }
     }
 
     /// How a point is named in messages: `file:line` or `point N`.
@@ -139,15 +352,42 @@ impl Observations {
     /// The nominal (model) tool positions of every point for `robot` (eq. 1).
     pub fn model_positions(&self, robot: &Robot) -> Vec<Vector3<f64>> {
         (0..self.len())
-            .map(|i| robot.tool_position(self.q(i)))
+            .map(|i| robot.target_position(self.q(i), self.target(i)))
             .collect()
     }
 
-    /// Rejects two points with identical joint values: a repeated pose adds no information about
-    /// the geometry and usually means a copy-paste error in the file.
+    /// Checks that `robot` carries every target the observations use.
+    pub fn check_targets(&self, robot: &Robot) -> Result<()> {
+        let k = self.target_count();
+        if k > robot.target_count() {
+            let i = (0..self.len())
+                .find(|&i| self.target(i) >= robot.target_count())
+                .unwrap_or(0);
+            return Err(Error::invalid(
+                format!("{}: target", self.describe(self.line(i))),
+                format!(
+                    "target {} is measured, but the robot has {} tool vector{} (give one per \
+                     target in the robot file: tools = [[x, y, z, a, b, c], ...])",
+                    self.target(i) + 1,
+                    robot.target_count(),
+                    if robot.target_count() == 1 { "" } else { "s" }
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Rejects two points with identical joint values and target: a repeated pose adds no
+    /// information about the geometry and usually means a copy-paste error in the file (one pose
+    /// seen through several targets is not a repeat).
     pub fn check_no_duplicate_poses(&self) -> Result<()> {
         let mut idx: Vec<usize> = (0..self.len()).collect();
-        let bits = |i: usize| self.q(i).iter().map(|v| v.to_bits());
+        let bits = |i: usize| {
+            self.q(i)
+                .iter()
+                .map(|v| v.to_bits())
+                .chain(std::iter::once(self.target(i) as u64))
+        };
         idx.sort_unstable_by(|&a, &b| bits(a).cmp(bits(b)).then(a.cmp(&b)));
         for w in idx.windows(2) {
             if bits(w[0]).eq(bits(w[1])) {

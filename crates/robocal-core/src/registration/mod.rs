@@ -18,6 +18,7 @@ mod affine;
 mod plane;
 pub(crate) mod procrustes;
 mod rigid;
+mod tool_fit;
 
 use crate::error::{Error, Result};
 use crate::frame::TrackerFrame;
@@ -30,6 +31,7 @@ pub use affine::Affine;
 use plane::{plane_frame, plane_tilt_deg};
 pub(crate) use rigid::IrlsOptions;
 use rigid::{fit_rigid, fit_rigid_sum_of_norms, residual_norms};
+pub use tool_fit::{fit_tools, ToolFit, MAX_ALTERNATIONS, TOOL_TOLERANCE_MM};
 
 /// What the rigid fit minimizes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -204,4 +206,20 @@ pub(crate) fn register(
         stats,
         affine,
     })
+}
+
+/// The rigid tracker frame that best maps `obs`'s measured points onto `robot`'s model points
+/// (least squares): for data measured from another tracker station, evaluated under a model
+/// whose frame is known only for the calibration's station.
+pub fn refit_frame(robot: &Robot, obs: &Observations) -> Result<TrackerFrame> {
+    if obs.len() < 3 {
+        return Err(Error::invalid(
+            "validation data",
+            format!(
+                "{} points; a frame of their own needs at least 3",
+                obs.len()
+            ),
+        ));
+    }
+    fit_rigid(obs.measured(), &obs.model_positions(robot), None)
 }

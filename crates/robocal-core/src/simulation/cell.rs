@@ -216,6 +216,65 @@ impl VirtualCell {
         }
     }
 
+    /// Where target `t`'s frame really is (base frame) when the controller is commanded to `q`
+    /// (0-based target of the truth robot; see [`Robot::target_count`]).
+    pub fn true_target_pose(&self, q: &[f64], t: usize) -> crate::frame::Frame {
+        match &self.gravity {
+            Some(g) => self.truth.target_pose(&g.deflected(&self.truth, q), t),
+            None => self.truth.target_pose(q, t),
+        }
+    }
+
+    /// Measures target `t` (0-based) at every joint vector as a 6-DoF probe would: the point as
+    /// [`VirtualCell::measure`] does (the tracker's noise), and the frame's orientation in the
+    /// tracker frame, turned by a random rotation of `orientation_sigma_deg` per axis. Outliers
+    /// are not drawn.
+    pub fn measure_target_frames(
+        &mut self,
+        qs: &[Vec<f64>],
+        t: usize,
+        orientation_sigma_deg: f64,
+    ) -> Result<Vec<(Vector3<f64>, nalgebra::Matrix3<f64>)>> {
+        use rand_distr::{Distribution, StandardNormal};
+        if t >= self.truth.target_count() {
+            return Err(Error::invalid(
+                "target",
+                format!(
+                    "target {} of a robot with {} targets",
+                    t + 1,
+                    self.truth.target_count()
+                ),
+            ));
+        }
+        if !(orientation_sigma_deg >= 0.0 && orientation_sigma_deg.is_finite()) {
+            return Err(Error::invalid(
+                "orientation_sigma_deg",
+                format!("{orientation_sigma_deg} is not a non-negative angle (deg)"),
+            ));
+        }
+        let mut out = Vec::with_capacity(qs.len());
+        let fr = *self.tracker.frame.pose();
+        for (i, q) in qs.iter().enumerate() {
+            self.truth
+                .check_joints(q, &format!("joint vector {}", i + 1))?;
+            let f = self.true_target_pose(q, t);
+            let p = self
+                .tracker
+                .measure(&f.translation.vector, &mut self.noise_rng);
+            let mut r = fr.rotation.inverse() * f.rotation;
+            if orientation_sigma_deg > 0.0 {
+                let mut v = Vector3::zeros();
+                for k in 0..3 {
+                    let z: f64 = StandardNormal.sample(&mut self.noise_rng);
+                    v[k] = orientation_sigma_deg.to_radians() * z;
+                }
+                r = nalgebra::Rotation3::new(v) * r;
+            }
+            out.push((p, *r.matrix()));
+        }
+        Ok(out)
+    }
+
     /// Measures the tool at every joint vector (rad): the tracker's readings (mm, tracker frame).
     pub fn measure_joints(&mut self, qs: &[Vec<f64>]) -> Result<Vec<Vector3<f64>>> {
         Ok(self.measure(qs)?.points)

@@ -152,6 +152,9 @@ pub struct Plausibility {
 pub struct Fit<'a> {
     /// The nominal model.
     pub nominal: &'a Robot,
+    /// The model the identification started from: the nominal geometry with the tools fitted
+    /// to the data (a tool the user did not know is not a move of the calibration).
+    pub start: &'a Robot,
     /// The calibrated model.
     pub calibrated: &'a Robot,
     /// The identified parameters.
@@ -213,8 +216,8 @@ fn largest_move(fit: &Fit, unit: Unit) -> Option<(Param, f64)> {
         .iter()
         .filter(|p| p.unit() == unit)
         .map(|&p| {
-            let nominal = if fit.nominal.has_param(p) {
-                fit.nominal.get(p)
+            let nominal = if fit.start.has_param(p) {
+                fit.start.get(p)
             } else {
                 0.0
             };

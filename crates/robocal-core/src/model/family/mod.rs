@@ -23,6 +23,7 @@
 pub mod base;
 pub mod beta;
 pub mod link;
+pub mod reflector;
 pub mod tool;
 
 #[cfg(test)]
@@ -49,8 +50,10 @@ impl FamilyId {
 }
 
 /// Priority classes for the identifiability analysis (lower is kept first when two parameters
-/// have the same effect). The paper's choice: the base frame first, then the tool position, then
-/// the joints in order, the tool orientation last; families beyond geometry after the geometry.
+/// have the same effect). The paper's choice: the base frame first, then the tool (which absorbs
+/// the last joint's d and phi), then the joints in order; families beyond geometry after the
+/// geometry. The tool orientation has no effect on points (it is fixed whatever its class); with
+/// 6-DoF data it absorbs phi_n as the tool position absorbs d_n.
 pub mod priority {
     /// The base frame vector B.
     pub const BASE: u32 = 0;
@@ -63,7 +66,7 @@ pub mod priority {
     /// Parameters that act through the joints (compliance, transmission errors).
     pub const NON_GEOMETRIC: u32 = 100_000;
     /// The tool orientation (invisible to point measurements).
-    pub const TOOL_ORIENTATION: u32 = 1_000_000;
+    pub const TOOL_ORIENTATION: u32 = 500;
 }
 
 /// One family of model parameters (see the module docs). Implementations are unit structs
@@ -147,15 +150,22 @@ pub fn by_key(key: &str) -> Option<(FamilyId, &'static dyn ParameterFamily)> {
 
 // The registry: a family's `ID` constant is its position here.
 #[cfg(not(test))]
-static REGISTRY: [&dyn ParameterFamily; 4] = [&link::Link, &beta::Beta, &base::Base, &tool::Tool];
-
-// Tests add a family written only against the trait, which proves the seam (`seam_tests`).
-#[cfg(test)]
 static REGISTRY: [&dyn ParameterFamily; 5] = [
     &link::Link,
     &beta::Beta,
     &base::Base,
     &tool::Tool,
+    &reflector::Reflector,
+];
+
+// Tests add a family written only against the trait, which proves the seam (`seam_tests`).
+#[cfg(test)]
+static REGISTRY: [&dyn ParameterFamily; 6] = [
+    &link::Link,
+    &beta::Beta,
+    &base::Base,
+    &tool::Tool,
+    &reflector::Reflector,
     &seam_tests::JointOffsets,
 ];
 
@@ -213,8 +223,11 @@ pub struct PoseFrames {
     pub link: [Frame; MAX_JOINTS],
     /// The flange frame `F_n`.
     pub flange: Frame,
-    /// The tool point (mm, ACS).
+    /// The tool point (mm, ACS): the point of target [`PoseFrames::target`].
     pub point: Vector3<f64>,
+    /// Which target's point `point` is (0-based; 0 is the tool of the paper, see
+    /// [`Robot::target_count`]). Families of one target's tool give zero columns for another's.
+    pub target: usize,
 }
 
 impl PoseFrames {

@@ -15,7 +15,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 const KEY: &str = "qoffset";
-const ID: FamilyId = FamilyId::new(4);
+const ID: FamilyId = FamilyId::new(5);
 
 /// Constant offsets added to the joint values (a test family).
 pub struct JointOffsets;
@@ -98,6 +98,9 @@ fn the_registry_positions_are_the_families_ids() {
         let mut ps = Vec::new();
         let mut r = offsets(&preset("kuka-kr480-r3330").unwrap(), &[0.0; 6]);
         r.enable_beta(2).unwrap();
+        let t0 = *r.tool0();
+        r.set_target_tools(&[t0, [50.0, 0.0, 20.0, 0.0, 0.0, 0.0]])
+            .unwrap();
         fam.params(&r, &mut ps);
         assert!(!ps.is_empty(), "{}", fam.key());
         for p in ps {

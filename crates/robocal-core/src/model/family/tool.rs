@@ -63,6 +63,14 @@ impl ParameterFamily for Tool {
         dp: &mut [Vector3<f64>],
         mut dw: Option<&mut [Vector3<f64>]>,
     ) {
+        if pose.target != 0 {
+            // Another target's point: this tool does not move it.
+            for k in 0..6 {
+                dp[k] = Vector3::zeros();
+                put(&mut dw, k, Vector3::zeros());
+            }
+            return;
+        }
         // Translations along the flange axes; the orientation turns the tool frame about the
         // tool point (the Euler axes of T0 + T, in the flange frame).
         let rn = pose.flange.rotation.matrix();

@@ -12,8 +12,10 @@
 //! orientation is not identifiable from points, and the Jacobians skip the angular columns.
 
 mod point;
+mod pose6;
 
 pub use point::Point;
+pub use pose6::{rotation_log, Pose6};
 
 use crate::frame::TrackerFrame;
 use crate::observations::Observations;
@@ -57,12 +59,22 @@ pub trait MeasurementKind: Sync {
         None
     }
 
+    /// How many of the last residual rows are orientation rows (rad): a fit weights them by
+    /// the observations' mm per radian ([`Observations::mm_per_rad`]).
+    fn orientation_rows(&self) -> usize {
+        0
+    }
+
     /// Numbers per observation in [`MeasurementKind::target`].
     fn target_len(&self) -> usize;
 
     /// Observation `i`'s measured values mapped into the base frame by the tracker frame
     /// `frame` (the paper's MF to ACS mapping), written to `out` (`target_len` numbers).
     fn target(&self, obs: &Observations, i: usize, frame: &TrackerFrame, out: &mut [f64]);
+
+    /// The target the model's own tool would give (`target_len` numbers, ACS): the residual
+    /// against it is zero. The identifiability analysis linearizes there.
+    fn model_target(&self, tool: &ToolState, out: &mut [f64]);
 
     /// The residual rows `measured - model` for one observation (`rows` numbers; for a point,
     /// the paper's E_i of eq. 3).
@@ -72,9 +84,11 @@ pub trait MeasurementKind: Sync {
     /// positions in the robot's parameter list), from the parameters' screws at the tool:
     /// `jp` (tool point velocities) and, when the kind sees orientation, `jw` (angular
     /// velocities). Written row-major to `out` (`rows x cols.len()`). The residual's Jacobian is
-    /// minus this.
+    /// minus this. `target` is the observation's target (some kinds linearize about the
+    /// residual).
     fn jacobian_rows(
         &self,
+        target: &[f64],
         tool: &ToolState,
         jp: &[Vector3<f64>],
         jw: Option<&[Vector3<f64>]>,

@@ -40,6 +40,10 @@ impl MeasurementKind for Point {
         out.copy_from_slice(t.as_slice());
     }
 
+    fn model_target(&self, tool: &ToolState, out: &mut [f64]) {
+        out[..3].copy_from_slice(tool.point.as_slice());
+    }
+
     #[inline]
     fn residual(&self, target: &[f64], tool: &ToolState, e: &mut [f64]) {
         for a in 0..3 {
@@ -50,6 +54,7 @@ impl MeasurementKind for Point {
     #[inline]
     fn jacobian_rows(
         &self,
+        _target: &[f64],
         _tool: &ToolState,
         jp: &[Vector3<f64>],
         _jw: Option<&[Vector3<f64>]>,

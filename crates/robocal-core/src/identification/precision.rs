@@ -1,0 +1,82 @@
+//! Practical identifiability: a parameter that is independent of the others in principle (it
+//! passes the rank test of [`super::identifiability`]) may still be one the data cannot pin, when
+//! its effect on the points is tiny compared with the measurement error: a wrist parameter seen
+//! only through a reflector 0.2 mm off the flange axis. Identifying it lets the solver move it by
+//! tens of millimetres or degrees to fit noise, and the plausibility gate then (rightly) rejects
+//! the fit.
+//!
+//! Before identification, at the starting model, the covariance of the identified parameters is
+//! predicted as `sigma0^2 (J^T W J)^-1` with `sigma0` the per-axis RMS error of the nominal
+//! geometry with the fitted tools (an upper bound of the noise: it still contains the geometric
+//! errors, so the prediction is conservative). A parameter whose predicted standard deviation
+//! exceeds a third of the largest move the plausibility gate accepts (3 sigma beyond it: 5% of
+//! the reach for lengths, 10 degrees for angles) is fixed, the worst first, and the others are
+//! predicted again without it, until every identified parameter is within its limit.
+
+use crate::identification::objective::Loss;
+use crate::identification::plausibility::{ANGLE_MOVE_LIMIT_DEG, LENGTH_MOVE_LIMIT};
+use crate::identification::system::{Level, Problem};
+use crate::model::{Param, Robot, Unit};
+use nalgebra::DMatrix;
+
+/// The limit of a parameter's predicted standard deviation (display unit): a third of the
+/// plausibility gate's largest move.
+pub fn std_limit(robot: &Robot, p: Param) -> f64 {
+    match p.unit() {
+        Unit::Mm => LENGTH_MOVE_LIMIT * robot.reach_mm() / 3.0,
+        _ => ANGLE_MOVE_LIMIT_DEG / 3.0,
+    }
+}
+
+/// A parameter the data cannot pin, with its predicted standard deviation and the limit (display
+/// unit).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Undetermined {
+    /// The parameter.
+    pub param: Param,
+    /// Its predicted standard deviation.
+    pub std: f64,
+    /// The limit it exceeds ([`std_limit`]).
+    pub limit: f64,
+}
+
+/// The identified parameters of `problem` that its data cannot pin (see the module docs), the
+/// worst first; `sigma0_mm` is the per-axis noise bound. Parameters in `keep` are never chosen.
+pub fn undetermined(
+    start: &Robot,
+    problem: &Problem,
+    sigma0_mm: f64,
+    keep_always: &[Param],
+) -> Vec<Undetermined> {
+    let params = problem.params();
+    if !(sigma0_mm > 0.0 && sigma0_mm.is_finite()) || params.is_empty() {
+        return Vec::new();
+    }
+    let acc = problem.accumulate(start, &Loss::Squared, Level::Full);
+    let Some(s) = acc.s else { return Vec::new() };
+    let mut keep: Vec<usize> = (0..params.len()).collect();
+    let mut out = Vec::new();
+    while !keep.is_empty() {
+        let k = keep.len();
+        let sub = DMatrix::from_fn(k, k, |r, c| s[(keep[r], keep[c])]);
+        let Some(ch) = sub.cholesky() else { break };
+        let inv = ch.inverse();
+        let worst = (0..k)
+            .filter(|&r| !keep_always.contains(&params[keep[r]]))
+            .map(|r| {
+                let p = params[keep[r]];
+                let std = sigma0_mm * inv[(r, r)].max(0.0).sqrt() * p.unit().from_internal(1.0);
+                (r, std, std_limit(start, p))
+            })
+            .filter(|(_, std, limit)| std > limit)
+            .max_by(|a, b| (a.1 / a.2).total_cmp(&(b.1 / b.2)));
+        let Some((r, std, limit)) = worst else { break };
+        out.push(Undetermined {
+            param: params[keep[r]],
+            std,
+            limit,
+        });
+        keep.remove(r);
+    }
+    out
+}

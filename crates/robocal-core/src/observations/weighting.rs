@@ -1,0 +1,82 @@
+//! Weighted fitting (DESIGN.md, `sigma_mm`): every tracker's uncertainty grows with the distance
+//! from the tracker, and 6-DoF data mix millimetres with degrees. A fit weights each
+//! observation's rows by `sigma_mean / sigma_i` (weighted least squares, with residuals kept in mm
+//! of a typical point), and an orientation row by the mm one degree of orientation error counts
+//! as. A point's sigma comes from its `sigma_mm` cell or, without one, from a tracker model
+//! `sigma(d) = fixed + per_m * d` with `d` the point's distance from the tracker (the norm of the
+//! measured point in the tracker frame).
+
+use super::Observations;
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// The default weight of orientation rows (mm per degree): the ratio of a 6-DoF probe's typical
+/// position uncertainty at a few metres (about 0.03 mm) to its orientation uncertainty (about
+/// 0.01 degree), so that one degree of orientation error counts like 3 mm of position error.
+pub const DEFAULT_MM_PER_DEG: f64 = 3.0;
+
+/// A tracker's 1-sigma uncertainty per axis as a function of distance.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrackerSigma {
+    /// The part independent of distance (mm).
+    pub fixed_mm: f64,
+    /// The part proportional to the distance from the tracker (mm per metre).
+    pub per_m_mm: f64,
+}
+
+impl TrackerSigma {
+    /// A checked model: both parts finite and non-negative, not both zero.
+    pub fn new(fixed_mm: f64, per_m_mm: f64) -> Result<TrackerSigma> {
+        let ok = |v: f64| v >= 0.0 && v.is_finite() && v <= 1e3;
+        if !ok(fixed_mm) || !ok(per_m_mm) || fixed_mm + per_m_mm <= 0.0 {
+            return Err(Error::invalid(
+                "weighting.tracker",
+                format!(
+                    "{fixed_mm}, {per_m_mm} is not a tracker uncertainty: a fixed part (mm) and a \
+                     part per metre of distance (mm/m), both non-negative and not both zero"
+                ),
+            ));
+        }
+        Ok(TrackerSigma { fixed_mm, per_m_mm })
+    }
+
+    /// The sigma at `distance_mm` from the tracker (mm).
+    pub fn sigma_at(&self, distance_mm: f64) -> f64 {
+        self.fixed_mm + self.per_m_mm * distance_mm / 1000.0
+    }
+}
+
+/// How a fit weights observations (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Weighting {
+    /// The tracker model for points without a `sigma_mm` cell; `None` leaves them unweighted
+    /// (when no point has a cell).
+    pub tracker: Option<TrackerSigma>,
+    /// How many mm of position error one degree of orientation error counts as.
+    pub mm_per_deg: f64,
+}
+
+impl Default for Weighting {
+    fn default() -> Self {
+        Weighting {
+            tracker: None,
+            mm_per_deg: DEFAULT_MM_PER_DEG,
+        }
+    }
+}
+
+impl Weighting {
+    /// `obs` with these weights applied: the tracker model's sigmas where the observations have
+    /// none, and the orientation weight.
+    pub fn apply(&self, obs: &Observations) -> Result<Observations> {
+        let mut out = obs.clone();
+        out.set_mm_per_deg(self.mm_per_deg)?;
+        if let (Some(t), false) = (self.tracker, obs.has_sigma()) {
+            let s = (0..obs.len())
+                .map(|i| t.sigma_at(obs.m(i).norm()))
+                .collect();
+            out.set_sigmas(Some(s))?;
+        }
+        Ok(out)
+    }
+}
