@@ -30,6 +30,7 @@ mod cli_joints;
 mod cli_result_self_contained;
 mod cli_robot;
 mod cli_settings;
+mod cli_shell;
 mod cli_simulate;
 #[cfg(unix)]
 mod cli_trust_files;
