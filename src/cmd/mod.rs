@@ -11,6 +11,7 @@ mod io_plan;
 mod limits;
 mod paper_tables;
 mod report;
+mod report_meta;
 mod robot;
 mod shell;
 mod simulate;

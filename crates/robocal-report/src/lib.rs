@@ -78,6 +78,14 @@ pub const HISTOGRAM_FILE: &str = "histogram.svg";
 /// Title of the histogram figure.
 pub const HISTOGRAM_TITLE: &str = "Displacement error before and after calibration";
 
+/// How a report names a file: its name alone, never the directories of the machine that made
+/// the report (a report is handed on; `/home/me/cell/data.csv` shows as `data.csv`).
+pub fn file_name(path: impl AsRef<Path>) -> String {
+    let p = path.as_ref();
+    p.file_name()
+        .map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
+}
+
 /// The rendered report, in memory.
 #[derive(Debug, Clone)]
 pub struct Rendered {
