@@ -81,10 +81,16 @@ impl ReportData {
     /// the paper's figures beside the tables. For previewing the report's layout and for tests:
     /// the numbers are made up.
     pub fn synthetic_example(seed: u64) -> ReportData {
+        ReportData::synthetic_sized(seed, 75, 73)
+    }
+
+    /// [`ReportData::synthetic_example`] with `calibration` calibration and verification points
+    /// and `validation` validation points: a large run for tests of the page's size and speed.
+    pub fn synthetic_sized(seed: u64, calibration: usize, validation: usize) -> ReportData {
         let mut rng = Mix(seed);
-        let cal = set("Calibration", 75, 0.17, &mut rng);
-        let val = set("Validation", 73, 0.24, &mut rng);
-        let mut ver = set("Verification", 75, 0.29, &mut rng);
+        let cal = set("Calibration", calibration, 0.17, &mut rng);
+        let val = set("Validation", validation, 0.24, &mut rng);
+        let mut ver = set("Verification", calibration, 0.29, &mut rng);
         for (p, c) in ver.points.iter_mut().zip(&cal.points) {
             p.reach_mm = c.reach_mm;
             p.before_mm = f64::NAN;
