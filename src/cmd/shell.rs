@@ -66,7 +66,5 @@ fn write_stdout(bytes: &[u8]) -> anyhow::Result<()> {
     let mut so = std::io::stdout().lock();
     so.write_all(bytes)
         .and_then(|_| so.flush())
-        .map_err(|e| {
-            anyhow::Error::new(e).context("writing to standard output")
-        })
+        .map_err(|e| anyhow::Error::new(e).context("writing to standard output"))
 }

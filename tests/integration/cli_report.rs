@@ -70,7 +70,10 @@ fn shipped_example_data_is_what_simulate_makes() {
             };
             assert_eq!(strip(&shipped), strip(&made), "{f} differs");
         } else {
-            assert!(shipped == made, "examples/data/{f} is not what simulate makes");
+            assert!(
+                shipped == made,
+                "examples/data/{f} is not what simulate makes"
+            );
         }
     }
 }
@@ -121,7 +124,10 @@ fn report_names_the_run_and_no_directory_of_this_machine() {
     assert_eq!(html.matches("<tr><td>Validation</td>").count(), 30);
     let tmp_dir = tmp.path().display().to_string();
     assert!(!html.contains(&tmp_dir), "the report shows {tmp_dir}");
-    assert!(!html.contains(root().to_str().unwrap()), "the report shows the repository path");
+    assert!(
+        !html.contains(root().to_str().unwrap()),
+        "the report shows the repository path"
+    );
     // the same date gives the same bytes
     let first = std::fs::read(out.join("report.html")).unwrap();
     assert!(at_epoch(&args, "86400").status.success());
@@ -142,7 +148,13 @@ fn paper_figures_only_for_the_papers_robot() {
     assert!(!tmp.join("rep").exists(), "nothing written");
     // the paper's robot: accepted (cli_demo checks the figures)
     let cell = fixtures::cell();
-    ok(&["report", p(&cell.result), "--paper", "--out", p(&tmp.join("kuka"))]);
+    ok(&[
+        "report",
+        p(&cell.result),
+        "--paper",
+        "--out",
+        p(&tmp.join("kuka")),
+    ]);
 }
 
 #[test]
@@ -161,7 +173,14 @@ fn bad_run_file_or_temperature_is_refused_before_any_work() {
     assert!(o.stderr().contains("operater"), "{}", o.stderr());
     let hot = tmp.write("hot.toml", "temperature_c = 250\n");
     robocal(&["report", p(&res), "--meta", p(&hot), "--out", p(&out)]).assert_code(3);
-    let o = robocal(&["report", p(&res), "--temperature-c", "-99", "--out", p(&out)]);
+    let o = robocal(&[
+        "report",
+        p(&res),
+        "--temperature-c",
+        "-99",
+        "--out",
+        p(&out),
+    ]);
     o.assert_code(2);
     assert!(o.stderr().contains("--temperature-c"), "{}", o.stderr());
     let o = robocal(&[
@@ -201,7 +220,10 @@ fn real_ur5_after_calibration_spreads_over_at_least_8_bins() {
     let out = ok(&["report", p(&res), "--out", p(&tmp.join("rep"))]);
     assert!(out.stdout().contains("report:"));
     let html = std::fs::read_to_string(tmp.join("rep/report.html")).unwrap();
-    assert!(html.contains("log-spaced bins"), "the caption names the rule");
+    assert!(
+        html.contains("log-spaced bins"),
+        "the caption names the rule"
+    );
 
     // The same report through the library: count the bins.
     let result = CalibrationResult::read(&res).unwrap();

@@ -14,7 +14,10 @@ fn completions_name_the_commands_and_flags() {
     }
     // bash: the script defines its function and registers it for robocal.
     let s = ok(&["completions", "bash"]).stdout();
-    assert!(s.contains("complete -F _robocal") && s.contains("robocal"), "{s}");
+    assert!(
+        s.contains("complete -F _robocal") && s.contains("robocal"),
+        "{s}"
+    );
     robocal(&["completions", "tcsh"]).assert_code(2);
 }
 

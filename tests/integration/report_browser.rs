@@ -208,7 +208,10 @@ fn layout(chromium: &Path, html: &Path, width: u32) -> serde_json::Value {
     let profile = Dir::new();
     let page = std::fs::read_to_string(html).unwrap();
     assert!(!page.contains("<script"), "a report never has scripts");
-    let probed = tmp.write("probed.html", page.replace("</body>", &format!("{PROBE}</body>")));
+    let probed = tmp.write(
+        "probed.html",
+        page.replace("</body>", &format!("{PROBE}</body>")),
+    );
     let o = Command::new(chromium)
         .args([
             "--headless",
@@ -229,10 +232,12 @@ fn layout(chromium: &Path, html: &Path, width: u32) -> serde_json::Value {
         .output()
         .expect("starting chromium");
     let dom = String::from_utf8_lossy(&o.stdout);
-    let start = dom
-        .find("<pre id=\"layout-probe\">")
-        .unwrap_or_else(|| panic!("no layout probe in the DOM Chromium dumped ({} bytes)", dom.len()))
-        + "<pre id=\"layout-probe\">".len();
+    let start = dom.find("<pre id=\"layout-probe\">").unwrap_or_else(|| {
+        panic!(
+            "no layout probe in the DOM Chromium dumped ({} bytes)",
+            dom.len()
+        )
+    }) + "<pre id=\"layout-probe\">".len();
     let end = start + dom[start..].find("</pre>").unwrap();
     serde_json::from_str(&dom[start..end].replace("&quot;", "\"")).expect("probe JSON")
 }
@@ -242,13 +247,19 @@ fn layout(chromium: &Path, html: &Path, width: u32) -> serde_json::Value {
 fn assert_fits(l: &serde_json::Value, width: u32, figures: u64) {
     eprintln!("layout at {width} px: {l}");
     let vw = l["vw"].as_f64().unwrap();
-    assert!(vw > 0.8 * width as f64, "viewport {vw} px in a {width} px window");
+    assert!(
+        vw > 0.8 * width as f64,
+        "viewport {vw} px in a {width} px window"
+    );
     assert!(
         l["scroll_w"].as_f64().unwrap() <= vw,
         "the page scrolls sideways at {width} px: {l}"
     );
     for what in ["nav", "figures", "sections", "meta"] {
-        assert_eq!(l[what][1], 0, "{what} outside the window at {width} px: {l}");
+        assert_eq!(
+            l[what][1], 0,
+            "{what} outside the window at {width} px: {l}"
+        );
     }
     assert!(l["nav"][0].as_u64().unwrap() >= 8, "navigation links: {l}");
     assert_eq!(l["figures"][0].as_u64().unwrap(), figures, "figures: {l}");
@@ -290,7 +301,10 @@ fn a_200000_point_report_loads_in_under_3_s() {
     let bytes = std::fs::metadata(&files.html).unwrap().len();
     let l = layout(&chromium, &files.html, 1280);
     let ms = l["load_ms"].as_f64().unwrap();
-    eprintln!("200,000 points: {:.2} MB, loaded and laid out in {ms:.0} ms", bytes as f64 / 1e6);
+    eprintln!(
+        "200,000 points: {:.2} MB, loaded and laid out in {ms:.0} ms",
+        bytes as f64 / 1e6
+    );
     assert!(bytes < 5_000_000, "{bytes} bytes");
     assert!(ms < 3000.0, "{ms:.0} ms to load and lay out");
     assert_fits(&l, 1280, 5);

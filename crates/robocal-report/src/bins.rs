@@ -198,7 +198,8 @@ pub fn bin_series(series: &[&[f64]]) -> Option<Binning> {
     };
     let want_log = min >= 0.0
         && max > 0.0
-        && (linear_needs > MAX_LINEAR_BINS as f64 || (med_lo > 0.0 && med_hi >= LOG_RATIO * med_lo));
+        && (linear_needs > MAX_LINEAR_BINS as f64
+            || (med_lo > 0.0 && med_hi >= LOG_RATIO * med_lo));
     let edges = if want_log {
         log_edges(&cleaned, hi)
     } else {

@@ -65,7 +65,11 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
         set.name.to_lowercase()
     );
     if stages.len() == 1 {
-        let _ = write!(cap, " Only {} calibration is known for these points.", stages[0].1);
+        let _ = write!(
+            cap,
+            " Only {} calibration is known for these points.",
+            stages[0].1
+        );
     }
     crate::markup::figure(h, &svg.finish(), &cap);
     h.push_str("</section>\n");
@@ -87,7 +91,14 @@ fn component(set: &PointSet, stage: usize, axis: usize) -> Vec<f64> {
 }
 
 /// One histogram panel at (x, y) of width `w`.
-fn panel(svg: &mut Svg, values: &[f64], stage: usize, axis: usize, when: &str, at: (f64, f64, f64)) {
+fn panel(
+    svg: &mut Svg,
+    values: &[f64],
+    stage: usize,
+    axis: usize,
+    when: &str,
+    at: (f64, f64, f64),
+) {
     let (x0, y0, w) = at;
     let name = ["dx", "dy", "dz"][axis];
     let Some(b) = bin_series(&[values]) else {

@@ -261,8 +261,7 @@ where
     let (plot_w, plot_h) = chart.plotting_area().dim_in_pixel();
     let bar_px = plot_w as f64 * b.width() * slot / (x_hi - x_lo);
     let show_counts = bar_px >= 11.0;
-    let shows_mean =
-        |s: usize| b.n[s] > 0 && b.mean[s].is_finite() && b.axis(b.mean[s]) <= x_hi;
+    let shows_mean = |s: usize| b.n[s] > 0 && b.mean[s].is_finite() && b.axis(b.mean[s]) <= x_hi;
     if log {
         log_ticks(&mut chart, b, x_lo, cap_axis, y_hi)?;
     }
@@ -438,4 +437,3 @@ pub(crate) fn section(page: &crate::sections::Page, h: &mut String) -> Result<bo
     h.push_str("</section>\n");
     Ok(true)
 }
-

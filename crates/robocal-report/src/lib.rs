@@ -60,8 +60,7 @@ pub use build::{before_after_histogram, paper, paper_tables};
 pub use data::{
     CorrelatedPair, ErrorRow, ErrorTable, FixedParam, HistogramSeries, Identifiability, Note,
     NoteLevel, PaperStats, ParamRow, PointDetail, PointError, PointSet, ReachKind, ReportData,
-    Setting,
-    SolverSummary,
+    Setting, SolverSummary,
 };
 pub use histogram::{histogram_svg, HistogramFigure};
 pub use numfmt::number_list;
@@ -82,8 +81,10 @@ pub const HISTOGRAM_TITLE: &str = "Displacement error before and after calibrati
 /// the report (a report is handed on; `/home/me/cell/data.csv` shows as `data.csv`).
 pub fn file_name(path: impl AsRef<Path>) -> String {
     let p = path.as_ref();
-    p.file_name()
-        .map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned())
+    p.file_name().map_or_else(
+        || p.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
 }
 
 /// The rendered report, in memory.

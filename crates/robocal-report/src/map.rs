@@ -30,7 +30,9 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
     }
     let errors: Vec<f64> = pts.iter().map(|p| p.1).collect();
     let emax = errors.iter().copied().fold(0.0f64, f64::max);
-    let top = crate::bins::outlier_cap(&errors, 0.0).unwrap_or(emax).max(1e-9);
+    let top = crate::bins::outlier_cap(&errors, 0.0)
+        .unwrap_or(emax)
+        .max(1e-9);
     let dense = pts.len() > MARKER_LIMIT;
     let mut svg = Svg::new(
         W,
@@ -43,22 +45,20 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
             top
         ),
     );
-    let reach = |p: &[f64; 3]| p[0].hypot(p[1]);
-    let views: [(&str, &str, &str, Box<dyn Fn(&[f64; 3]) -> (f64, f64)>); 2] = [
-        ("Top view", "x (mm)", "y (mm)", Box::new(|p| (p[0], p[1]))),
+    let views = [
+        ("Top view", "x (mm)", "y (mm)"),
         (
             "Side view (around the base axis)",
             "Reach from the base z axis (mm)",
             "z (mm)",
-            Box::new(move |p| (reach(p), p[2])),
         ),
     ];
     let pw = W as f64 / 2.0;
-    for (i, (title, xl, yl, f)) in views.iter().enumerate() {
+    for (i, (title, xl, yl)) in views.iter().enumerate() {
         let xy: Vec<(f64, f64, f64)> = pts
             .iter()
             .map(|(p, e)| {
-                let (x, y) = f(p);
+                let (x, y) = project(i, p);
                 (x, y, *e)
             })
             .collect();
@@ -130,4 +130,13 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
     crate::markup::figure(h, &svg.finish(), &cap);
     h.push_str("</section>\n");
     Ok(true)
+}
+
+/// A point in view `view`: 0 from above (x, y), 1 from the side (reach from the base z axis, z).
+fn project(view: usize, p: &[f64; 3]) -> (f64, f64) {
+    if view == 0 {
+        (p[0], p[1])
+    } else {
+        (p[0].hypot(p[1]), p[2])
+    }
 }

@@ -253,12 +253,7 @@ impl ReportData {
             ));
         }
         data.point_sets = sets;
-        data.joint_units = run
-            .nominal
-            .joint_types()
-            .iter()
-            .map(|t| t.unit())
-            .collect();
+        data.joint_units = run.nominal.joint_types().iter().map(|t| t.unit()).collect();
         data.reach = ReachKind::Radial;
         Ok(data)
     }

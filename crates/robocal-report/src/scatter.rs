@@ -344,12 +344,10 @@ pub(crate) fn section(page: &crate::sections::Page, h: &mut String) -> Result<bo
             cap,
             " {} points: every {}th point of each set is drawn, and the 20 largest errors of \
              each panel (the statistics use them all).",
-            fig.total,
-            fig.shown_every
+            fig.total, fig.shown_every
         );
     }
     crate::markup::figure(h, &fig.svg, &cap);
     h.push_str("</section>\n");
     Ok(true)
 }
-

@@ -30,17 +30,61 @@ pub struct Section {
 
 /// The sections, in page order.
 pub const SECTIONS: &[Section] = &[
-    Section { id: "summary", nav: "Summary", render: crate::summary::section },
-    Section { id: "errors", nav: "Error statistics", render: crate::tables::errors_section },
-    Section { id: "histogram", nav: "Histogram", render: crate::histogram::section },
-    Section { id: "components", nav: "x, y, z", render: crate::components::section },
-    Section { id: "workspace", nav: "Reach", render: crate::scatter::section },
-    Section { id: "joints", nav: "Joints", render: crate::joints::section },
-    Section { id: "map", nav: "Workspace map", render: crate::map::section },
-    Section { id: "parameters", nav: "Parameters", render: crate::tables::parameters_section },
-    Section { id: "identification", nav: "Identifiability & solver", render: crate::identification::section },
-    Section { id: "settings", nav: "Settings", render: crate::tables::settings_section },
-    Section { id: "points", nav: "Points", render: crate::points_table::section },
+    Section {
+        id: "summary",
+        nav: "Summary",
+        render: crate::summary::section,
+    },
+    Section {
+        id: "errors",
+        nav: "Error statistics",
+        render: crate::tables::errors_section,
+    },
+    Section {
+        id: "histogram",
+        nav: "Histogram",
+        render: crate::histogram::section,
+    },
+    Section {
+        id: "components",
+        nav: "x, y, z",
+        render: crate::components::section,
+    },
+    Section {
+        id: "workspace",
+        nav: "Reach",
+        render: crate::scatter::section,
+    },
+    Section {
+        id: "joints",
+        nav: "Joints",
+        render: crate::joints::section,
+    },
+    Section {
+        id: "map",
+        nav: "Workspace map",
+        render: crate::map::section,
+    },
+    Section {
+        id: "parameters",
+        nav: "Parameters",
+        render: crate::tables::parameters_section,
+    },
+    Section {
+        id: "identification",
+        nav: "Identifiability & solver",
+        render: crate::identification::section,
+    },
+    Section {
+        id: "settings",
+        nav: "Settings",
+        render: crate::tables::settings_section,
+    },
+    Section {
+        id: "points",
+        nav: "Points",
+        render: crate::points_table::section,
+    },
 ];
 
 /// The point set whose details the per-axis, per-joint and map views show, and the others with

@@ -115,4 +115,3 @@ fn notes(h: &mut String, notes: &[Note]) {
         }
     }
 }
-

@@ -114,10 +114,10 @@ impl Frame {
         let mut v = (self.y.0 / ys).ceil() * ys;
         while v <= self.y.1 + 1e-9 * ys {
             let y = self.py(v);
-            let _ = write!(
+            let _ = writeln!(
                 s,
                 "<path d=\"M{l:.1} {y:.1}h{w:.1}\" stroke=\"#e3e3e3\"/>\
-                 <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"end\" fill=\"#444\">{}</text>\n",
+                 <text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"end\" fill=\"#444\">{}</text>",
                 l - 4.0,
                 y + 3.5,
                 axis_number(v, yd + 1)
@@ -130,10 +130,10 @@ impl Frame {
         let mut v = (self.x.0 / xs).ceil() * xs;
         while v <= self.x.1 + 1e-9 * xs {
             let x = self.px(v);
-            let _ = write!(
+            let _ = writeln!(
                 s,
                 "<path d=\"M{x:.1} {:.1}v4\" stroke=\"#666\"/>\
-                 <text x=\"{x:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"middle\" fill=\"#444\">{}</text>\n",
+                 <text x=\"{x:.1}\" y=\"{:.1}\" font-size=\"11\" text-anchor=\"middle\" fill=\"#444\">{}</text>",
                 t + h,
                 t + h + 15.0,
                 axis_number(v, xd + 1)
@@ -145,8 +145,22 @@ impl Frame {
             "<rect x=\"{l:.1}\" y=\"{t:.1}\" width=\"{w:.1}\" height=\"{h:.1}\" fill=\"none\" stroke=\"#666\"/>"
         );
         svg.raw(&s);
-        svg.text(l + w / 2.0, t - 8.0, title, 13.0, "middle", "font-weight=\"600\"");
-        svg.text(l + w / 2.0, t + h + 31.0, xlabel, 11.5, "middle", "fill=\"#333\"");
+        svg.text(
+            l + w / 2.0,
+            t - 8.0,
+            title,
+            13.0,
+            "middle",
+            "font-weight=\"600\"",
+        );
+        svg.text(
+            l + w / 2.0,
+            t + h + 31.0,
+            xlabel,
+            11.5,
+            "middle",
+            "fill=\"#333\"",
+        );
         let (cx, cy) = (l - 36.0, t + h / 2.0);
         let _ = writeln!(
             svg.buf,
@@ -194,7 +208,11 @@ pub fn viridis(t: f64) -> String {
         (94.0, 201.0, 98.0),
         (253.0, 231.0, 37.0),
     ];
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.0 };
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let f = t * (STOPS.len() - 1) as f64;
     let i = (f.floor() as usize).min(STOPS.len() - 2);
     let u = f - i as f64;
@@ -219,9 +237,30 @@ pub fn colorbar(svg: &mut Svg, x: f64, y: f64, w: f64, lo: f64, hi: f64, label: 
     s.push('\n');
     svg.raw(&s);
     let d = decimals_for(nice_step((hi - lo) / 4.0)) + 1;
-    svg.text(x, y + 23.0, &axis_number(lo, d), 11.0, "start", "fill=\"#444\"");
-    svg.text(x + w, y + 23.0, &axis_number(hi, d), 11.0, "end", "fill=\"#444\"");
-    svg.text(x + w / 2.0, y + 23.0, label, 11.0, "middle", "fill=\"#333\"");
+    svg.text(
+        x,
+        y + 23.0,
+        &axis_number(lo, d),
+        11.0,
+        "start",
+        "fill=\"#444\"",
+    );
+    svg.text(
+        x + w,
+        y + 23.0,
+        &axis_number(hi, d),
+        11.0,
+        "end",
+        "fill=\"#444\"",
+    );
+    svg.text(
+        x + w / 2.0,
+        y + 23.0,
+        label,
+        11.0,
+        "middle",
+        "fill=\"#333\"",
+    );
 }
 
 /// Counts of points in a grid of `nx` x `ny` cells over a frame, with a value summed per cell.
@@ -238,7 +277,12 @@ pub struct Grid {
 
 impl Grid {
     /// Bins `(x, y, value)` over `frame`; points outside the frame are left out.
-    pub fn new(frame: &Frame, nx: usize, ny: usize, pts: impl Iterator<Item = (f64, f64, f64)>) -> Grid {
+    pub fn new(
+        frame: &Frame,
+        nx: usize,
+        ny: usize,
+        pts: impl Iterator<Item = (f64, f64, f64)>,
+    ) -> Grid {
         let mut g = Grid {
             nx,
             ny,
@@ -296,7 +340,12 @@ pub fn density_color(count: usize, max: usize) -> String {
     let t = ((count as f64).ln_1p() / (max.max(1) as f64).ln_1p()).clamp(0.0, 1.0);
     let t = 0.15 + 0.85 * t;
     let mix = |c: f64| (255.0 + t * (c - 255.0)).round() as u8;
-    format!("#{:02x}{:02x}{:02x}", mix(0.0), mix(0x72 as f64), mix(0xB2 as f64))
+    format!(
+        "#{:02x}{:02x}{:02x}",
+        mix(0.0),
+        mix(0x72 as f64),
+        mix(0xB2 as f64)
+    )
 }
 
 #[cfg(test)]

@@ -4,9 +4,9 @@
 use crate::data::{ErrorRow, ErrorTable, FixedParam, ParamRow, ReportData};
 use crate::escape::xml as esc;
 use crate::numfmt::{fixed, mm, sig2, signed, DASH};
-use robocal_core::Unit;
 use crate::sections::Page;
 use robocal_core::Result;
+use robocal_core::Unit;
 use std::fmt::Write;
 
 /// Decimals of parameter values (mm and degrees).
