@@ -28,12 +28,56 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
     if pts.is_empty() {
         return Ok(false);
     }
-    let errors: Vec<f64> = pts.iter().map(|p| p.1).collect();
-    let emax = errors.iter().copied().fold(0.0f64, f64::max);
-    let top = crate::bins::outlier_cap(&errors, 0.0)
-        .unwrap_or(emax)
-        .max(1e-9);
     let dense = pts.len() > MARKER_LIMIT;
+    let pw = W as f64 / 2.0;
+    let frames: Vec<Frame> = (0..2)
+        .map(|i| {
+            let xy: Vec<(f64, f64)> = pts.iter().map(|(p, _)| project(i, p)).collect();
+            Frame {
+                left: i as f64 * pw + 66.0,
+                top: 30.0,
+                width: pw - 86.0,
+                height: H as f64 - 30.0 - 100.0,
+                x: range_of(xy.iter().map(|p| p.0), false),
+                y: range_of(xy.iter().map(|p| p.1), false),
+            }
+            .equal_aspect()
+        })
+        .collect();
+    let grids: Vec<Grid> = if dense {
+        frames
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let xy = pts.iter().map(|(p, e)| {
+                    let (x, y) = project(i, p);
+                    (x, y, *e)
+                });
+                Grid::new(f, 64, 40, xy)
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
+    // The colour scale spans the 2nd to the 98th percentile of what is coloured (the points'
+    // errors, or the cells' mean errors), so that a few extremes do not darken everything.
+    let coloured: Vec<f64> = if dense {
+        grids
+            .iter()
+            .flat_map(|g| {
+                g.count
+                    .iter()
+                    .zip(&g.sum)
+                    .filter(|(c, _)| **c > 0)
+                    .map(|(c, s)| s / *c as f64)
+            })
+            .collect()
+    } else {
+        pts.iter().map(|p| p.1).collect()
+    };
+    let lo = robocal_core::stats::percentile(&coloured, 0.02);
+    let top = robocal_core::stats::percentile(&coloured, 0.98).max(lo + 1e-9);
+    let scale = |e: f64| (e - lo) / (top - lo);
     let mut svg = Svg::new(
         W,
         H,
@@ -53,8 +97,8 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
             "z (mm)",
         ),
     ];
-    let pw = W as f64 / 2.0;
     for (i, (title, xl, yl)) in views.iter().enumerate() {
+        let frame = frames[i];
         let xy: Vec<(f64, f64, f64)> = pts
             .iter()
             .map(|(p, e)| {
@@ -62,19 +106,9 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
                 (x, y, *e)
             })
             .collect();
-        let frame = Frame {
-            left: i as f64 * pw + 66.0,
-            top: 30.0,
-            width: pw - 86.0,
-            height: H as f64 - 30.0 - 100.0,
-            x: range_of(xy.iter().map(|p| p.0), false),
-            y: range_of(xy.iter().map(|p| p.1), false),
-        }
-        .equal_aspect();
         frame.axes(&mut svg, title, xl, yl);
         if dense {
-            let g = Grid::new(&frame, 64, 40, xy.iter().copied());
-            g.draw(&mut svg, &frame, |_, mean| viridis(mean / top));
+            grids[i].draw(&mut svg, &frame, |_, mean| viridis(scale(mean)));
         } else {
             // Smallest errors first, so that the largest are on top.
             let mut order: Vec<usize> = (0..xy.len()).collect();
@@ -82,7 +116,7 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
             let mut buckets: Vec<Vec<(f64, f64)>> = vec![Vec::new(); STEPS];
             for k in order {
                 let (x, y, e) = xy[k];
-                let b = (((e / top) * STEPS as f64).floor() as usize).min(STEPS - 1);
+                let b = ((scale(e).max(0.0) * STEPS as f64).floor() as usize).min(STEPS - 1);
                 // One marker path per colour step, drawn from the smallest step up.
                 buckets[b].push((frame.px(x), frame.py(y)));
             }
@@ -102,7 +136,7 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
         W as f64 / 2.0 - 180.0,
         H as f64 - 38.0,
         360.0,
-        0.0,
+        lo,
         top,
         "Error after calibration (mm)",
     );
@@ -120,13 +154,18 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
             pts.len()
         );
     }
-    if top < emax {
-        let _ = write!(
-            cap,
-            " Errors above {} mm have the colour of the scale's top.",
-            crate::numfmt::mm(top)
-        );
-    }
+    let _ = write!(
+        cap,
+        " The colour scale runs from the 2nd to the 98th percentile of the {} ({} to {} mm); \
+         values beyond it have the colour of its end.",
+        if dense {
+            "cells' mean errors"
+        } else {
+            "errors"
+        },
+        crate::numfmt::mm(lo),
+        crate::numfmt::mm(top)
+    );
     crate::markup::figure(h, &svg.finish(), &cap);
     h.push_str("</section>\n");
     Ok(true)
