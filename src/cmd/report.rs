@@ -128,6 +128,7 @@ impl TryFrom<&ReportArgs> for Settings {
             .input_opt("--data", a.data.as_deref())
             .input_opt("--validate", a.validate.as_deref())
             .input_opt("--verify", a.verify.as_deref())
+            .input_opt("--meta", a.meta.meta.as_deref())
             .output_dir("--out", &a.out, &[HTML_FILE, HISTOGRAM_FILE]);
         if let Some(r) = &a.robot {
             plan.robot("--robot", r);

@@ -193,6 +193,13 @@ fn bad_run_file_or_temperature_is_refused_before_any_work() {
     ]);
     o.assert_code(4);
     assert!(!out.exists(), "nothing written");
+    // The run file is an input: the report may not overwrite it.
+    std::fs::create_dir(&out).unwrap();
+    let inside = out.join("report.html");
+    std::fs::write(&inside, "serial = \"A\"\n").unwrap();
+    let o = robocal(&["report", p(&res), "--meta", p(&inside), "--out", p(&out)]);
+    o.assert_code(2);
+    assert_eq!(std::fs::read_to_string(&inside).unwrap(), "serial = \"A\"\n");
 }
 
 /// The first finding: fixed 0.2 mm bins put 956 of the 1000 calibrated UR5 points into
