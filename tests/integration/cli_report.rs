@@ -199,7 +199,10 @@ fn bad_run_file_or_temperature_is_refused_before_any_work() {
     std::fs::write(&inside, "serial = \"A\"\n").unwrap();
     let o = robocal(&["report", p(&res), "--meta", p(&inside), "--out", p(&out)]);
     o.assert_code(2);
-    assert_eq!(std::fs::read_to_string(&inside).unwrap(), "serial = \"A\"\n");
+    assert_eq!(
+        std::fs::read_to_string(&inside).unwrap(),
+        "serial = \"A\"\n"
+    );
 }
 
 /// The first finding: fixed 0.2 mm bins put 956 of the 1000 calibrated UR5 points into
