@@ -6,8 +6,8 @@
 use crate::bins::bin_series;
 use crate::data::PointSet;
 use crate::numfmt::signed;
+use crate::page::{detailed_sets, Page};
 use crate::plot::SERIES_COLORS;
-use crate::sections::{detailed_sets, Page};
 use crate::svgplot::{range_of, Frame, Svg};
 use robocal_core::Result;
 use std::fmt::Write;

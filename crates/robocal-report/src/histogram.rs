@@ -419,21 +419,3 @@ fn tick_label(v: f64) -> String {
         format!("{v:.*}", (-k) as usize)
     }
 }
-
-/// The histogram section of the page.
-pub(crate) fn section(page: &crate::sections::Page, h: &mut String) -> Result<bool> {
-    let (data, fig) = (page.data, page.histogram);
-    h.push_str("<section id=\"histogram\">\n<h2>Distribution of the displacement error</h2>\n");
-
-    let mut cap = String::from(
-        "Histogram of the displacement error before and after calibration (cf. the paper’s \
-         Fig. 2). Bars: number of points per bin; dashed lines: means.",
-    );
-    for n in fig.notes(&data.histogram) {
-        cap.push(' ');
-        cap.push_str(&n);
-    }
-    crate::markup::figure(h, &fig.svg, &cap);
-    h.push_str("</section>\n");
-    Ok(true)
-}

@@ -3,7 +3,8 @@
 //! identifies the calibration, navigation) and the sections of [`crate::sections::SECTIONS`].
 
 use crate::escape::xml as esc;
-use crate::sections::{Page, SECTIONS};
+use crate::page::Page;
+use crate::sections::SECTIONS;
 use robocal_core::Result;
 use std::fmt::Write;
 

@@ -4,7 +4,7 @@
 use crate::escape::xml as esc;
 use crate::markup::kv;
 use crate::numfmt::magnitude;
-use crate::sections::Page;
+use crate::page::Page;
 use robocal_core::Result;
 use std::fmt::Write;
 

@@ -3,8 +3,8 @@
 //! encoder error, an elastic joint, a wrong offset.
 
 use crate::data::ReportData;
+use crate::page::{detailed_sets, Page};
 use crate::plot::series_color;
-use crate::sections::{detailed_sets, Page};
 use crate::svgplot::{density_color, markers, range_of, Frame, Grid, Svg, MARKER_LIMIT};
 use robocal_core::{Result, Unit};
 use std::fmt::Write;

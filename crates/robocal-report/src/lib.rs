@@ -39,12 +39,14 @@ mod demo;
 pub mod escape;
 mod example;
 pub mod histogram;
+mod histogram_section;
 mod html;
 mod identification;
 mod joints;
 mod map;
 mod markup;
 mod numfmt;
+mod page;
 mod plot;
 mod points_table;
 mod result_details;
@@ -108,7 +110,7 @@ pub struct ReportFiles {
 /// Renders the report without writing anything.
 pub fn render(data: &ReportData) -> Result<Rendered> {
     let hist = histogram_svg(&data.histogram, HISTOGRAM_TITLE)?;
-    let html = html::render(&sections::Page {
+    let html = html::render(&page::Page {
         data,
         histogram: &hist,
     })?;

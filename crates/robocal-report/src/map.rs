@@ -2,7 +2,7 @@
 //! from above (x, y) and from the side (reach from the base axis, z), coloured by the error.
 
 use crate::data::ReportData;
-use crate::sections::{detailed_sets, Page};
+use crate::page::{detailed_sets, Page};
 use crate::svgplot::{colorbar, markers, range_of, viridis, Frame, Grid, Svg, MARKER_LIMIT};
 use robocal_core::Result;
 use std::fmt::Write;

@@ -3,7 +3,7 @@
 
 use crate::escape::xml as esc;
 use crate::numfmt::{mm, signed};
-use crate::sections::Page;
+use crate::page::Page;
 use robocal_core::Result;
 use std::fmt::Write;
 

@@ -300,7 +300,7 @@ where
 }
 
 /// The error-against-reach section, or nothing when no point has a reach.
-pub(crate) fn section(page: &crate::sections::Page, h: &mut String) -> Result<bool> {
+pub(crate) fn section(page: &crate::page::Page, h: &mut String) -> Result<bool> {
     let data = page.data;
     let has_points = data
         .point_sets

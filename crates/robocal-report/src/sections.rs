@@ -3,20 +3,11 @@
 //! A section is a file with one function, `fn(&Page, &mut String) -> Result<bool>`, that writes
 //! its `<section id="...">` (with an `<h2>`) and returns whether it wrote anything (a section
 //! with nothing to show writes nothing and is left out of the navigation). Adding a panel is
-//! writing that file and adding one line to [`SECTIONS`]. Sections use [`crate::markup`] and the
-//! figure modules, never [`crate::html`] or each other.
+//! writing that file and adding one line to [`SECTIONS`]. Sections use [`crate::page`], [`crate::markup`]
+//! and the figure modules, never [`crate::html`], this list or each other.
 
-use crate::data::ReportData;
-use crate::histogram::HistogramFigure;
+use crate::page::Page;
 use robocal_core::Result;
-
-/// What every section sees: the report's data and the figures made once for the whole report.
-pub struct Page<'a> {
-    /// Everything the report shows.
-    pub data: &'a ReportData,
-    /// The error histogram (also written as a file of its own).
-    pub histogram: &'a HistogramFigure,
-}
 
 /// One section of the page.
 pub struct Section {
@@ -43,7 +34,7 @@ pub const SECTIONS: &[Section] = &[
     Section {
         id: "histogram",
         nav: "Histogram",
-        render: crate::histogram::section,
+        render: crate::histogram_section::section,
     },
     Section {
         id: "components",
@@ -86,15 +77,6 @@ pub const SECTIONS: &[Section] = &[
         render: crate::points_table::section,
     },
 ];
-
-/// The point set whose details the per-axis, per-joint and map views show, and the others with
-/// details: calibration first (the points the histogram shows), then the rest.
-pub(crate) fn detailed_sets(data: &ReportData) -> Vec<&crate::data::PointSet> {
-    data.point_sets
-        .iter()
-        .filter(|s| !s.details.is_empty() && s.details.len() == s.points.len())
-        .collect()
-}
 
 #[cfg(test)]
 mod tests {

@@ -4,7 +4,7 @@
 use crate::data::{finite, Note, NoteLevel, PointSet};
 use crate::escape::xml as esc;
 use crate::numfmt::{fixed, mm};
-use crate::sections::Page;
+use crate::page::Page;
 use robocal_core::Result;
 use std::fmt::Write;
 

@@ -4,7 +4,7 @@
 use crate::data::{ErrorRow, ErrorTable, FixedParam, ParamRow, ReportData};
 use crate::escape::xml as esc;
 use crate::numfmt::{fixed, mm, sig2, signed, DASH};
-use crate::sections::Page;
+use crate::page::Page;
 use robocal_core::Result;
 use robocal_core::Unit;
 use std::fmt::Write;
