@@ -21,6 +21,8 @@ const COMMANDS: &[&[&str]] = &[
     &["compensate"],
     &["demo"],
     &["report"],
+    &["completions"],
+    &["man"],
 ];
 
 const FLAGS: &[&str] = &[
@@ -32,7 +34,8 @@ const FLAGS: &[&str] = &[
     "--footprint-mm", "--length-error-mm", "--angle-error-deg", "--tilt-parallel-axes",
     "--compliance", "--link-masses-kg", "--payload-kg", "--outlier-fraction", "--outlier-min-mm",
     "--outlier-max-mm", "--per-point", "--strict", "--tolerance-mm", "--json", "--paper",
-    "--result", "--verify", "--help",
+    "--result", "--verify", "--help", "--meta", "--serial", "--tracker", "--reflector",
+    "--operator", "--temperature-c", "--measured", "--notes", "--point-table",
 ];
 
 /// Values worth trying: boundaries, absurd magnitudes, non-numbers, joint lists and names.
@@ -42,7 +45,8 @@ const VALUES: &[&str] = &[
     "0,0,0,0,0,0", "10,-80,90,0,90,0", "1,2", "nan,0,0,0,0,0", "1e308,0,0,0,0,0",
     "3112.8,-2179.6,1200,125,0,0", "1e308,0,0,0,0,0", "random", "none", "parallel", "2,3",
     "d1,base_z", "alpha1,d1,a1,phi1", "tool_a,tool_b,tool_c", "sum-of-norms", "least-squares",
-    "robust", "cauchy", "huber", "kuka-kr480-r3330", "kuka-kr480-r3330-table3", "-",
+    "robust", "cauchy", "huber", "kuka-kr480-r3330", "kuka-kr480-r3330-table3", "-", "bash",
+    "zsh", "calibrate",
 ];
 
 /// Paths: fixture inputs (by name, resolved in the cell directory), outputs, special files.

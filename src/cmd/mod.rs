@@ -11,7 +11,9 @@ mod io_plan;
 mod limits;
 mod paper_tables;
 mod report;
+mod report_meta;
 mod robot;
+mod shell;
 mod simulate;
 
 use clap::{Parser, Subcommand};
@@ -48,6 +50,10 @@ enum Command {
     Demo(demo::DemoArgs),
     /// The HTML report of a calibration result (tables, histogram, per-point errors, parameters).
     Report(report::ReportArgs),
+    /// Shell completions (bash, zsh, fish, elvish, powershell) on standard output.
+    Completions(shell::CompletionsArgs),
+    /// The manual page (roff) of robocal or one of its commands on standard output.
+    Man(shell::ManArgs),
 }
 
 /// Runs a parsed command line.
@@ -61,5 +67,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compensate(a) => compensate::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Report(a) => report::run(a),
+        Command::Completions(a) => shell::completions(a),
+        Command::Man(a) => shell::man(a),
     }
 }

@@ -34,13 +34,22 @@ pub struct ReportArgs {
     /// verification, the paper's Table V.
     #[arg(long, value_name = "VERIFY.csv")]
     verify: Option<PathBuf>,
-    /// Show the paper's figures (Samak et al. 2019, KR 480 R3330) beside the error tables.
+    /// Show the paper's figures (Samak et al. 2019) beside the error tables: only for a result
+    /// of the paper's robot (the KUKA KR 480 R3330, preset kuka-kr480-r3330).
     #[arg(long)]
     paper: bool,
+    /// Add a table of every point's errors (collapsed until opened; long for large sets).
+    #[arg(long)]
+    point_table: bool,
+    #[command(flatten)]
+    meta: super::report_meta::MetaArgs,
     /// Directory for report.html and histogram.svg (created if needed).
     #[arg(long)]
     out: PathBuf,
 }
+
+/// The robot whose figures `--paper` shows.
+const PAPER_ROBOT: &str = "kuka-kr480-r3330";
 
 /// A file setting recorded in the result by `robocal calibrate` (`robot_arg`, `data`,
 /// `validate`).
@@ -103,6 +112,9 @@ struct Settings {
     validate: Option<PathBuf>,
     verify: Option<PathBuf>,
     paper: bool,
+    point_table: bool,
+    /// What identifies the calibration (serial, tracker, operator...).
+    metadata: Vec<robocal_report::Setting>,
     out: PathBuf,
 }
 
@@ -116,11 +128,13 @@ impl TryFrom<&ReportArgs> for Settings {
             .input_opt("--data", a.data.as_deref())
             .input_opt("--validate", a.validate.as_deref())
             .input_opt("--verify", a.verify.as_deref())
+            .input_opt("--meta", a.meta.meta.as_deref())
             .output_dir("--out", &a.out, &[HTML_FILE, HISTOGRAM_FILE]);
         if let Some(r) = &a.robot {
             plan.robot("--robot", r);
         }
         plan.check()?;
+        let metadata = super::report_meta::metadata(&a.meta)?;
         let result = CalibrationResult::read(&a.result)?;
         // The robot: --robot, else the one the result embeds, else (older results) the --robot
         // recorded in the result's settings.
@@ -149,6 +163,20 @@ impl TryFrom<&ReportArgs> for Settings {
                 (None, None) => format!("the robot embedded in {}", a.result.display()),
             })?;
         super::common::warn_not_calibrated(&result, &a.result);
+        if a.paper {
+            let paper_robot = common::robot(PAPER_ROBOT)?;
+            if let Some(diff) =
+                robocal_core::model::description::nominal_difference(&paper_robot, &nominal)
+            {
+                return Err(exit::usage(format!(
+                    "--paper shows the figures of Samak et al. (2019) for their robot (preset \
+                     {PAPER_ROBOT}), but {} is a calibration of `{}`, another robot ({diff}): \
+                     leave out --paper",
+                    a.result.display(),
+                    nominal.name()
+                )));
+            }
+        }
         let data_path = file_arg(&a.data, &result, |s| &s.data, "--data");
         let val_path = file_arg(&a.validate, &result, |s| &s.validate, "--validate");
         Ok(Settings {
@@ -160,6 +188,8 @@ impl TryFrom<&ReportArgs> for Settings {
             validate: val_path,
             verify: a.verify.clone(),
             paper: a.paper,
+            point_table: a.point_table,
+            metadata,
             out: a.out.clone(),
         })
     }
@@ -175,6 +205,8 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         validate: val_path,
         verify,
         paper,
+        point_table,
+        metadata,
         out,
     } = Settings::try_from(&a)?;
     let joints = nominal.joint_space();
@@ -190,26 +222,33 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         verification: verification.as_ref(),
         with_paper: paper,
     })?;
+    // File names only: the report is handed on, the directories of this machine mean nothing
+    // to its reader.
+    let name = robocal_report::file_name;
     report.subtitle = Some(format!(
         "Result {}{}{}",
-        result_path.display(),
-        data_path.as_ref().map_or(String::new(), |p| format!(
-            "; calibration data {}",
-            p.display()
-        )),
+        name(&result_path),
+        data_path
+            .as_ref()
+            .map_or(String::new(), |p| format!("; calibration data {}", name(p))),
         verify
             .as_ref()
-            .map_or(String::new(), |p| format!("; verification {}", p.display()))
+            .map_or(String::new(), |p| format!("; verification {}", name(p)))
     ));
+    report.metadata = metadata;
+    report.metadata.push(robocal_report::Setting::new(
+        "Report made",
+        super::report_meta::now_utc(),
+    ));
+    report.point_table = point_table;
     report.settings.insert(
         0,
-        robocal_report::Setting::new("Result file", result_path.display()),
+        robocal_report::Setting::new("Result file", name(&result_path)),
     );
     if let Some(v) = &verify {
-        report.settings.push(robocal_report::Setting::new(
-            "Verification data",
-            v.display(),
-        ));
+        report
+            .settings
+            .push(robocal_report::Setting::new("Verification data", name(v)));
     }
     let files = write_report(&out, &report)?;
     print_summary(&report);

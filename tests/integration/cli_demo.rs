@@ -156,7 +156,11 @@ fn demo_prints_the_papers_tables_and_its_commands_reproduce_the_files() {
     ] {
         assert!(html.contains(label), "report lacks {label:?}");
     }
-    assert_eq!(html.matches("<svg").count(), 2);
+    assert_eq!(
+        html.matches("<svg").count(),
+        5,
+        "histogram, components, reach, joints, map"
+    );
     let svg = std::fs::read_to_string(dir.join("histogram.svg")).unwrap();
     assert!(svg.starts_with("<?xml") && svg.trim_end().ends_with("</svg>"));
 
@@ -251,7 +255,11 @@ fn report_of_a_calibrate_result() {
         "{out}"
     );
     let html = well_formed_html(&out_dir.join("report.html"));
-    assert_eq!(html.matches("<svg").count(), 2, "histogram and reach plot");
+    assert_eq!(
+        html.matches("<svg").count(),
+        5,
+        "histogram, components, reach plot, joints and map"
+    );
     assert!(html.contains("Validation points") && html.contains("same effect as base_z"));
     assert!(
         !html.contains("Paper: Samak"),
@@ -286,7 +294,7 @@ fn report_of_a_calibrate_result() {
         ]);
         well_formed_html(&d.join("rep3/report.html"))
     };
-    assert_eq!(html2.matches("<svg").count(), 2);
+    assert_eq!(html2.matches("<svg").count(), 5);
 
     // Errors: another robot (exit 3), a missing result (4), a bad data file (3).
     let o = robocal(&[

@@ -27,12 +27,15 @@ mod cli_compensate;
 mod cli_demo;
 mod cli_evaluate;
 mod cli_joints;
+mod cli_report;
 mod cli_result_self_contained;
 mod cli_robot;
 mod cli_settings;
+mod cli_shell;
 mod cli_simulate;
 #[cfg(unix)]
 mod cli_trust_files;
 mod cli_trust_gate;
 mod cli_trust_readers;
+mod readme_commands;
 mod report_browser;

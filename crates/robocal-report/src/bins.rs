@@ -1,17 +1,49 @@
 //! Histogram binning shared by all series of a histogram (same edges for "before" and "after",
 //! as in the paper's Fig. 2), and "nice" axis steps.
+//!
+//! **The rule.** Each series with at least two values gets its Freedman–Diaconis bin width,
+//! `h = 2 IQR n^(-1/3)` (IQR: interquartile range; `range / sqrt(n)` when the IQR is 0), the
+//! width that shows the shape of a distribution of `n` values without drowning it in noise.
+//! - **Linear bins** (from 0, or from the smallest value if it is negative): the narrowest
+//!   series' width rounded up to 1, 2, 2.5 or 5 times a power of ten, and never fewer than
+//!   [`MIN_BINS`] over the range. Every series is counted over the same edges.
+//! - **Log-spaced bins** when the linear ones cannot show every series: when the narrowest width
+//!   would need more than [`MAX_LINEAR_BINS`] bins over the pooled range, or when the series'
+//!   medians differ by [`LOG_RATIO`] times or more (before and after a calibration often do).
+//!   The bins are then equally wide in log10 of the error: the narrowest series' Freedman–
+//!   Diaconis width of the log values, between [`MIN_BINS`] and [`MAX_LOG_BINS`] bins; still
+//!   shared by all series, so the bars compare count for count. Values of exactly 0 go into the
+//!   first bin.
+//! - A few gross outliers (a failed point) are gathered in an overflow bin ([`outlier_cap`]).
 
 use crate::data::finite;
 
-/// About how many bins a histogram gets (between `TARGET_BINS / 2.5` and `TARGET_BINS`).
-const TARGET_BINS: f64 = 25.0;
+/// Fewest regular bins a histogram gets (unless all values are equal).
+pub const MIN_BINS: usize = 10;
+/// Most linear bins before the histogram turns to log-spaced bins.
+pub const MAX_LINEAR_BINS: usize = 60;
+/// Most log-spaced bins.
+pub const MAX_LOG_BINS: usize = 60;
+/// Ratio of the largest to the smallest series median from which the bins are log-spaced.
+pub const LOG_RATIO: f64 = 10.0;
+
+/// How the bin edges are spaced.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scale {
+    /// Equal widths in mm.
+    Linear,
+    /// Equal widths in log10(mm).
+    Log,
+}
 
 /// Bins of several series over the same edges.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Binning {
-    /// Edges of the regular bins, ascending: bin `i` is `[edges[i], edges[i+1])`. Without
+    /// Edges of the regular bins, ascending (mm): bin `i` is `[edges[i], edges[i+1])`. Without
     /// overflow the last edge lies above the largest value.
     pub edges: Vec<f64>,
+    /// How the edges are spaced (equal steps in mm, or in log10 of mm).
+    pub scale: Scale,
     /// Whether an extra last bin gathers the values above `edges.last()` (very large errors
     /// that would otherwise squeeze every other bin into one).
     pub overflow: bool,
@@ -26,9 +58,9 @@ pub struct Binning {
 }
 
 impl Binning {
-    /// Width of one regular bin.
+    /// Width of one regular bin in axis units (mm for linear bins, decades for log bins).
     pub fn width(&self) -> f64 {
-        self.edges[1] - self.edges[0]
+        self.axis(self.edges[1]) - self.axis(self.edges[0])
     }
 
     /// Number of bins including the overflow bin.
@@ -41,13 +73,22 @@ impl Binning {
         *self.edges.last().expect("at least two edges")
     }
 
-    /// Lower and upper end of bin `i` (the overflow bin is drawn one bin wide).
+    /// A value in axis units: itself (linear) or its log10 (log bins; 0 and below map to the
+    /// first edge).
+    pub fn axis(&self, x: f64) -> f64 {
+        match self.scale {
+            Scale::Linear => x,
+            Scale::Log => x.max(self.edges[0]).log10(),
+        }
+    }
+
+    /// Lower and upper end of bin `i` in axis units (the overflow bin is drawn one bin wide).
     pub fn bin_range(&self, i: usize) -> (f64, f64) {
-        let w = self.width();
         if i + 1 < self.edges.len() {
-            (self.edges[i], self.edges[i + 1])
+            (self.axis(self.edges[i]), self.axis(self.edges[i + 1]))
         } else {
-            (self.cap(), self.cap() + w)
+            let c = self.axis(self.cap());
+            (c, c + self.width())
         }
     }
 
@@ -59,50 +100,127 @@ impl Binning {
             .max()
             .unwrap_or(0)
     }
+
+    /// Bins of series `s` that hold at least one value.
+    pub fn occupied(&self, s: usize) -> usize {
+        self.counts[s].iter().filter(|&&c| c > 0).count()
+    }
+
+    /// The rule that chose the bins, in words (for a figure's caption).
+    pub fn describe(&self) -> String {
+        let nb = self.edges.len() - 1;
+        match self.scale {
+            Scale::Linear => format!(
+                "{nb} bins of {} mm (Freedman–Diaconis width of the narrowest series)",
+                crate::plot::axis_number(self.width(), decimals_for(self.width()).max(1) + 1)
+            ),
+            Scale::Log => format!(
+                "{nb} log-spaced bins, {:.0} per decade, from {} mm (the series differ in scale, \
+                 so equal widths in mm would put the smaller errors in a few bars)",
+                1.0 / self.width(),
+                crate::numfmt::magnitude(self.edges[0])
+            ),
+        }
+    }
 }
 
-/// Bins `series` over common edges starting at 0 (or at the smallest value if negative).
-/// Returns `None` when no series has a finite value.
+/// Freedman–Diaconis width of `v` (sorted, finite, at least two values), or `None` when all
+/// values are equal.
+fn fd_width(sorted: &[f64]) -> Option<f64> {
+    let n = sorted.len();
+    if n < 2 {
+        return None;
+    }
+    let q = |p: f64| robocal_core::stats::percentile(sorted, p);
+    let iqr = q(0.75) - q(0.25);
+    let range = sorted[n - 1] - sorted[0];
+    let h = if iqr > 0.0 {
+        2.0 * iqr * (n as f64).powf(-1.0 / 3.0)
+    } else {
+        range / (n as f64).sqrt()
+    };
+    (h > 0.0 && h.is_finite()).then_some(h)
+}
+
+fn median(sorted: &[f64]) -> f64 {
+    robocal_core::stats::percentile(sorted, 0.5)
+}
+
+/// Bins `series` over common edges by the rule of this module. Returns `None` when no series
+/// has a finite value.
 pub fn bin_series(series: &[&[f64]]) -> Option<Binning> {
-    let cleaned: Vec<(Vec<f64>, usize)> =
-        series.iter().map(|s| finite(s.iter().copied())).collect();
-    let pooled: Vec<f64> = cleaned
+    let cleaned: Vec<(Vec<f64>, usize)> = series
+        .iter()
+        .map(|s| {
+            let (mut v, k) = finite(s.iter().copied());
+            v.sort_by(f64::total_cmp);
+            (v, k)
+        })
+        .collect();
+    let mut pooled: Vec<f64> = cleaned
         .iter()
         .flat_map(|(v, _)| v.iter().copied())
         .collect();
     if pooled.is_empty() {
         return None;
     }
-    let min = pooled.iter().copied().fold(f64::INFINITY, f64::min);
-    let max = pooled.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    pooled.sort_by(f64::total_cmp);
+    let min = pooled[0];
+    let max = pooled[pooled.len() - 1];
     let lo = min.min(0.0);
 
     // A few huge values (a failed point, a gross measurement error) would leave every other
     // value in the first bin: gather them in an overflow bin instead.
-    let mut hi = max;
-    let mut overflow = false;
-    if let Some(cap) = outlier_cap(&pooled, lo) {
-        hi = cap;
-        overflow = true;
-    }
+    let cap = outlier_cap(&pooled, lo);
+    let hi = cap.unwrap_or(max);
+    let overflow = cap.is_some();
+
+    let widths: Vec<f64> = cleaned
+        .iter()
+        .filter_map(|(v, _)| {
+            let v: Vec<f64> = v.iter().copied().filter(|&x| x <= hi).collect();
+            fd_width(&v)
+        })
+        .collect();
+    let narrowest = widths.iter().copied().fold(f64::INFINITY, f64::min);
+    let medians: Vec<f64> = cleaned
+        .iter()
+        .filter(|(v, _)| !v.is_empty())
+        .map(|(v, _)| median(v))
+        .collect();
+    let med_lo = medians.iter().copied().fold(f64::INFINITY, f64::min);
+    let med_hi = medians.iter().copied().fold(f64::NEG_INFINITY, f64::max);
     let span = hi - lo;
-    let span = if span > 1e-12 * lo.abs().max(1.0) && span.is_finite() {
-        span
-    } else if lo == 0.0 {
-        1.0
+    let linear_needs = if narrowest.is_finite() {
+        span / nice_step(narrowest)
     } else {
-        lo.abs()
+        0.0
     };
-    let width = nice_step(span / TARGET_BINS);
-    // Half-open bins up to and including the one holding the largest value (or the cap).
-    let nbins = if overflow {
-        ((span / width) * (1.0 - 1e-12)).ceil().max(1.0) as usize
+    let want_log = min >= 0.0
+        && max > 0.0
+        && (linear_needs > MAX_LINEAR_BINS as f64
+            || (med_lo > 0.0 && med_hi >= LOG_RATIO * med_lo));
+    let edges = if want_log {
+        log_edges(&cleaned, hi)
     } else {
-        (span / width + 1e-9).floor() as usize + 1
+        None
     };
-    let edges: Vec<f64> = (0..=nbins).map(|i| lo + i as f64 * width).collect();
+    let (edges, scale) = match edges {
+        Some(e) => (e, Scale::Log),
+        None => (linear_edges(lo, hi, narrowest, overflow), Scale::Linear),
+    };
+    let nbins = edges.len() - 1;
     let cap = edges[nbins];
     let total_bins = nbins + usize::from(overflow);
+    let index = |x: f64| -> usize {
+        if overflow && x > cap * (1.0 + 1e-12) + 1e-300 {
+            return nbins;
+        }
+        // The first edge above x, minus one; values on or beyond the last edge go into the
+        // last regular bin.
+        let i = edges.partition_point(|&e| e <= x);
+        i.saturating_sub(1).min(nbins - 1)
+    };
 
     let mut counts = Vec::with_capacity(cleaned.len());
     let mut n = Vec::with_capacity(cleaned.len());
@@ -111,15 +229,7 @@ pub fn bin_series(series: &[&[f64]]) -> Option<Binning> {
     for (values, k) in &cleaned {
         let mut c = vec![0usize; total_bins];
         for &x in values {
-            let idx = ((x - lo) / width).floor();
-            let i = if idx < nbins as f64 {
-                idx.max(0.0) as usize
-            } else if overflow && x > cap + 1e-9 * width {
-                nbins
-            } else {
-                nbins - 1
-            };
-            c[i] += 1;
+            c[index(x)] += 1;
         }
         counts.push(c);
         n.push(values.len());
@@ -132,12 +242,101 @@ pub fn bin_series(series: &[&[f64]]) -> Option<Binning> {
     }
     Some(Binning {
         edges,
+        scale,
         overflow,
         counts,
         n,
         skipped,
         mean,
     })
+}
+
+/// Linear edges from `lo` over `lo..hi`: the width `narrowest` rounded up to a nice step, at
+/// least `MIN_BINS` bins (fewer only when all values are equal), at most `MAX_LINEAR_BINS`.
+fn linear_edges(lo: f64, hi: f64, narrowest: f64, overflow: bool) -> Vec<f64> {
+    let span = hi - lo;
+    let span = if span > 1e-12 * lo.abs().max(1.0) && span.is_finite() {
+        span
+    } else if lo == 0.0 {
+        1.0
+    } else {
+        lo.abs()
+    };
+    let mut width = if narrowest.is_finite() {
+        nice_step(narrowest)
+    } else {
+        nice_step(span / MIN_BINS as f64)
+    };
+    // Not fewer than MIN_BINS bins...
+    while span / width < MIN_BINS as f64 - 1.0 {
+        let smaller = nice_step(width * 0.5);
+        if smaller >= width {
+            break;
+        }
+        width = smaller;
+    }
+    // ... nor more than MAX_LINEAR_BINS.
+    if span / width > MAX_LINEAR_BINS as f64 {
+        width = nice_step(span / MAX_LINEAR_BINS as f64);
+    }
+    // Half-open bins up to and including the one holding the largest value (or the cap).
+    let nbins = if overflow {
+        ((span / width) * (1.0 - 1e-12)).ceil().max(1.0) as usize
+    } else {
+        (span / width + 1e-9).floor() as usize + 1
+    };
+    (0..=nbins).map(|i| lo + i as f64 * width).collect()
+}
+
+/// Log-spaced edges up to `hi` (all values non-negative), or `None` when there is no positive
+/// value to start from.
+fn log_edges(cleaned: &[(Vec<f64>, usize)], hi: f64) -> Option<Vec<f64>> {
+    let smallest = cleaned
+        .iter()
+        .flat_map(|(v, _)| v.iter().copied())
+        .filter(|&x| x > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    if !smallest.is_finite() || hi <= smallest {
+        return None;
+    }
+    let logs: Vec<Vec<f64>> = cleaned
+        .iter()
+        .map(|(v, _)| {
+            v.iter()
+                .copied()
+                .filter(|&x| x > 0.0 && x <= hi)
+                .map(f64::log10)
+                .collect()
+        })
+        .collect();
+    let narrowest = logs
+        .iter()
+        .filter_map(|l| fd_width(l))
+        .fold(f64::INFINITY, f64::min);
+    let (a, b) = (smallest.log10(), hi.log10());
+    let decades = b - a;
+    let mut width = if narrowest.is_finite() {
+        narrowest
+    } else {
+        decades / MIN_BINS as f64
+    };
+    // Round to a whole number of bins per decade (1/width), clamp the bin count.
+    width = 1.0 / (1.0 / width).round().max(1.0);
+    if decades / width > MAX_LOG_BINS as f64 {
+        width = 1.0 / (MAX_LOG_BINS as f64 / decades).floor().max(1.0);
+    }
+    while decades / width < MIN_BINS as f64 - 1.0 {
+        width = 1.0 / (1.0 / width + 1.0);
+    }
+    // Start on a multiple of the width so that edges fall on round values (1, 10, 100...
+    // are edges).
+    let start = (a / width).floor() * width;
+    let nbins = (((b - start) / width) + 1e-9).floor() as usize + 1;
+    Some(
+        (0..=nbins)
+            .map(|i| 10f64.powf(start + i as f64 * width))
+            .collect(),
+    )
 }
 
 /// Where to cut an axis over `values` (all finite, at least `lo`) so that a few gross outliers do
@@ -266,6 +465,71 @@ mod tests {
         assert_eq!(*b.counts[0].last().unwrap(), 2);
         assert_eq!(sum(&b, 0), 62);
         assert!(b.cap() < 5.0, "cap {}", b.cap());
+    }
+
+    /// `n` values spread like calibration errors: a Rayleigh-like shape of median `m`.
+    fn spread(n: usize, m: f64) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let u = (i as f64 + 0.5) / n as f64;
+                m * (-2.0 * (1.0 - u).ln()).sqrt() / 1.1774
+            })
+            .collect()
+    }
+
+    #[test]
+    fn before_and_after_of_a_real_calibration_both_show_their_shape() {
+        // The UR5 case of issue 16: 1000 points, 0.8 mm before, 0.1 mm after. Fixed 0.2 mm bins
+        // put 956 of the 1000 "after" points into one bar.
+        for n in [1000, 20_000] {
+            let before = spread(n, 0.8);
+            let after = spread(n, 0.1);
+            let b = bin_series(&[&before, &after]).unwrap();
+            assert_eq!(b.scale, Scale::Log, "n = {n}");
+            assert!(b.occupied(1) >= 8, "after: {} bins", b.occupied(1));
+            assert!(b.occupied(0) >= 8, "before: {} bins", b.occupied(0));
+            assert_eq!(sum(&b, 0), n);
+            assert_eq!(sum(&b, 1), n);
+            assert!(b.bins() <= MAX_LOG_BINS + 1, "{} bins", b.bins());
+            // no bar holds more than a fifth of a series
+            let top = b.counts[1].iter().max().unwrap();
+            assert!(*top < n / 5, "{top} of {n} in one bar");
+            assert!(b.describe().contains("log-spaced"));
+        }
+    }
+
+    #[test]
+    fn medians_ten_times_apart_give_log_bins_and_close_ones_linear() {
+        let before = spread(50, 1.0);
+        let after = spread(50, 0.09);
+        assert_eq!(bin_series(&[&before, &after]).unwrap().scale, Scale::Log);
+        let after = spread(50, 0.5);
+        let b = bin_series(&[&before, &after]).unwrap();
+        assert_eq!(b.scale, Scale::Linear);
+        let nb = b.edges.len() - 1;
+        assert!((MIN_BINS..=MAX_LINEAR_BINS).contains(&nb), "{nb} bins");
+        // signed values (a per-axis error) stay linear, around zero
+        let signed: Vec<f64> = (0..200).map(|i| (i as f64 - 100.0) * 0.003).collect();
+        let b = bin_series(&[&signed]).unwrap();
+        assert_eq!(b.scale, Scale::Linear);
+        assert!(b.edges[0] <= -0.3);
+        assert_eq!(sum(&b, 0), 200);
+    }
+
+    #[test]
+    fn log_bins_count_zero_in_the_first_bin() {
+        let mut after = spread(300, 0.05);
+        after[0] = 0.0;
+        let before = spread(300, 2.0);
+        let b = bin_series(&[&before, &after]).unwrap();
+        assert_eq!(b.scale, Scale::Log);
+        assert_eq!(sum(&b, 1), 300);
+        assert!(b.counts[1][0] >= 1);
+        // edges ascend and are equally spaced in log10
+        let w = b.width();
+        for pair in b.edges.windows(2) {
+            assert!(((pair[1] / pair[0]).log10() - w).abs() < 1e-9);
+        }
     }
 
     #[test]

@@ -255,10 +255,12 @@ mod tests {
             PointSet {
                 name: "Calibration".into(),
                 points: vec![p(1.0, 0.1), p(2.0, 0.2)],
+                details: Vec::new(),
             },
             PointSet {
                 name: "Verification".into(),
                 points: vec![p(f64::NAN, 0.3)],
+                details: Vec::new(),
             },
         ];
         let h = before_after_histogram(&sets, &["Calibration"], &["Verification"]);

@@ -14,8 +14,18 @@ use serde::{Deserialize, Serialize};
 pub struct ReportData {
     /// The report's title, e.g. "KUKA KR 480 R3330 — simulated calibration".
     pub title: String,
-    /// One line under the title (robot, data files, date...).
+    /// One line under the title (robot, data files...). Never an absolute path of the machine
+    /// that made the report: file names only.
     pub subtitle: Option<String>,
+    /// What identifies the calibration, shown under the title: robot serial, tracker,
+    /// reflector, operator, temperature, notes, dates (in the order given; empty values are
+    /// left out).
+    pub metadata: Vec<Setting>,
+    /// Units of the joint values in [`PointDetail::joints`] (degrees for a revolute joint, mm for
+    /// a prismatic one): one per joint, for the error-against-joint panels.
+    pub joint_units: Vec<Unit>,
+    /// Add the table of every point's errors (long for large sets: on demand).
+    pub point_table: bool,
     /// Settings of the run, shown in order (seed, point counts, noise, files, ...).
     pub settings: Vec<Setting>,
     /// Error statistics tables (the paper's Tables II, IV and V).
@@ -149,6 +159,40 @@ pub struct PointSet {
     pub name: String,
     /// Its points.
     pub points: Vec<PointError>,
+    /// Where each point is and its error vectors, in the order of `points` (empty when not
+    /// known, e.g. a report from a result file without its measurements): the per-axis,
+    /// per-joint and workspace views need them.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub details: Vec<PointDetail>,
+}
+
+impl PointSet {
+    /// A set without point details.
+    pub fn new(name: impl Into<String>, points: Vec<PointError>) -> PointSet {
+        PointSet {
+            name: name.into(),
+            points,
+            details: Vec::new(),
+        }
+    }
+}
+
+/// Where one point is and its error vectors (base frame, mm).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PointDetail {
+    /// The joint values of the pose (degrees, mm for a prismatic joint).
+    pub joints: Vec<f64>,
+    /// The tool point of the nominal model at these joints (mm, base frame): where the point
+    /// is in the workspace.
+    #[serde(with = "crate::serde_nan::arr3")]
+    pub position_mm: [f64; 3],
+    /// Error vector E = P_act − P_ref before calibration (NaN components when not available).
+    #[serde(with = "crate::serde_nan::arr3")]
+    pub before_mm: [f64; 3],
+    /// Error vector after calibration (or, for a verification set, as measured after
+    /// compensation).
+    #[serde(with = "crate::serde_nan::arr3")]
+    pub after_mm: [f64; 3],
 }
 
 /// The error of one point before and after calibration, and where the point is.
@@ -398,6 +442,7 @@ mod tests {
                 before_mm: 1.5,
                 after_mm: f64::NAN,
             }],
+            details: vec![],
         };
         let j = serde_json::to_string(&s).unwrap();
         assert!(j.contains("\"after_mm\":null"), "{j}");

@@ -158,7 +158,7 @@ impl ReportData {
                 exp.compensation.len()
             ),
         ));
-        settings.push(Setting::new("Files", dir));
+        settings.push(Setting::new("Files", crate::file_name(dir)));
         // The result's own settings (data files, objective, registration) follow, without the
         // robot lines already given above.
         settings.extend(

@@ -26,21 +26,42 @@ impl Mix {
 }
 
 fn set(name: &str, n: usize, after_mean: f64, rng: &mut Mix) -> PointSet {
-    let points = (0..n)
-        .map(|_| {
-            let reach = 1200.0 + 2100.0 * rng.next();
-            let before = (0.55 + 0.00045 * reach + 0.22 * rng.normal()).abs();
-            let after = (after_mean * (1.0 + 0.45 * rng.normal())).abs();
-            PointError {
-                reach_mm: reach,
-                before_mm: before,
-                after_mm: after,
-            }
-        })
-        .collect();
+    let mut points = Vec::with_capacity(n);
+    let mut details = Vec::with_capacity(n);
+    for _ in 0..n {
+        // Joint values of a six-joint arm, and a tool point that follows them roughly (a
+        // shoulder at 1045 mm, a 3 m arm); errors that grow with the reach and with joint 3.
+        let q: Vec<f64> = [170.0, 60.0, 100.0, 300.0, 110.0, 300.0]
+            .iter()
+            .map(|r| r * (2.0 * rng.next() - 1.0))
+            .collect();
+        let (q1, q2, q3) = (q[0].to_radians(), q[1].to_radians(), q[2].to_radians());
+        let reach = 1200.0 + 1050.0 * (1.0 + (q2 - 0.3 * q3).sin());
+        let z = 1045.0 + 1400.0 * (q2 + 0.4 * q3).cos() - 900.0;
+        let position = [reach * q1.cos(), reach * q1.sin(), z];
+        let before = (0.55 + 0.00045 * reach + 0.22 * rng.normal()).abs();
+        let after = (after_mean * (1.0 + 0.45 * rng.normal() + 0.3 * q3.sin())).abs();
+        let mut dir = |norm: f64| {
+            let v = [rng.normal(), rng.normal(), 0.6 * rng.normal() - 0.4];
+            let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt().max(1e-9);
+            [norm * v[0] / l, norm * v[1] / l, norm * v[2] / l]
+        };
+        details.push(PointDetail {
+            joints: q,
+            position_mm: position,
+            before_mm: dir(before),
+            after_mm: dir(after),
+        });
+        points.push(PointError {
+            reach_mm: reach,
+            before_mm: before,
+            after_mm: after,
+        });
+    }
     PointSet {
         name: name.into(),
         points,
+        details,
     }
 }
 
@@ -60,13 +81,24 @@ impl ReportData {
     /// the paper's figures beside the tables. For previewing the report's layout and for tests:
     /// the numbers are made up.
     pub fn synthetic_example(seed: u64) -> ReportData {
+        ReportData::synthetic_sized(seed, 75, 73)
+    }
+
+    /// [`ReportData::synthetic_example`] with `calibration` calibration and verification points
+    /// and `validation` validation points: a large run for tests of the page's size and speed.
+    pub fn synthetic_sized(seed: u64, calibration: usize, validation: usize) -> ReportData {
         let mut rng = Mix(seed);
-        let cal = set("Calibration", 75, 0.17, &mut rng);
-        let val = set("Validation", 73, 0.24, &mut rng);
-        let mut ver = set("Verification", 75, 0.29, &mut rng);
+        let cal = set("Calibration", calibration, 0.17, &mut rng);
+        let val = set("Validation", validation, 0.24, &mut rng);
+        let mut ver = set("Verification", calibration, 0.29, &mut rng);
         for (p, c) in ver.points.iter_mut().zip(&cal.points) {
             p.reach_mm = c.reach_mm;
             p.before_mm = f64::NAN;
+        }
+        for (d, c) in ver.details.iter_mut().zip(&cal.details) {
+            d.joints.clone_from(&c.joints);
+            d.position_mm = c.position_mm;
+            d.before_mm = [f64::NAN; 3];
         }
         let error_tables = paper_tables(
             BeforeAfter {
@@ -130,6 +162,13 @@ impl ReportData {
             })
             .collect();
         ReportData {
+            metadata: vec![
+                Setting::new("Robot serial", "KR480-EXAMPLE-0001"),
+                Setting::new("Tracker", "laser tracker (example)"),
+                Setting::new("Operator", "A. Example"),
+            ],
+            joint_units: vec![Unit::Deg; 6],
+            point_table: false,
             title: "KUKA KR 480 R3330 – calibration report (synthetic example)".into(),
             subtitle: Some(
                 "Made-up data shaped like the paper's experiment: a preview of the report layout."

@@ -1,12 +1,13 @@
 //! The error histogram before and after calibration (the paper's Fig. 2): grouped bars over
 //! common bin edges, counts above the bars, dashed lines at each series' mean.
 
-use crate::bins::{bin_series, decimals_for, nice_step, Binning};
+use crate::bins::{bin_series, decimals_for, nice_step, Binning, Scale};
 use crate::data::HistogramSeries;
 use crate::plot::{
     axis_number, bold, draw_err, draw_legend, finish_svg, font, legend_layout, legend_row_height,
     series_color, LegendItem, AXIS, GRID, MUTED,
 };
+use plotters::coord::types::{RangedCoordf64, RangedCoordu32};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use robocal_core::Result;
@@ -32,8 +33,8 @@ impl HistogramFigure {
         };
         let d = decimals_for(b.width()).max(1);
         notes.push(format!(
-            "Bin width {} mm; all series share the same bin edges.",
-            axis_number(b.width(), d + 1)
+            "{}; all series share the same bin edges.",
+            b.describe()
         ));
         if b.overflow {
             let beyond: usize = b.counts.iter().map(|c| c[c.len() - 1]).sum();
@@ -202,8 +203,9 @@ where
         legend_px,
     )?;
 
-    let x_lo = b.edges[0];
+    let x_lo = b.bin_range(0).0;
     let x_hi = b.bin_range(b.bins() - 1).1;
+    let log = b.scale == Scale::Log;
     let max_count = b.max_count().max(1) as u32;
     // Head room for the count labels and the mean labels.
     let y_hi = max_count + (max_count as f64 * 0.22).ceil() as u32 + 2;
@@ -221,10 +223,11 @@ where
     let tick_step = nice_step((x_hi - x_lo) / 12.0);
     let x_dec = decimals_for(tick_step);
     let cap = b.cap();
+    let cap_axis = b.axis(cap);
     let overflow = b.overflow;
     let x_fmt = move |v: &f64| {
         // The overflow bin is labelled "> cap" below it; no numbers at or beyond the cap.
-        if overflow && *v > cap - 1e-9 * tick_step {
+        if overflow && *v > cap_axis - 1e-9 * tick_step {
             String::new()
         } else {
             axis_number(*v, x_dec + 1)
@@ -232,11 +235,16 @@ where
     };
     chart
         .configure_mesh()
-        .x_labels(14)
+        // Log bins: the mesh draws no x labels; the 1-2-5 ticks are drawn below.
+        .x_labels(if log { 0 } else { 14 })
         .y_labels(8)
         .x_label_formatter(&x_fmt)
         .y_label_formatter(&|v: &u32| v.to_string())
-        .x_desc("Displacement error ‖Eᵢ‖ (mm)")
+        .x_desc(if log {
+            "Displacement error ‖Eᵢ‖ (mm, log scale)"
+        } else {
+            "Displacement error ‖Eᵢ‖ (mm)"
+        })
         .y_desc("Number of points")
         .axis_desc_style(font(14.0))
         .label_style(font(12.5))
@@ -253,11 +261,14 @@ where
     let (plot_w, plot_h) = chart.plotting_area().dim_in_pixel();
     let bar_px = plot_w as f64 * b.width() * slot / (x_hi - x_lo);
     let show_counts = bar_px >= 11.0;
-    let shows_mean = |s: usize| b.n[s] > 0 && b.mean[s].is_finite() && b.mean[s] <= x_hi;
+    let shows_mean = |s: usize| b.n[s] > 0 && b.mean[s].is_finite() && b.axis(b.mean[s]) <= x_hi;
+    if log {
+        log_ticks(&mut chart, b, x_lo, cap_axis, y_hi)?;
+    }
 
     // Mean lines first, so that bars and counts stay on top of them.
     for s in (0..series.len()).filter(|&s| shows_mean(s)) {
-        let m = b.mean[s];
+        let m = b.axis(b.mean[s]);
         chart
             .draw_series(DashedLineSeries::new(
                 [(m, 0u32), (m, y_hi)],
@@ -304,7 +315,7 @@ where
     // Mean labels at the top, staggered so that close means stay readable.
     let px_per_count = plot_h as f64 / y_hi as f64;
     for (row, s) in (0..series.len()).filter(|&s| shows_mean(s)).enumerate() {
-        let m = b.mean[s];
+        let m = b.axis(b.mean[s]);
         let y = y_hi.saturating_sub(((4.0 + 16.0 * row as f64) / px_per_count).round() as u32);
         let near_right = (m - x_lo) / (x_hi - x_lo) > 0.85;
         let px = 5.0 * (x_hi - x_lo) / plot_w as f64;
@@ -315,7 +326,7 @@ where
         };
         chart
             .draw_series(std::iter::once(Text::new(
-                format!("mean {}", crate::numfmt::mm(m)),
+                format!("mean {}", crate::numfmt::mm(b.mean[s])),
                 (m + dx, y),
                 font(12.0)
                     .color(&series_color(s))
@@ -327,7 +338,7 @@ where
         let (l, r) = b.bin_range(b.bins() - 1);
         chart
             .draw_series(std::iter::once(Text::new(
-                format!("> {}", axis_number(cap, x_dec + 2)),
+                format!("> {}", crate::numfmt::magnitude(cap)),
                 ((l + r) / 2.0, 0u32),
                 font(12.0)
                     .color(&MUTED)
@@ -336,4 +347,75 @@ where
             .map_err(&e)?;
     }
     Ok(())
+}
+
+/// Tick marks and labels of a log axis at 1, 2 and 5 times the powers of ten in `lo..hi`
+/// (axis units: log10 mm), with a vertical grid line at each power of ten.
+fn log_ticks<DB: DrawingBackend>(
+    chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordu32>>,
+    b: &Binning,
+    lo: f64,
+    hi: f64,
+    y_hi: u32,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = draw_err("histogram");
+    let _ = b;
+    let mut ticks = Vec::new();
+    let first = lo.floor() as i32;
+    let last = hi.ceil() as i32;
+    for k in first..=last {
+        for m in [1.0, 2.0, 5.0] {
+            let v = m * 10f64.powi(k);
+            let a = v.log10();
+            if a >= lo - 1e-9 && a <= hi + 1e-9 {
+                ticks.push((a, v, m == 1.0));
+            }
+        }
+    }
+    for &(a, _, major) in &ticks {
+        if major {
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(a, 0u32), (a, y_hi)],
+                    GRID,
+                )))
+                .map_err(&e)?;
+        }
+    }
+    let (plot_w, _) = chart.plotting_area().dim_in_pixel();
+    let span = chart.x_range().end - chart.x_range().start;
+    let mut last_px = f64::NEG_INFINITY;
+    for (a, v, _) in ticks {
+        // Skip a label that would touch the previous one.
+        let px = (a - chart.x_range().start) / span * plot_w as f64;
+        if px - last_px < 34.0 {
+            continue;
+        }
+        last_px = px;
+        chart
+            .draw_series(std::iter::once(
+                EmptyElement::at((a, 0u32))
+                    + PathElement::new(vec![(0, 0), (0, 5)], AXIS)
+                    + Text::new(
+                        tick_label(v),
+                        (0, 8),
+                        font(12.5).pos(Pos::new(HPos::Center, VPos::Top)),
+                    ),
+            ))
+            .map_err(&e)?;
+    }
+    Ok(())
+}
+
+/// A 1-2-5 tick value with just the decimals it needs (0.01, 0.2, 5, 100).
+fn tick_label(v: f64) -> String {
+    let k = v.log10().floor() as i32;
+    if k >= 0 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.*}", (-k) as usize)
+    }
 }

@@ -33,25 +33,36 @@
 
 pub mod bins;
 mod build;
+mod components;
 pub mod data;
 mod demo;
 pub mod escape;
 mod example;
 pub mod histogram;
+mod histogram_section;
 mod html;
+mod identification;
+mod joints;
+mod map;
+mod markup;
 mod numfmt;
+mod page;
 mod plot;
+mod points_table;
 mod result_details;
 pub mod run;
 pub mod scatter;
+mod sections;
 mod serde_nan;
+mod summary;
+mod svgplot;
 mod tables;
 
 pub use build::{before_after_histogram, paper, paper_tables};
 pub use data::{
     CorrelatedPair, ErrorRow, ErrorTable, FixedParam, HistogramSeries, Identifiability, Note,
-    NoteLevel, PaperStats, ParamRow, PointError, PointSet, ReachKind, ReportData, Setting,
-    SolverSummary,
+    NoteLevel, PaperStats, ParamRow, PointDetail, PointError, PointSet, ReachKind, ReportData,
+    Setting, SolverSummary,
 };
 pub use histogram::{histogram_svg, HistogramFigure};
 pub use numfmt::number_list;
@@ -67,6 +78,16 @@ pub const HTML_FILE: &str = "report.html";
 pub const HISTOGRAM_FILE: &str = "histogram.svg";
 /// Title of the histogram figure.
 pub const HISTOGRAM_TITLE: &str = "Displacement error before and after calibration";
+
+/// How a report names a file: its name alone, never the directories of the machine that made
+/// the report (a report is handed on; `/home/me/cell/data.csv` shows as `data.csv`).
+pub fn file_name(path: impl AsRef<Path>) -> String {
+    let p = path.as_ref();
+    p.file_name().map_or_else(
+        || p.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
 
 /// The rendered report, in memory.
 #[derive(Debug, Clone)]
@@ -89,23 +110,10 @@ pub struct ReportFiles {
 /// Renders the report without writing anything.
 pub fn render(data: &ReportData) -> Result<Rendered> {
     let hist = histogram_svg(&data.histogram, HISTOGRAM_TITLE)?;
-    // The reach plot needs points with a reach (a report from a result file alone has none).
-    let has_points = data
-        .point_sets
-        .iter()
-        .any(|s| s.points.iter().any(|p| p.reach_mm.is_finite()));
-    let scatter = if has_points {
-        Some(scatter_svg(&data.point_sets, data.reach)?)
-    } else {
-        None
-    };
-    let html = html::render(
+    let html = html::render(&page::Page {
         data,
-        &html::Figures {
-            histogram: &hist,
-            scatter: scatter.as_ref(),
-        },
-    );
+        histogram: &hist,
+    })?;
     Ok(Rendered {
         html,
         histogram_svg: format!("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n{}", hist.svg),

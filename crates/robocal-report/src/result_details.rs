@@ -78,10 +78,10 @@ pub fn settings(result: &CalibrationResult) -> Vec<Setting> {
     let mut out = Vec::new();
     let s = result.settings.as_ref();
     if let Some(d) = s.and_then(|s| s.data.as_deref()) {
-        out.push(Setting::new("Calibration data", d));
+        out.push(Setting::new("Calibration data", crate::file_name(d)));
     }
     if let Some(v) = s.and_then(|s| s.validate.as_deref()) {
-        out.push(Setting::new("Validation data", v));
+        out.push(Setting::new("Validation data", crate::file_name(v)));
     }
     if let Some(s) = s {
         out.push(Setting::new("Objective", s.objective.phrase()));

@@ -2,7 +2,9 @@
 //! per-point figures need (what `robocal report` and `robocal demo` show).
 
 use crate::build::{before_after_histogram, paper_tables};
-use crate::data::{HistogramSeries, Note, PointError, PointSet, ReachKind, ReportData};
+use crate::data::{
+    HistogramSeries, Note, PointDetail, PointError, PointSet, ReachKind, ReportData,
+};
 use robocal_core::evaluation::{evaluate, Against, Evaluation};
 use robocal_core::io::result::BeforeAfter;
 use robocal_core::io::{CalibrationResult, MeasurementSet, SetLabel};
@@ -39,6 +41,7 @@ pub struct RunData<'a> {
 /// What the per-point errors of a data set are.
 struct Evaluated {
     points: Vec<PointError>,
+    details: Vec<PointDetail>,
     stats: [ErrorStats; 2],
 }
 
@@ -68,32 +71,39 @@ fn evaluated(run: &RunData, set: &MeasurementSet, against: Against) -> Result<Ev
     let frame = run.result.tracker_frame();
     let ev: Evaluation = evaluate(run.nominal, run.calibrated, &frame, set, against)?;
     let desired = against == Against::Desired;
-    let points = set
-        .rows
-        .iter()
-        .enumerate()
-        .map(|(k, r)| {
-            let measured = frame.to_base(&r.p.unwrap_or_default());
-            let (reach, before, after) = if desired {
-                // The desired position is the measured point minus its error.
-                let e = ev.series[0].errors[k];
-                (reach_of(measured - e), f64::NAN, e.norm())
-            } else {
-                (
-                    reach_of(run.nominal.tool_position(&r.q)),
-                    ev.series[0].errors[k].norm(),
-                    ev.series[1].errors[k].norm(),
-                )
-            };
-            PointError {
-                reach_mm: reach,
-                before_mm: before,
-                after_mm: after,
-            }
-        })
-        .collect();
+    let joints = run.nominal.joint_space();
+    let arr = |v: nalgebra::Vector3<f64>| [v.x, v.y, v.z];
+    let mut points = Vec::with_capacity(set.rows.len());
+    let mut details = Vec::with_capacity(set.rows.len());
+    for (k, r) in set.rows.iter().enumerate() {
+        let measured = frame.to_base(&r.p.unwrap_or_default());
+        let (position, before, after) = if desired {
+            // The desired position is the measured point minus its error.
+            let e = ev.series[0].errors[k];
+            (measured - e, [f64::NAN; 3], arr(e))
+        } else {
+            (
+                run.nominal.tool_position(&r.q),
+                arr(ev.series[0].errors[k]),
+                arr(ev.series[1].errors[k]),
+            )
+        };
+        let norm = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        points.push(PointError {
+            reach_mm: reach_of(position),
+            before_mm: norm(before),
+            after_mm: norm(after),
+        });
+        details.push(PointDetail {
+            joints: joints.joints_to_display(&r.q),
+            position_mm: arr(position),
+            before_mm: before,
+            after_mm: after,
+        });
+    }
     Ok(Evaluated {
         points,
+        details,
         stats: [ev.series[0].stats, ev.series[1].stats],
     })
 }
@@ -138,6 +148,7 @@ impl ReportData {
                 sets.push(PointSet {
                     name: CALIBRATION.into(),
                     points: e.points,
+                    details: e.details,
                 });
                 let val = rows_where(set, &[SetLabel::Validation], true)?;
                 if !val.rows.is_empty() {
@@ -149,6 +160,7 @@ impl ReportData {
                     sets.push(PointSet {
                         name: CALIBRATION.into(),
                         points,
+                        details: Vec::new(),
                     });
                 }
             }
@@ -186,6 +198,7 @@ impl ReportData {
                 sets.push(PointSet {
                     name: VALIDATION.into(),
                     points: e.points,
+                    details: e.details,
                 });
             }
             None => {
@@ -193,6 +206,7 @@ impl ReportData {
                     sets.push(PointSet {
                         name: VALIDATION.into(),
                         points,
+                        details: Vec::new(),
                     });
                 }
             }
@@ -206,6 +220,7 @@ impl ReportData {
             sets.push(PointSet {
                 name: VERIFICATION.into(),
                 points: e.points,
+                details: e.details,
             });
         }
 
@@ -238,6 +253,7 @@ impl ReportData {
             ));
         }
         data.point_sets = sets;
+        data.joint_units = run.nominal.joint_types().iter().map(|t| t.unit()).collect();
         data.reach = ReachKind::Radial;
         Ok(data)
     }

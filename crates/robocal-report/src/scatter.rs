@@ -12,6 +12,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use robocal_core::Result;
+use std::fmt::Write;
 
 /// Width and height of the figure in CSS pixels.
 pub const SIZE: (u32, u32) = (960, 460);
@@ -45,6 +46,11 @@ pub struct ScatterFigure {
     pub after: PanelCounts,
     /// Top of the before and after panels' error axes (mm) when clipped.
     pub clip_mm: [Option<f64>; 2],
+    /// 1 when every point is drawn; k when a large set is thinned to every k-th point (and
+    /// the largest errors), so that the page stays small.
+    pub shown_every: usize,
+    /// Points in all sets.
+    pub total: usize,
 }
 
 /// Renders error against reach for `sets`.
@@ -52,6 +58,8 @@ pub fn scatter_svg(sets: &[PointSet], reach: ReachKind) -> Result<ScatterFigure>
     let mut buf = String::new();
     let mut counts = [PanelCounts::default(); 2];
     let mut clip_mm = [None; 2];
+    let total: usize = sets.iter().map(|s| s.points.len()).sum();
+    let every = total.div_ceil(crate::svgplot::MARKER_LIMIT).max(1);
     {
         let root = SVGBackend::with_string(&mut buf, SIZE).into_drawing_area();
         root.fill(&WHITE).map_err(draw_err("scatter"))?;
@@ -89,7 +97,7 @@ pub fn scatter_svg(sets: &[PointSet], reach: ReachKind) -> Result<ScatterFigure>
         draw_legend(&band, &items, (x0.max(20), 22), SIZE.0 as i32 - 40, 13.0)?;
         let panels = body.split_evenly((1, 2));
         for (i, (area, stage)) in panels.iter().zip([Stage::Before, Stage::After]).enumerate() {
-            let (c, clip) = draw_panel(area, sets, stage, x_range, reach)?;
+            let (c, clip) = draw_panel(area, sets, stage, x_range, reach, every)?;
             counts[i] = c;
             clip_mm[i] = clip;
         }
@@ -105,6 +113,8 @@ pub fn scatter_svg(sets: &[PointSet], reach: ReachKind) -> Result<ScatterFigure>
         before: counts[0],
         after: counts[1],
         clip_mm,
+        shown_every: every,
+        total,
     })
 }
 
@@ -124,6 +134,26 @@ fn pairs(set: &PointSet, stage: Stage) -> (Vec<(f64, f64)>, usize) {
         }
     }
     (v, skipped)
+}
+
+/// Every `every`-th point of `pts` and the 20 largest errors (all points when `every` is 1).
+fn thin(pts: Vec<(f64, f64)>, every: usize) -> Vec<(f64, f64)> {
+    if every <= 1 {
+        return pts;
+    }
+    let mut order: Vec<usize> = (0..pts.len()).collect();
+    order.sort_by(|&a, &b| pts[b].1.total_cmp(&pts[a].1));
+    let mut keep = vec![false; pts.len()];
+    for &i in order.iter().take(20) {
+        keep[i] = true;
+    }
+    for i in (0..pts.len()).step_by(every) {
+        keep[i] = true;
+    }
+    pts.into_iter()
+        .zip(keep)
+        .filter_map(|(p, k)| k.then_some(p))
+        .collect()
 }
 
 /// Marker shapes by set index: filled circle, open triangle, cross, open circle.
@@ -152,6 +182,7 @@ fn draw_panel<DB: DrawingBackend>(
     stage: Stage,
     x_range: (f64, f64),
     reach: ReachKind,
+    every: usize,
 ) -> Result<(PanelCounts, Option<f64>)>
 where
     DB::ErrorType: 'static,
@@ -236,6 +267,8 @@ where
         let above: Vec<(f64, f64)> = pts.iter().copied().filter(|p| p.1 > top).collect();
         counts.shown += inside.len();
         counts.clipped += above.len();
+        let inside = thin(inside, every);
+        let above = thin(above, every);
         let i = *i;
         chart
             .draw_series(
@@ -264,4 +297,57 @@ where
         }
     }
     Ok((counts, clip))
+}
+
+/// The error-against-reach section, or nothing when no point has a reach.
+pub(crate) fn section(page: &crate::page::Page, h: &mut String) -> Result<bool> {
+    let data = page.data;
+    let has_points = data
+        .point_sets
+        .iter()
+        .any(|s| s.points.iter().any(|p| p.reach_mm.is_finite()));
+    if !has_points {
+        return Ok(false);
+    }
+    let fig = &scatter_svg(&data.point_sets, data.reach)?;
+    h.push_str("<section id=\"workspace\">\n<h2>Error against reach</h2>\n");
+    let mut cap = format!(
+        "Displacement error of each point against its reach ({}). Left: nominal model with \
+         the fitted measurement frame; right: calibrated model (for a verification set: as \
+         measured after compensation). The panels have their own error scales.",
+        data.reach.description()
+    );
+    for (name, c, clip) in [
+        ("before", fig.before, fig.clip_mm[0]),
+        ("after", fig.after, fig.clip_mm[1]),
+    ] {
+        if c.skipped > 0 {
+            let _ = write!(
+                cap,
+                " {} point{} without a finite reach or error {name} calibration not shown.",
+                c.skipped,
+                if c.skipped == 1 { "" } else { "s" }
+            );
+        }
+        if let (Some(t), true) = (clip, c.clipped > 0) {
+            let _ = write!(
+                cap,
+                " {} point{} above {} mm {name} calibration drawn as ▲ at the top edge.",
+                c.clipped,
+                if c.clipped == 1 { "" } else { "s" },
+                crate::numfmt::fixed(t, 3)
+            );
+        }
+    }
+    if fig.shown_every > 1 {
+        let _ = write!(
+            cap,
+            " {} points: every {}th point of each set is drawn, and the 20 largest errors of \
+             each panel (the statistics use them all).",
+            fig.total, fig.shown_every
+        );
+    }
+    crate::markup::figure(h, &fig.svg, &cap);
+    h.push_str("</section>\n");
+    Ok(true)
 }

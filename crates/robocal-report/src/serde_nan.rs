@@ -37,3 +37,23 @@ pub mod vec {
             .collect())
     }
 }
+
+/// For an `[f64; 3]` field.
+pub mod arr3 {
+    use serde::{Deserialize, Deserializer, Serializer};
+
+    /// Writes the three values; NaN and infinities become `null`.
+    pub fn serialize<S: Serializer>(v: &[f64; 3], s: S) -> Result<S::Ok, S::Error> {
+        super::vec::serialize(v, s)
+    }
+
+    /// Reads three numbers, `null` as NaN.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[f64; 3], D::Error> {
+        let [a, b, c] = <[Option<f64>; 3]>::deserialize(d)?;
+        Ok([
+            a.unwrap_or(f64::NAN),
+            b.unwrap_or(f64::NAN),
+            c.unwrap_or(f64::NAN),
+        ])
+    }
+}

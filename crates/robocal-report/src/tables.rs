@@ -4,6 +4,8 @@
 use crate::data::{ErrorRow, ErrorTable, FixedParam, ParamRow, ReportData};
 use crate::escape::xml as esc;
 use crate::numfmt::{fixed, mm, sig2, signed, DASH};
+use crate::page::Page;
+use robocal_core::Result;
 use robocal_core::Unit;
 use std::fmt::Write;
 
@@ -11,11 +13,12 @@ use std::fmt::Write;
 const PARAM_DECIMALS: usize = 4;
 
 /// The "Error statistics" section.
-pub fn errors_section(h: &mut String, data: &ReportData) {
+pub(crate) fn errors_section(page: &Page, h: &mut String) -> Result<bool> {
+    let data = page.data;
     h.push_str("<section id=\"errors\">\n<h2>Error statistics</h2>\n");
     if data.error_tables.is_empty() {
         h.push_str("<p class=\"empty\">No error statistics were given.</p>\n</section>\n");
-        return;
+        return Ok(true);
     }
     let with_paper = data
         .error_tables
@@ -37,6 +40,7 @@ pub fn errors_section(h: &mut String, data: &ReportData) {
         error_table(h, t);
     }
     h.push_str("</table>\n</section>\n");
+    Ok(true)
 }
 
 /// One table of the paper as a group of rows: a heading row, then one row per point set.
@@ -124,11 +128,12 @@ fn fixed_list(data: &ReportData) -> Vec<FixedParam> {
 }
 
 /// The "Model parameters" section: all parameters, and the fixed ones with reasons.
-pub fn parameters_section(h: &mut String, data: &ReportData) {
+pub(crate) fn parameters_section(page: &Page, h: &mut String) -> Result<bool> {
+    let data = page.data;
     h.push_str("<section id=\"parameters\">\n<h2>Model parameters</h2>\n");
     if data.parameters.is_empty() {
         h.push_str("<p class=\"empty\">No parameters were given.</p>\n</section>\n");
-        return;
+        return Ok(true);
     }
     let identified = data.parameters.iter().filter(|p| !p.fixed).count();
     let with_truth = data.parameters.iter().any(|p| p.truth.is_some());
@@ -190,6 +195,7 @@ pub fn parameters_section(h: &mut String, data: &ReportData) {
         h.push_str("</tbody>\n</table>\n");
     }
     h.push_str("</div>\n</div>\n</section>\n");
+    Ok(true)
 }
 
 /// The group a parameter belongs to, from its name: a joint, the base frame or the tool.
@@ -263,13 +269,15 @@ fn param_row(h: &mut String, p: &ParamRow, with_truth: bool) {
 }
 
 /// The "Run settings" section.
-pub fn settings_section(h: &mut String, data: &ReportData) {
+pub(crate) fn settings_section(page: &Page, h: &mut String) -> Result<bool> {
+    let data = page.data;
     if data.settings.is_empty() {
-        return;
+        return Ok(false);
     }
     h.push_str("<section id=\"settings\">\n<h2>Run settings</h2>\n<dl class=\"kv\">\n");
     for s in &data.settings {
-        crate::html::kv(h, &s.key, &s.value);
+        crate::markup::kv(h, &s.key, &s.value);
     }
     h.push_str("</dl>\n</section>\n");
+    Ok(true)
 }

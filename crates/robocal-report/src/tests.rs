@@ -65,10 +65,20 @@ fn example_report_is_well_formed_and_complete() {
     let data = ReportData::synthetic_example(7);
     let r = render(&data).unwrap();
     let names = xml_elements(&xmlish(&r.html));
+    // histogram, x/y/z components, reach, joints and workspace map inline
     assert!(
-        names.iter().filter(|n| *n == "svg").count() == 2,
-        "histogram and scatter inline"
+        names.iter().filter(|n| *n == "svg").count() == 5,
+        "histogram, components, scatter, joints and map inline"
     );
+    for title in [
+        "<title>Displacement error before and after calibration</title>",
+        "<title>Error components in the base frame</title>",
+        "<title>Displacement error across the workspace</title>",
+        "<title>Error after calibration against each joint</title>",
+        "<title>Error after calibration across the workspace</title>",
+    ] {
+        assert!(r.html.contains(title), "missing figure {title}");
+    }
     xml_elements(&r.histogram_svg);
     for label in [
         "Displacement error ‖Eᵢ‖ (mm)",
@@ -199,6 +209,7 @@ fn edge_cases_render() {
             point_sets: vec![PointSet {
                 name: "Calibration".into(),
                 points,
+                details: Vec::new(),
             }],
             ..ReportData::default()
         };
@@ -290,7 +301,11 @@ mod runs {
         let r = render(&data).unwrap();
         xml_elements(&xmlish(&r.html));
         xml_elements(&r.histogram_svg);
-        assert_eq!(svg_count(&r.html), 2, "histogram and reach plot");
+        assert_eq!(
+            svg_count(&r.html),
+            5,
+            "histogram, components, reach plot, joints and map"
+        );
         for label in [
             "Before calibration (Table II)",
             "After calibration, predicted (Table IV)",

@@ -172,7 +172,11 @@ pub fn example(name: &str) -> String {
 /// The real data sets of ../shared/data (see its README); `None` (and a printed reason) when the
 /// folder is absent.
 pub fn real_data() -> Option<PathBuf> {
-    let d = root().join("../shared/data");
+    // ROBOCAL_REAL_DATA names the folder where the repository is not beside shared/ (a git
+    // worktree elsewhere).
+    let d = std::env::var_os("ROBOCAL_REAL_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root().join("../shared/data"));
     if d.join("jacobi_ur5_grid.csv").is_file() {
         Some(d)
     } else {
