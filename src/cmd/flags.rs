@@ -31,6 +31,10 @@ const FLAGS: &[(&str, &str)] = &[
     ("identifiability.free", "--free"),
     ("identifiability.rank_tolerance", "--rank-tol"),
     ("robust_scale_mm", "--robust-scale"),
+    // planning::PlanSettings (`poses` and `noise_mm` as above)
+    ("candidates", "--candidates"),
+    ("include", "--include"),
+    ("tracker_range", "--range-mm"),
     // compensation::DampedLeastSquares
     ("tolerance_mm", "--tolerance-mm"),
     ("max_iterations", "--max-iterations"),

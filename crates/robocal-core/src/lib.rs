@@ -41,6 +41,7 @@ pub mod io;
 pub mod kinematics;
 pub mod model;
 pub mod observations;
+pub mod planning;
 pub mod progress;
 pub mod ranges;
 pub mod registration;

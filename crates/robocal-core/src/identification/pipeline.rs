@@ -15,22 +15,24 @@ use crate::identification::identifiability::{
     analyze, Identifiability, IdentifiabilityOptions, MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
 };
 use crate::identification::objective::{
-    Loss, Objective, RobustLoss, CHI3_MEDIAN, ROBUST_SCALE_SIGMAS, SUM_OF_NORMS_SMOOTHING_MM,
+    robust_sigma, Loss, Objective, RobustLoss, ROBUST_SCALE_SIGMAS, SUM_OF_NORMS_SMOOTHING_MM,
 };
 use crate::identification::param_vector::ParamVector;
 use crate::identification::plausibility::{self, Plausibility};
+use crate::identification::prediction::{predict, Prediction};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
 use crate::observations::Observations;
 use crate::progress::{self, Observer};
 use crate::registration::{register, Registration, RegistrationObjective, RegistrationOptions};
-use crate::stats::{percentile, ErrorStats};
+use crate::stats::ErrorStats;
 
 /// Everything that steers a calibration.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CalibrationSettings {
-    /// The objective (default: the paper's sum of norms).
+    /// The objective (default: [`Objective::Adaptive`]; the paper's is
+    /// [`Objective::SumOfNorms`]).
     pub objective: Objective,
     /// Scale of the robust loss (mm); `None`: from the residuals (see [`RobustLoss`]).
     pub robust_scale_mm: Option<f64>,
@@ -45,7 +47,7 @@ pub struct CalibrationSettings {
 impl Default for CalibrationSettings {
     fn default() -> Self {
         CalibrationSettings {
-            objective: Objective::SumOfNorms,
+            objective: Objective::default(),
             robust_scale_mm: None,
             affine_registration: false,
             identifiability: IdentifiabilityOptions::default(),
@@ -135,6 +137,9 @@ pub struct Calibration {
     pub stages: Vec<Stage>,
     /// Uncertainty of the identified parameters.
     pub covariance: Covariance,
+    /// The predicted accuracy at new poses spread like the calibration poses (`None` when the
+    /// standard deviations are unavailable).
+    pub prediction: Option<Prediction>,
     /// Errors on the calibration points.
     pub calibration: SetErrors,
     /// Errors on the validation points.
@@ -307,26 +312,35 @@ pub fn calibrate(
             run(&mut robot, son, &mut stages)?;
             son
         }
-        Objective::Robust(kind) => {
+        Objective::Robust(_) | Objective::Adaptive => {
             run(&mut robot, son, &mut stages)?;
-            let make = |c: f64| match kind {
-                RobustLoss::Cauchy => Loss::Cauchy { c },
-                RobustLoss::Huber => Loss::Huber { k: c },
+            let make = |c: f64| match settings.objective {
+                Objective::Robust(RobustLoss::Cauchy) => Loss::Cauchy { c },
+                Objective::Robust(RobustLoss::Huber) => Loss::Huber { k: c },
+                _ => Loss::Adaptive { k: c },
             };
+            // The scale follows the residuals: re-estimated after every reweighted fit until
+            // it settles (within 5%; the adaptive objective, whose threshold decides which
+            // points count fully, within 1%).
+            let (rounds, settle) = match settings.objective {
+                Objective::Adaptive => (8, 0.01),
+                _ => (3, 0.05),
+            };
+            let rows = problem.kind().rows();
             let scale_of = |r: &Robot| {
-                let med = percentile(&problem.error_norms(r), 0.5);
-                (ROBUST_SCALE_SIGMAS * med / CHI3_MEDIAN).max(SUM_OF_NORMS_SMOOTHING_MM)
+                (ROBUST_SCALE_SIGMAS * robust_sigma(&problem.error_norms(r), rows))
+                    .max(SUM_OF_NORMS_SMOOTHING_MM)
             };
             let mut c = settings.robust_scale_mm.unwrap_or_else(|| scale_of(&robot));
             let mut loss = make(c);
-            for _ in 0..3 {
+            for _ in 0..rounds {
                 loss = make(c);
                 run(&mut robot, loss, &mut stages)?;
                 if settings.robust_scale_mm.is_some() {
                     break;
                 }
                 let c2 = scale_of(&robot);
-                if (c2 - c).abs() <= 0.05 * c {
+                if (c2 - c).abs() <= settle * c {
                     break;
                 }
                 c = c2;
@@ -344,6 +358,17 @@ pub fn calibrate(
     }
 
     let calibration = SetErrors::new(cal, &registration, nominal, &robot);
+    // Points beyond the robust threshold are outliers, not noise a new measurement shares.
+    let threshold = robust_scale.unwrap_or_else(|| {
+        ROBUST_SCALE_SIGMAS * robust_sigma(&calibration.after, problem.kind().rows())
+    });
+    let prediction = predict(
+        &robot,
+        &covariance,
+        cal,
+        &calibration.after,
+        Some(threshold),
+    );
     let validation = data
         .validation
         .filter(|v| !v.is_empty())
@@ -380,6 +405,7 @@ pub fn calibrate(
         identifiability: ident,
         stages,
         covariance,
+        prediction,
         calibration,
         validation,
         robust_scale_mm: robust_scale,

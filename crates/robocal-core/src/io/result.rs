@@ -142,6 +142,13 @@ pub struct CalibrationResult {
         serialize_with = "sorted_opt"
     )]
     pub points: Option<Points>,
+    /// The predicted accuracy at new poses.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub prediction: Option<crate::io::result_prediction::PredictionSection>,
     /// The measurement frame fit.
     #[serde(
         default,
@@ -319,6 +326,7 @@ impl CalibrationResult {
             partial_reason: None,
             plausibility: None,
             points: None,
+            prediction: None,
             registration: None,
             settings: None,
             solver: None,
