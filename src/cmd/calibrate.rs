@@ -45,8 +45,9 @@ pub struct CalibrateArgs {
     /// The robust loss of `--objective robust`.
     #[arg(long, value_enum, default_value_t = RobustArg::Cauchy)]
     robust_loss: RobustArg,
-    /// Scale of the robust loss, or the adaptive objective's threshold, in mm (default: 4 sigma,
-    /// sigma estimated from the median error after every reweighting).
+    /// Scale of the robust loss, or the adaptive objective's threshold, in mm (default: 4 sigma
+    /// for the robust losses, 5 sigma for adaptive; sigma estimated from the median error after
+    /// every reweighting).
     #[arg(long, value_name = "MM")]
     robust_scale: Option<f64>,
     /// Parameters to hold at their nominal values (comma-separated names, e.g. `a6,alpha6`).

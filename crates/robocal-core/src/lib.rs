@@ -51,6 +51,8 @@ pub mod unit;
 
 #[cfg(test)]
 mod messages_tests;
+#[cfg(test)]
+mod study_tests;
 
 pub use compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
 pub use error::{Error, Result};

@@ -22,7 +22,7 @@ pub enum Objective {
     /// A robust loss whose scale comes from the residuals (see [`RobustLoss`]).
     Robust(RobustLoss),
     /// Least squares with outliers down-weighted beyond a data-scaled threshold
-    /// ([`Loss::Adaptive`] with `k = ROBUST_SCALE_SIGMAS * sigma`, sigma re-estimated from the
+    /// ([`Loss::Adaptive`] with `k = ADAPTIVE_THRESHOLD_SIGMAS * sigma`, sigma re-estimated from the
     /// median residual after every reweighting; a sum-of-norms fit gives the robust start).
     /// Default: as efficient as least squares on clean data, as robust as the Cauchy loss.
     Adaptive,
@@ -82,6 +82,14 @@ pub fn robust_sigma(norms: &[f64], rows: usize) -> f64 {
 /// the scale with probability 0.1% (chi-square, 3 degrees of freedom), so only real outliers are
 /// down-weighted.
 pub const ROBUST_SCALE_SIGMAS: f64 = 4.0;
+
+/// The adaptive objective's threshold `k` in units of the estimated per-axis sigma. Beyond 5
+/// sigma lie 1.4e-5 of clean Gaussian points (chi-square, 3 degrees of freedom), so on clean
+/// data the adaptive fit is the least-squares fit; a real robot's heavier-tailed residuals
+/// (unmodelled errors) also stay at full weight (on the real UR5 set none is down-weighted at 5
+/// sigma, seven were at 4, for a validation mean 0.05% above least squares), while gross
+/// outliers (millimetres against hundredths) lose nearly all influence.
+pub const ADAPTIVE_THRESHOLD_SIGMAS: f64 = 5.0;
 
 /// Smoothing of the sum of norms (mm): `l(r) = sqrt(r^2 + delta^2) - delta`. Far below any
 /// tracker's resolution, it only keeps the objective differentiable at a zero error.

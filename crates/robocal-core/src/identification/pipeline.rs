@@ -15,7 +15,8 @@ use crate::identification::identifiability::{
     analyze, Identifiability, IdentifiabilityOptions, MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
 };
 use crate::identification::objective::{
-    robust_sigma, Loss, Objective, RobustLoss, ROBUST_SCALE_SIGMAS, SUM_OF_NORMS_SMOOTHING_MM,
+    robust_sigma, Loss, Objective, RobustLoss, ADAPTIVE_THRESHOLD_SIGMAS, ROBUST_SCALE_SIGMAS,
+    SUM_OF_NORMS_SMOOTHING_MM,
 };
 use crate::identification::param_vector::ParamVector;
 use crate::identification::plausibility::{self, Plausibility};
@@ -327,8 +328,12 @@ pub fn calibrate(
                 _ => (3, 0.05),
             };
             let rows = problem.kind().rows();
+            let sigmas = match settings.objective {
+                Objective::Adaptive => ADAPTIVE_THRESHOLD_SIGMAS,
+                _ => ROBUST_SCALE_SIGMAS,
+            };
             let scale_of = |r: &Robot| {
-                (ROBUST_SCALE_SIGMAS * robust_sigma(&problem.error_norms(r), rows))
+                (sigmas * robust_sigma(&problem.error_norms(r), rows))
                     .max(SUM_OF_NORMS_SMOOTHING_MM)
             };
             let mut c = settings.robust_scale_mm.unwrap_or_else(|| scale_of(&robot));

@@ -208,19 +208,54 @@ impl<'a> Predictor<'a> {
 }
 
 /// The per-axis noise of the calibration residuals `norms` (mm) over `rows` rows each: the
-/// points at or below `threshold_mm` (all when `None`) with `k` fitted parameters,
-/// `sqrt(sum r^2 / (rows n - k))`. NaN when too few points remain.
-pub fn noise_sigma(norms: &[f64], rows: usize, k: usize, threshold_mm: Option<f64>) -> f64 {
-    let kept: Vec<f64> = norms
-        .iter()
-        .copied()
-        .filter(|r| threshold_mm.is_none_or(|t| *r <= t))
+/// points at or below `threshold_mm` (all when `None`), each squared residual divided by its
+/// degrees of freedom `rows - h_i` (`h_i` its leverage, `tr(J_i S^-1 J_i^T)` with `S` the kept
+/// points' `sum J^T J`), averaged: `sqrt(mean r_i^2 / (rows - h_i))`. Unlike one global correction `sum r^2 / (rows n - k)`, it stays unbiased when the noise
+/// differs between poses (a tracker's grows with distance) and the high-leverage poses are the
+/// noisier ones (Horn, Horn and Duncan's HC2 idea). `leverage` gives `h_i`; NaN when too few
+/// points remain.
+pub fn noise_sigma(
+    norms: &[f64],
+    rows: usize,
+    threshold_mm: Option<f64>,
+    leverage: &dyn Fn(&[usize]) -> Option<Vec<f64>>,
+) -> f64 {
+    let kept: Vec<usize> = (0..norms.len())
+        .filter(|&i| threshold_mm.is_none_or(|t| norms[i] <= t))
         .collect();
-    let dof = (rows * kept.len()) as f64 - k as f64;
-    if dof <= 0.0 {
+    let Some(h) = leverage(&kept) else {
         return f64::NAN;
+    };
+    let rows = rows as f64;
+    let mut sum = 0.0;
+    for (&i, hi) in kept.iter().zip(&h) {
+        let dof = rows - hi;
+        if !(dof > 1e-6) {
+            return f64::NAN;
+        }
+        sum += norms[i] * norms[i] / dof;
     }
-    (kept.iter().map(|r| r * r).sum::<f64>() / dof).sqrt()
+    (sum / kept.len() as f64).sqrt()
+}
+
+/// The leverages `h_i = tr(J_i S^-1 J_i^T)` of points `kept` (Jacobian blocks `jac`, `rows x k`
+/// row-major each), `S = sum J^T J` over them; `None` when `S` is singular.
+fn leverages(jac: &[Vec<f64>], k: usize, rows: usize, kept: &[usize]) -> Option<Vec<f64>> {
+    let mut s = DMatrix::zeros(k, k);
+    for &i in kept {
+        let j = DMatrix::from_row_slice(rows, k, &jac[i]);
+        s += j.transpose() * &j;
+    }
+    let ch = s.cholesky()?;
+    Some(
+        kept.iter()
+            .map(|&i| {
+                let j = DMatrix::from_row_slice(rows, k, &jac[i]);
+                let x = ch.solve(&j.transpose());
+                (&j * x).trace()
+            })
+            .collect(),
+    )
 }
 
 /// The prediction of a calibrated model from its calibration points (see the module docs);
@@ -233,7 +268,24 @@ pub fn predict(
     threshold_mm: Option<f64>,
 ) -> Option<Prediction> {
     let rows = calibration.kind().rows();
-    let sigma = noise_sigma(residual_norms, rows, covariance.params.len(), threshold_mm);
+    let index = covariance
+        .params
+        .iter()
+        .map(|p| calibrated.param_position(*p))
+        .collect::<Option<Vec<_>>>()?;
+    let k = index.len();
+    let mut jp = vec![Vector3::zeros(); calibrated.param_count()];
+    let jac: Vec<Vec<f64>> = (0..calibration.len())
+        .map(|i| {
+            let mut j = vec![0.0; 3 * k];
+            point_jacobian(calibrated, &index, calibration.q(i), &mut jp, &mut j);
+            j
+        })
+        .collect();
+    // (The leverages come from the tool point's rows: exact for point measurements.)
+    let sigma = noise_sigma(residual_norms, rows, threshold_mm, &|kept| {
+        leverages(&jac, k, 3, kept)
+    });
     let pred = Predictor::new(calibrated, covariance, sigma)?;
     let qs: Vec<&[f64]> = (0..calibration.len()).map(|i| calibration.q(i)).collect();
     let floor = (0..calibration.len())
@@ -265,9 +317,12 @@ mod tests {
     #[test]
     fn noise_sigma_counts_degrees_of_freedom_and_skips_outliers() {
         let norms = [1.0, 1.0, 1.0, 1.0, 50.0];
-        // 4 kept points, 3 rows each, 2 parameters: 4 / 10.
-        let s = noise_sigma(&norms, 3, 2, Some(10.0));
-        assert!((s - (4.0f64 / 10.0).sqrt()).abs() < 1e-12);
-        assert!(noise_sigma(&norms, 3, 20, Some(10.0)).is_nan());
+        // 4 kept points, 3 rows each, leverage 0.5 each (2 parameters): r^2 / 2.5 per point.
+        let half = |kept: &[usize]| Some(vec![0.5; kept.len()]);
+        let s = noise_sigma(&norms, 3, Some(10.0), &half);
+        assert!((s - (1.0f64 / 2.5).sqrt()).abs() < 1e-12);
+        let full = |kept: &[usize]| Some(vec![3.0; kept.len()]);
+        assert!(noise_sigma(&norms, 3, Some(10.0), &full).is_nan());
+        assert!(noise_sigma(&norms, 3, Some(10.0), &|_| None).is_nan());
     }
 }
