@@ -41,6 +41,7 @@ pub mod histogram;
 mod html;
 mod numfmt;
 mod plot;
+mod prediction;
 mod result_details;
 pub mod run;
 pub mod scatter;

@@ -313,8 +313,16 @@ pub fn calibrate(
             run(&mut robot, son, &mut stages)?;
             son
         }
-        Objective::Robust(_) | Objective::Adaptive => {
+        Objective::Robust(_) | Objective::Adaptive => 'staged: {
             run(&mut robot, son, &mut stages)?;
+            // A stage stopped by the iteration limit ends the identification: the result is
+            // partial, and the later stages would only restart from a point that is not a
+            // minimum.
+            let converged =
+                |st: &[Stage]| st.last().is_some_and(|s| s.report.termination.converged());
+            if !converged(&stages) {
+                break 'staged son;
+            }
             let make = |c: f64| match settings.objective {
                 Objective::Robust(RobustLoss::Cauchy) => Loss::Cauchy { c },
                 Objective::Robust(RobustLoss::Huber) => Loss::Huber { k: c },
@@ -341,7 +349,7 @@ pub fn calibrate(
             for _ in 0..rounds {
                 loss = make(c);
                 run(&mut robot, loss, &mut stages)?;
-                if settings.robust_scale_mm.is_some() {
+                if settings.robust_scale_mm.is_some() || !converged(&stages) {
                     break;
                 }
                 let c2 = scale_of(&robot);
