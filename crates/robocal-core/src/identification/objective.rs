@@ -13,7 +13,7 @@
 //! noise floor, see the project's estimator study).
 
 /// Which objective to minimize (the CLI's `--objective`).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum Objective {
     /// The paper's total displacement error, `sum |e_i|` (eq. 4).
     SumOfNorms,
@@ -25,13 +25,8 @@ pub enum Objective {
     /// ([`Loss::Adaptive`] with `k = ADAPTIVE_THRESHOLD_SIGMAS * sigma`, sigma re-estimated from the
     /// median residual after every reweighting; a sum-of-norms fit gives the robust start).
     /// Default: as efficient as least squares on clean data, as robust as the Cauchy loss.
+    #[default]
     Adaptive,
-}
-
-impl Default for Objective {
-    fn default() -> Self {
-        Objective::Adaptive
-    }
 }
 
 impl Objective {

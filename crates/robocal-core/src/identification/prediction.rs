@@ -230,7 +230,7 @@ pub fn noise_sigma(
     let mut sum = 0.0;
     for (&i, hi) in kept.iter().zip(&h) {
         let dof = rows - hi;
-        if !(dof > 1e-6) {
+        if dof.is_nan() || dof <= 1e-6 {
             return f64::NAN;
         }
         sum += norms[i] * norms[i] / dof;
