@@ -30,7 +30,7 @@ use crate::registration::{register, Registration, RegistrationObjective, Registr
 use crate::stats::ErrorStats;
 
 /// Everything that steers a calibration.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct CalibrationSettings {
     /// The objective (default: [`Objective::Adaptive`]; the paper's is
     /// [`Objective::SumOfNorms`]).
@@ -43,18 +43,6 @@ pub struct CalibrationSettings {
     pub identifiability: IdentifiabilityOptions,
     /// Solver settings.
     pub solver: SolverOptions,
-}
-
-impl Default for CalibrationSettings {
-    fn default() -> Self {
-        CalibrationSettings {
-            objective: Objective::default(),
-            robust_scale_mm: None,
-            affine_registration: false,
-            identifiability: IdentifiabilityOptions::default(),
-            solver: SolverOptions::default(),
-        }
-    }
 }
 
 /// The measured points of a calibration.

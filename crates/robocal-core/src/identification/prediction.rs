@@ -221,7 +221,7 @@ pub fn noise_sigma(
     leverage: &dyn Fn(&[usize]) -> Option<Vec<f64>>,
 ) -> f64 {
     let kept: Vec<usize> = (0..norms.len())
-        .filter(|&i| threshold_mm.is_none_or(|t| norms[i] <= t))
+        .filter(|&i| threshold_mm.map_or(true, |t| norms[i] <= t))
         .collect();
     let Some(h) = leverage(&kept) else {
         return f64::NAN;

@@ -14,6 +14,9 @@
 use nalgebra::{Cholesky, DMatrix, Matrix3};
 use rayon::prelude::*;
 
+/// One parallel work item: a chunk's index, its `D_i` and (I-optimality) its `E_i`.
+type Work<'a> = (usize, &'a mut [f64], Option<&'a mut [f64]>);
+
 /// Rows per candidate supported (point measurements: 3).
 pub const ROWS: usize = 3;
 
@@ -221,7 +224,7 @@ impl<'a> Selector<'a> {
             Vec::new()
         };
         let mut e_iter = e_chunks.into_iter();
-        let work: Vec<(usize, &mut [f64], Option<&mut [f64]>)> = self
+        let work: Vec<Work> = self
             .d
             .chunks_mut(CHUNK * sq)
             .enumerate()
@@ -338,7 +341,7 @@ impl<'a> Selector<'a> {
         let sq = ROWS * ROWS;
         let mut e = std::mem::take(&mut self.e);
         let mut e_iter = e.chunks_mut(CHUNK * sq);
-        let work: Vec<(usize, &mut [f64], Option<&mut [f64]>)> = self
+        let work: Vec<Work> = self
             .d
             .chunks_mut(CHUNK * sq)
             .enumerate()

@@ -89,7 +89,7 @@ pub fn random_poses_within<R: Rng + ?Sized>(
             };
         }
         let p = robot.tool_position(&q);
-        if sampler.accepts(&p) && range.is_none_or(|r| r.accepts(&p)) {
+        if sampler.accepts(&p) && range.map_or(true, |r| r.accepts(&p)) {
             out.push(q.clone());
             tries = 0;
         } else {
