@@ -38,14 +38,17 @@ pub struct CalibrateArgs {
     /// listing the lines (recorded in the result's settings) instead of an error (exit code 3).
     #[arg(long)]
     nominal_limits: bool,
-    /// What to minimize: the paper's total displacement error, squared errors, or a robust loss
-    /// that down-weights outliers.
-    #[arg(long, value_enum, default_value_t = ObjectiveArg::SumOfNorms)]
+    /// What to minimize. Default `adaptive`: least squares with outliers down-weighted beyond a
+    /// threshold scaled from the data (efficient on clean data, robust to gross outliers);
+    /// `sum-of-norms` is the paper's total displacement error (eq. 4).
+    #[arg(long, value_enum, default_value_t = ObjectiveArg::Adaptive)]
     objective: ObjectiveArg,
     /// The robust loss of `--objective robust`.
     #[arg(long, value_enum, default_value_t = RobustArg::Cauchy)]
     robust_loss: RobustArg,
-    /// Scale of the robust loss in mm (default: 4 sigma, sigma estimated from the median error).
+    /// Scale of the robust loss, or the adaptive objective's threshold, in mm (default: 4 sigma
+    /// for the robust losses, 5 sigma for adaptive; sigma estimated from the median error after
+    /// every reweighting).
     #[arg(long, value_name = "MM")]
     robust_scale: Option<f64>,
     /// Parameters to hold at their nominal values (comma-separated names, e.g. `a6,alpha6`).
@@ -109,6 +112,8 @@ pub struct CalibrateArgs {
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
 enum ObjectiveArg {
+    /// Least squares, outliers down-weighted beyond a data-scaled threshold (default).
+    Adaptive,
     /// Sum of error norms, the paper's eq. 4.
     SumOfNorms,
     /// Sum of squared errors.
@@ -317,6 +322,7 @@ impl TryFrom<&CalibrateArgs> for Settings {
         }
         let calibration = CalibrationSettings {
             objective: match a.objective {
+                ObjectiveArg::Adaptive => Objective::Adaptive,
                 ObjectiveArg::SumOfNorms => Objective::SumOfNorms,
                 ObjectiveArg::LeastSquares => Objective::LeastSquares,
                 ObjectiveArg::Robust => Objective::Robust(match a.robust_loss {
@@ -719,5 +725,31 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
             &format!("Table IV. Error after calibration (calibrated model){partial}"),
             &after_cols
         )
+    );
+    print_prediction(c);
+}
+
+/// The predicted error at new poses, beside the measured validation mean when there is one.
+fn print_prediction(c: &Calibration) {
+    let Some(p) = &c.prediction else {
+        println!("predicted error at new poses: unavailable (no standard deviations)");
+        return;
+    };
+    let measured = c.validation.as_ref().map(|v| v.after_stats().mean_mm);
+    println!(
+        "Predicted at new poses like the calibration poses: mean {:.4} mm, std {:.4} mm, RMS \
+         {:.4} mm (noise {:.4} mm per axis, parameter uncertainty {:.4} mm RMS){}",
+        p.mean_mm,
+        p.std_mm,
+        p.rms_mm,
+        p.noise_sigma_mm,
+        p.model_rms_mm,
+        match measured {
+            Some(m) => format!(
+                "; validation measured {m:.4} mm ({:+.1}%)",
+                100.0 * (m / p.mean_mm - 1.0)
+            ),
+            None => String::new(),
+        }
     );
 }

@@ -389,6 +389,8 @@ fn print_files(exp: &Experiment, dir: &Path) {
     command(&[
         "robocal calibrate".to_owned(),
         robot.clone(),
+        // The paper's objective (eq. 4); calibrate's default is the adaptive one.
+        "--objective sum-of-norms".to_owned(),
         format!("--data {}", p(files::CELL)),
         format!("--validate {}", p(files::VALIDATION)),
         format!("--out {}", p(files::RESULT)),

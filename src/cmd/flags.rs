@@ -34,6 +34,10 @@ const FLAGS: &[(&str, &str)] = &[
     ("weighting.tracker", "--tracker-sigma"),
     ("validation_refit_frame", "--validate-refit-frame"),
     ("orientation_mm_per_deg", "--orientation-weight"),
+    // planning::PlanSettings (`poses` and `noise_mm` as above)
+    ("candidates", "--candidates"),
+    ("include", "--include"),
+    ("tracker_range", "--range-mm"),
     // compensation::DampedLeastSquares
     ("tolerance_mm", "--tolerance-mm"),
     ("max_iterations", "--max-iterations"),

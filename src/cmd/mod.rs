@@ -10,6 +10,7 @@ pub(crate) mod flags;
 mod io_plan;
 mod limits;
 mod paper_tables;
+mod plan;
 mod report;
 mod report_meta;
 mod robot;
@@ -48,6 +49,9 @@ enum Command {
     /// The paper's whole experiment in simulation: its tables beside the paper's, a report, and
     /// the files of every step.
     Demo(demo::DemoArgs),
+    /// Choose the poses worth measuring: D-optimal selection from random candidates within the
+    /// joint limits (and the tracker's range), compared with random poses.
+    Plan(plan::PlanArgs),
     /// The HTML report of a calibration result (tables, histogram, per-point errors, parameters).
     Report(report::ReportArgs),
     /// Shell completions (bash, zsh, fish, elvish, powershell) on standard output.
@@ -66,6 +70,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Evaluate(a) => evaluate::run(a),
         Command::Compensate(a) => compensate::run(a),
         Command::Demo(a) => demo::run(a),
+        Command::Plan(a) => plan::run(a),
         Command::Report(a) => report::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),

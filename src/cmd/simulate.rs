@@ -127,7 +127,7 @@ fn per_joint(name: &str, s: &str, dof: usize) -> anyhow::Result<Vec<f64>> {
     }
 }
 
-fn tracker_arg(s: &str) -> anyhow::Result<FrameVec> {
+pub(crate) fn tracker_arg(s: &str) -> anyhow::Result<FrameVec> {
     let v: Vec<f64> = s
         .split(',')
         .map(|p| p.trim().parse::<f64>())

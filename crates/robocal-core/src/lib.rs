@@ -41,6 +41,7 @@ pub mod io;
 pub mod kinematics;
 pub mod model;
 pub mod observations;
+pub mod planning;
 pub mod progress;
 pub mod ranges;
 pub mod registration;
@@ -50,6 +51,8 @@ pub mod unit;
 
 #[cfg(test)]
 mod messages_tests;
+#[cfg(test)]
+mod study_tests;
 
 pub use compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
 pub use error::{Error, Result};

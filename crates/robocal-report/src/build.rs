@@ -215,6 +215,7 @@ impl ReportData {
             ),
         ];
         settings.extend(crate::result_details::settings(result));
+        settings.extend(crate::prediction::setting(result));
         let mut notes = Vec::new();
         if result.errors.validation.is_none() {
             notes.push(Note::info(

@@ -49,6 +49,7 @@ mod numfmt;
 mod page;
 mod plot;
 mod points_table;
+mod prediction;
 mod result_details;
 pub mod run;
 pub mod scatter;

@@ -48,6 +48,7 @@ fn loss_name(l: &LossEntry) -> &'static str {
         LossEntry::LeastSquares => "least-squares",
         LossEntry::Huber { .. } => "huber",
         LossEntry::Cauchy { .. } => "cauchy",
+        LossEntry::Adaptive { .. } => "adaptive",
     }
 }
 
@@ -130,6 +131,7 @@ mod tests {
             ObjectiveName::LeastSquares,
             ObjectiveName::RobustCauchy,
             ObjectiveName::RobustHuber,
+            ObjectiveName::Adaptive,
         ] {
             let raw = serde_json::to_value(o).unwrap();
             let phrase = o.phrase();

@@ -403,7 +403,8 @@ mod runs {
                 plane: Some(&split.plane),
                 validation: None,
             },
-            &Default::default(),
+            // The experiment's settings (the paper's objective).
+            &e.config.calibration,
             &(),
         )
         .unwrap();

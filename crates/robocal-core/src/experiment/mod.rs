@@ -137,7 +137,11 @@ impl ExperimentConfig {
             truth: preset(PAPER_TRUTH)?,
             session,
             verification_seed: seed.wrapping_add(1),
-            calibration: CalibrationSettings::default(),
+            // The paper's objective, explicitly: the library's default is the adaptive one.
+            calibration: CalibrationSettings {
+                objective: crate::identification::Objective::SumOfNorms,
+                ..CalibrationSettings::default()
+            },
             ik: DampedLeastSquares::default(),
             result_settings: serde_json::Map::new(),
         })

@@ -11,6 +11,7 @@
 //! - [`solver`]: Levenberg–Marquardt with reweighting and a termination report;
 //! - [`param_vector`]: every parameter with its name, unit, family, values and verdicts;
 //! - [`covariance`]: standard deviations and correlations of the estimates;
+//! - [`prediction`]: the expected error at new poses (noise plus parameter uncertainty);
 //! - [`pipeline`]: registration + all of the above ([`calibrate`]);
 //! - [`plausibility`]: the gate run after every fit (units, handedness, nominal error, parameter
 //!   moves, convergence) and the likely cause of a failure;
@@ -23,6 +24,7 @@ pub mod param_vector;
 pub mod pipeline;
 pub mod plausibility;
 pub mod precision;
+pub mod prediction;
 pub mod report;
 pub mod solver;
 pub mod split;
@@ -47,6 +49,7 @@ pub use pipeline::{
     calibrate, Calibration, CalibrationData, CalibrationSettings, DownWeighted, SetErrors, Stage,
 };
 pub use plausibility::{Check, CheckKind, Plausibility};
+pub use prediction::{MapPoint, Prediction};
 pub use solver::{solve, SolverOptions, SolverReport, Termination};
 pub use split::{split_measurements, SplitData};
 pub use system::Problem;

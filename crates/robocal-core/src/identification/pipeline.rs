@@ -16,11 +16,13 @@ use crate::identification::identifiability::{
     MIN_RANK_TOLERANCE,
 };
 use crate::identification::objective::{
-    Loss, Objective, RobustLoss, CHI3_MEDIAN, ROBUST_SCALE_SIGMAS, SUM_OF_NORMS_SMOOTHING_MM,
+    robust_sigma, Loss, Objective, RobustLoss, ADAPTIVE_THRESHOLD_SIGMAS, ROBUST_SCALE_SIGMAS,
+    SUM_OF_NORMS_SMOOTHING_MM,
 };
 use crate::identification::param_vector::ParamVector;
 use crate::identification::plausibility::{self, Plausibility};
 use crate::identification::precision;
+use crate::identification::prediction::{predict, Prediction};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
@@ -30,12 +32,13 @@ use crate::progress::{self, Observer};
 use crate::registration::{
     fit_tools, register, Registration, RegistrationObjective, RegistrationOptions, ToolFit,
 };
-use crate::stats::{percentile, ErrorStats};
+use crate::stats::ErrorStats;
 
 /// Everything that steers a calibration.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct CalibrationSettings {
-    /// The objective (default: the paper's sum of norms).
+    /// The objective (default: [`Objective::Adaptive`]; the paper's is
+    /// [`Objective::SumOfNorms`]).
     pub objective: Objective,
     /// Scale of the robust loss (mm); `None`: from the residuals (see [`RobustLoss`]).
     pub robust_scale_mm: Option<f64>,
@@ -50,20 +53,6 @@ pub struct CalibrationSettings {
     /// The validation points were measured from another tracker station: fit them a frame of
     /// their own (the errors then show the model's shape, not where the tracker stood).
     pub validation_refit_frame: bool,
-}
-
-impl Default for CalibrationSettings {
-    fn default() -> Self {
-        CalibrationSettings {
-            objective: Objective::SumOfNorms,
-            robust_scale_mm: None,
-            affine_registration: false,
-            identifiability: IdentifiabilityOptions::default(),
-            solver: SolverOptions::default(),
-            weighting: Weighting::default(),
-            validation_refit_frame: false,
-        }
-    }
 }
 
 /// The measured points of a calibration.
@@ -189,6 +178,9 @@ pub struct Calibration {
     pub stages: Vec<Stage>,
     /// Uncertainty of the identified parameters.
     pub covariance: Covariance,
+    /// The predicted accuracy at new poses spread like the calibration poses (`None` when the
+    /// standard deviations are unavailable).
+    pub prediction: Option<Prediction>,
     /// Errors on the calibration points.
     pub calibration: SetErrors,
     /// Errors on the validation points.
@@ -403,26 +395,47 @@ pub fn calibrate(
             run(&mut robot, son, &mut stages)?;
             son
         }
-        Objective::Robust(kind) => {
+        Objective::Robust(_) | Objective::Adaptive => 'staged: {
             run(&mut robot, son, &mut stages)?;
-            let make = |c: f64| match kind {
-                RobustLoss::Cauchy => Loss::Cauchy { c },
-                RobustLoss::Huber => Loss::Huber { k: c },
+            // A stage stopped by the iteration limit ends the identification: the result is
+            // partial, and the later stages would only restart from a point that is not a
+            // minimum.
+            let converged =
+                |st: &[Stage]| st.last().is_some_and(|s| s.report.termination.converged());
+            if !converged(&stages) {
+                break 'staged son;
+            }
+            let make = |c: f64| match settings.objective {
+                Objective::Robust(RobustLoss::Cauchy) => Loss::Cauchy { c },
+                Objective::Robust(RobustLoss::Huber) => Loss::Huber { k: c },
+                _ => Loss::Adaptive { k: c },
+            };
+            // The scale follows the residuals: re-estimated after every reweighted fit until
+            // it settles (within 5%; the adaptive objective, whose threshold decides which
+            // points count fully, within 1%).
+            let (rounds, settle) = match settings.objective {
+                Objective::Adaptive => (8, 0.01),
+                _ => (3, 0.05),
+            };
+            let rows = problem.kind().rows();
+            let sigmas = match settings.objective {
+                Objective::Adaptive => ADAPTIVE_THRESHOLD_SIGMAS,
+                _ => ROBUST_SCALE_SIGMAS,
             };
             let scale_of = |r: &Robot| {
-                let med = percentile(&problem.fit_norms(r), 0.5);
-                (ROBUST_SCALE_SIGMAS * med / CHI3_MEDIAN).max(SUM_OF_NORMS_SMOOTHING_MM)
+                (sigmas * robust_sigma(&problem.fit_norms(r), rows))
+                    .max(SUM_OF_NORMS_SMOOTHING_MM)
             };
             let mut c = settings.robust_scale_mm.unwrap_or_else(|| scale_of(&robot));
             let mut loss = make(c);
-            for _ in 0..3 {
+            for _ in 0..rounds {
                 loss = make(c);
                 run(&mut robot, loss, &mut stages)?;
-                if settings.robust_scale_mm.is_some() {
+                if settings.robust_scale_mm.is_some() || !converged(&stages) {
                     break;
                 }
                 let c2 = scale_of(&robot);
-                if (c2 - c).abs() <= 0.05 * c {
+                if (c2 - c).abs() <= settle * c {
                     break;
                 }
                 c = c2;
@@ -441,6 +454,17 @@ pub fn calibrate(
 
     let frame = &tool_fit.frame;
     let calibration = SetErrors::new(cal, &registration, nominal, frame, &robot);
+    // Points beyond the robust threshold are outliers, not noise a new measurement shares.
+    let threshold = robust_scale.unwrap_or_else(|| {
+        ROBUST_SCALE_SIGMAS * robust_sigma(&calibration.after, problem.kind().rows())
+    });
+    let prediction = predict(
+        &robot,
+        &covariance,
+        cal,
+        &calibration.after,
+        Some(threshold),
+    );
     let mut validation_frame = None;
     let validation = match data.validation.filter(|v| !v.is_empty()) {
         None => None,
@@ -489,6 +513,7 @@ pub fn calibrate(
         identifiability: ident,
         stages,
         covariance,
+        prediction,
         calibration,
         validation,
         validation_frame,

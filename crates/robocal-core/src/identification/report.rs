@@ -36,6 +36,7 @@ fn loss_entry(l: &Loss) -> LossEntry {
         Loss::Squared => LossEntry::LeastSquares,
         Loss::Huber { k } => LossEntry::Huber { scale_mm: k },
         Loss::Cauchy { c } => LossEntry::Cauchy { scale_mm: c },
+        Loss::Adaptive { k } => LossEntry::Adaptive { scale_mm: k },
     }
 }
 
@@ -46,6 +47,7 @@ fn objective_name(objective: &Objective) -> ObjectiveName {
         Objective::LeastSquares => ObjectiveName::LeastSquares,
         Objective::Robust(RobustLoss::Cauchy) => ObjectiveName::RobustCauchy,
         Objective::Robust(RobustLoss::Huber) => ObjectiveName::RobustHuber,
+        Objective::Adaptive => ObjectiveName::Adaptive,
     }
 }
 
@@ -328,6 +330,7 @@ impl Calibration {
                     .map(|(b, a)| pair(b, a)),
             }
         });
+        result.prediction = self.prediction.as_ref().map(Into::into);
         result
     }
 }

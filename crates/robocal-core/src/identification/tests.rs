@@ -322,7 +322,7 @@ fn sum_of_norms_solution_is_a_true_minimum() {
     let tr = tracker(0.010, 0.005);
     let mut rng = ChaCha8Rng::seed_from_u64(41);
     let cal = measure(&truth, &tr, 75, &mut rng);
-    let c = run(&nominal(), &cal, None, &CalibrationSettings::default());
+    let c = run(&nominal(), &cal, None, &settings(Objective::SumOfNorms));
     assert!(c.solver().termination.converged(), "{:?}", c.solver());
     let ps = c.identifiability.identified.clone();
     let problem = Problem::new(&c.nominal, &ps, &cal, c.tracker_frame());

@@ -145,6 +145,13 @@ pub struct CalibrationResult {
         serialize_with = "sorted_opt"
     )]
     pub points: Option<Points>,
+    /// The predicted accuracy at new poses.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        serialize_with = "sorted_opt"
+    )]
+    pub prediction: Option<crate::io::result_prediction::PredictionSection>,
     /// The measurement frame fit.
     #[serde(
         default,
@@ -322,6 +329,7 @@ impl CalibrationResult {
             partial_reason: None,
             plausibility: None,
             points: None,
+            prediction: None,
             registration: None,
             orientation_errors: None,
             settings: None,

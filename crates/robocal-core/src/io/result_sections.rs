@@ -62,6 +62,9 @@ pub enum ObjectiveName {
     /// A sum of norms, then the Cauchy loss.
     #[serde(rename = "robust (Cauchy)")]
     RobustCauchy,
+    /// A sum of norms, then least squares with outliers down-weighted (the default).
+    #[serde(rename = "adaptive")]
+    Adaptive,
     /// A sum of norms, then the Huber loss.
     #[serde(rename = "robust (Huber)")]
     RobustHuber,
@@ -79,6 +82,10 @@ impl ObjectiveName {
             ObjectiveName::RobustHuber => {
                 "robust Huber loss (sum of norms first, then down-weighting outliers)"
             }
+            ObjectiveName::Adaptive => {
+                "squared displacement errors, outliers down-weighted beyond a data-scaled \
+                 threshold (sum of norms first)"
+            }
         }
     }
 
@@ -87,7 +94,9 @@ impl ObjectiveName {
         match self {
             ObjectiveName::SumOfNorms => Some("mm"),
             ObjectiveName::LeastSquares => Some("mm²"),
-            ObjectiveName::RobustCauchy | ObjectiveName::RobustHuber => None,
+            ObjectiveName::RobustCauchy | ObjectiveName::RobustHuber | ObjectiveName::Adaptive => {
+                None
+            }
         }
     }
 }
@@ -351,6 +360,11 @@ pub enum LossEntry {
     /// Cauchy.
     Cauchy {
         /// Scale (mm).
+        scale_mm: f64,
+    },
+    /// Least squares up to the threshold, a logarithmic tail beyond.
+    Adaptive {
+        /// Threshold (mm).
         scale_mm: f64,
     },
 }

@@ -56,7 +56,7 @@ pub use gravity::{GravityModel, STANDARD_GRAVITY};
 pub use monte_carlo::{run_trials, simulate_trials, trial_seed};
 pub use outliers::{Outlier, OutlierModel};
 pub use plane::{plane_poses, quantize_joints, reach_position};
-pub use poses::{random_poses, PoseSampler};
+pub use poses::{random_poses, random_poses_within, PoseSampler, TrackerRange};
 pub use session::{
     simulate, simulate_joints, Simulation, SET_CALIBRATION, SET_PLANE, SET_VALIDATION,
 };

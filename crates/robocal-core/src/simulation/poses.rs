@@ -35,11 +35,43 @@ impl PoseSampler {
     }
 }
 
+/// Tool positions within a laser tracker's working range: distance from the tracker's origin
+/// (base frame) between `min_mm` and `max_mm`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackerRange {
+    /// The tracker's origin in the base frame (mm).
+    pub origin: nalgebra::Vector3<f64>,
+    /// Nearest measurable distance (mm).
+    pub min_mm: f64,
+    /// Farthest measurable distance (mm).
+    pub max_mm: f64,
+}
+
+impl TrackerRange {
+    /// Whether a tool position (base frame, mm) is within range.
+    pub fn accepts(&self, p: &nalgebra::Vector3<f64>) -> bool {
+        let d = (p - self.origin).norm();
+        d >= self.min_mm && d <= self.max_mm
+    }
+}
+
 /// Draws `n` joint vectors (rad) for `robot` following `sampler`.
 pub fn random_poses<R: Rng + ?Sized>(
     robot: &Robot,
     n: usize,
     sampler: &PoseSampler,
+    rng: &mut R,
+) -> Result<Vec<Vec<f64>>> {
+    random_poses_within(robot, n, sampler, None, rng)
+}
+
+/// Draws `n` joint vectors (rad) for `robot` following `sampler` and, if given, within the
+/// tracker's range.
+pub fn random_poses_within<R: Rng + ?Sized>(
+    robot: &Robot,
+    n: usize,
+    sampler: &PoseSampler,
+    range: Option<&TrackerRange>,
     rng: &mut R,
 ) -> Result<Vec<Vec<f64>>> {
     if n == 0 {
@@ -56,17 +88,24 @@ pub fn random_poses<R: Rng + ?Sized>(
                 l.min
             };
         }
-        if sampler.accepts(&robot.tool_position(&q)) {
+        let p = robot.tool_position(&q);
+        if sampler.accepts(&p) && range.map_or(true, |r| r.accepts(&p)) {
             out.push(q.clone());
             tries = 0;
         } else {
             tries += 1;
             if tries >= sampler.max_tries_per_pose {
+                let within = range.map_or(String::new(), |r| {
+                    format!(
+                        " within {}..{} mm of the tracker at ({:.0}, {:.0}, {:.0}) mm",
+                        r.min_mm, r.max_mm, r.origin.x, r.origin.y, r.origin.z
+                    )
+                });
                 return Err(Error::invalid(
                     "poses",
                     format!(
                         "no acceptable pose in {} random draws: the joint limits leave no tool \
-                         position above z = {} mm and outside radius {} mm",
+                         position above z = {} mm and outside radius {} mm{within}",
                         sampler.max_tries_per_pose, sampler.floor_z_mm, sampler.footprint_radius_mm
                     ),
                 ));

@@ -1,0 +1,296 @@
+//! `robocal plan`: the poses worth measuring (D-optimal selection from random candidates).
+
+use super::io_plan::IoPlan;
+use super::{common, limits};
+use crate::exit;
+use clap::Args;
+use robocal_core::io::{
+    read_measurements, write_measurements, Measurement, MeasurementSet, Positions,
+};
+use robocal_core::planning::{
+    plan, tracker_range, Criterion, Plan, PlanSettings, DEFAULT_CANDIDATES,
+};
+use robocal_core::simulation::{SimulationConfig, DEFAULT_NOISE_MM, DEFAULT_NOISE_PER_M};
+use robocal_core::{Robot, TrackerFrame};
+use std::path::PathBuf;
+
+/// Most candidates: 200,000 take about 150 MB for a six-joint robot and a few seconds.
+const MAX_CANDIDATES: usize = 200_000;
+
+#[derive(Args, Debug)]
+pub struct PlanArgs {
+    /// The nominal robot: a preset name or a TOML robot file.
+    #[arg(long)]
+    robot: String,
+    /// Number of poses to choose (besides those of --include).
+    #[arg(long)]
+    poses: usize,
+    /// Where to write the chosen poses (CSV: q1..qn in degrees, mm for a prismatic joint), a
+    /// joints file for `simulate --joints` or for measuring.
+    #[arg(long)]
+    out: PathBuf,
+    /// Number of random candidates to choose from.
+    #[arg(long, default_value_t = DEFAULT_CANDIDATES)]
+    candidates: usize,
+    /// Seed of the candidates: same arguments and seed give the same poses.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// The tracker's pose in the base frame x,y,z,A,B,C (mm, deg), for --range-mm; default: the
+    /// simulation's.
+    #[arg(long, value_name = "x,y,z,A,B,C", allow_hyphen_values = true)]
+    tracker: Option<String>,
+    /// The tracker's working range MIN,MAX (mm): only poses whose tool point is at a distance
+    /// from the tracker within it.
+    #[arg(long, value_name = "MIN,MAX")]
+    range_mm: Option<String>,
+    /// Poses measured anyway (a joints or measurement CSV): part of the design, not written.
+    #[arg(long, value_name = "FILE")]
+    include: Option<PathBuf>,
+    /// Reject poses whose nominal tool point is below this height (mm, base frame), as
+    /// `simulate` does.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    floor_mm: f64,
+    /// Reject poses whose nominal tool point is closer than this to the base axis (mm); default:
+    /// 15% of the chain's total length, as `simulate`.
+    #[arg(long, allow_hyphen_values = true)]
+    footprint_mm: Option<f64>,
+    /// Tracker noise, constant part: standard deviation per axis (mm), for the predicted
+    /// standard deviations.
+    #[arg(long, default_value_t = DEFAULT_NOISE_MM)]
+    noise_mm: f64,
+    /// Tracker noise per metre of distance (mm/m); with --tracker, poses far from the tracker
+    /// count less in the design.
+    #[arg(long, default_value_t = DEFAULT_NOISE_PER_M)]
+    noise_per_m: f64,
+    /// What the plan optimizes: `workspace` (the mean model error over the workspace,
+    /// I-optimality) or `d-optimal` (the parameters' joint confidence region).
+    #[arg(long, value_enum, default_value_t = CriterionArg::Workspace)]
+    criterion: CriterionArg,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
+enum CriterionArg {
+    /// I-optimality: minimize the mean squared model error over the workspace.
+    Workspace,
+    /// D-optimality: maximize det(J^T J).
+    DOptimal,
+}
+
+/// Two numbers `MIN,MAX`.
+fn range_arg(s: &str) -> anyhow::Result<(f64, f64)> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| exit::usage(format!("--range-mm: `{s}` is not two numbers MIN,MAX")))?;
+    let [a, b] = v[..] else {
+        return Err(exit::usage(format!(
+            "--range-mm: expected MIN,MAX (mm), got {} value(s)",
+            v.len()
+        )));
+    };
+    if !(a >= 0.0 && b > a && b <= limits::MAX_LENGTH_MM) {
+        return Err(exit::usage(format!(
+            "--range-mm {s}: not a range of distances (0 <= MIN < MAX <= {} mm)",
+            limits::MAX_LENGTH_MM
+        )));
+    }
+    Ok((a, b))
+}
+
+struct Settings {
+    robot: Robot,
+    plan: PlanSettings,
+    include: Option<PathBuf>,
+    out: PathBuf,
+}
+
+impl TryFrom<&PlanArgs> for Settings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &PlanArgs) -> anyhow::Result<Settings> {
+        limits::count(
+            "--poses",
+            a.poses,
+            1,
+            MAX_CANDIDATES,
+            "no calibration measures more",
+        )?;
+        limits::count(
+            "--candidates",
+            a.candidates,
+            a.poses,
+            MAX_CANDIDATES,
+            "memory and time grow with the candidates",
+        )?;
+        limits::magnitude("--floor-mm", a.floor_mm, limits::MAX_LENGTH_MM, "mm")?;
+        if let Some(f) = a.footprint_mm {
+            limits::magnitude("--footprint-mm", f, limits::MAX_LENGTH_MM, "mm")?;
+        }
+        if !(a.noise_mm > 0.0 && a.noise_mm <= 1000.0) {
+            return Err(exit::usage(format!(
+                "--noise-mm {}: must be a positive length up to 1000 mm",
+                a.noise_mm
+            )));
+        }
+        if !(a.noise_per_m >= 0.0 && a.noise_per_m <= 1000.0) {
+            return Err(exit::usage(format!(
+                "--noise-per-m {}: must be within 0..1000 mm/m",
+                a.noise_per_m
+            )));
+        }
+        let robot = common::robot(&a.robot)?;
+        let cfg = SimulationConfig {
+            floor_z_mm: a.floor_mm,
+            footprint_radius_mm: a.footprint_mm,
+            ..SimulationConfig::default()
+        };
+        cfg.validate(&robot)?;
+        let tracker = match &a.tracker {
+            Some(s) => super::simulate::tracker_arg(s)?,
+            None => cfg.tracker_frame,
+        };
+        let frame = TrackerFrame::from_vector_deg(&[
+            tracker.x, tracker.y, tracker.z, tracker.a, tracker.b, tracker.c,
+        ]);
+        let tracker_range = match &a.range_mm {
+            Some(r) => {
+                let (min, max) = range_arg(r)?;
+                Some(tracker_range(&frame, min, max)?)
+            }
+            None => None,
+        };
+        IoPlan::new()
+            .robot("--robot", &a.robot)
+            .input_opt("--include", a.include.as_deref())
+            .output(
+                "--out",
+                &a.out,
+                "the poses are a file that later commands read",
+            )
+            .check()?;
+        Ok(Settings {
+            plan: PlanSettings {
+                poses: a.poses,
+                candidates: a.candidates,
+                seed: a.seed,
+                sampler: cfg.sampler(&robot),
+                tracker_range,
+                include: Vec::new(),
+                noise_mm: a.noise_mm,
+                noise_per_m: a.noise_per_m,
+                tracker_origin: a.tracker.is_some().then(|| frame.origin()),
+                criterion: match a.criterion {
+                    CriterionArg::Workspace => Criterion::IOptimal,
+                    CriterionArg::DOptimal => Criterion::DOptimal,
+                },
+            },
+            robot,
+            include: a.include.clone(),
+            out: a.out.clone(),
+        })
+    }
+}
+
+pub fn run(a: PlanArgs) -> anyhow::Result<()> {
+    let mut s = Settings::try_from(&a)?;
+    if let Some(path) = &s.include {
+        let set = read_measurements(path, s.robot.joint_space(), Positions::Optional)?;
+        for w in &set.warnings {
+            eprintln!("warning: {w}");
+        }
+        s.plan.include = set.rows.into_iter().map(|r| r.q).collect();
+    }
+    let p = plan(&s.robot, &s.plan)?;
+    print_plan(&s, &p);
+    let set = MeasurementSet {
+        path: s.out.clone(),
+        joints: s.robot.joint_space().clone(),
+        extra_columns: Vec::new(),
+        warnings: Vec::new(),
+        rows: p
+            .poses
+            .iter()
+            .enumerate()
+            .map(|(i, q)| Measurement {
+                line: i + 2,
+                q: q.clone(),
+                p: None,
+                extra: Vec::new(),
+            })
+            .collect(),
+    };
+    write_measurements(&s.out, &set)?;
+    println!("{} poses written to {}", p.poses.len(), s.out.display());
+    Ok(())
+}
+
+fn print_plan(s: &Settings, p: &Plan) {
+    let n = s.plan.poses + s.plan.include.len();
+    println!(
+        "robot {} ({} joints): {} poses chosen from {} candidates (seed {}){}; {} identifiable \
+         parameters",
+        s.robot.name(),
+        s.robot.dof(),
+        s.plan.poses,
+        s.plan.candidates,
+        s.plan.seed,
+        if s.plan.include.is_empty() {
+            String::new()
+        } else {
+            format!(", {} included", s.plan.include.len())
+        },
+        p.identified.len()
+    );
+    println!(
+        "{} design: greedy, then {} exchange pass(es) replacing {} pose(s){}",
+        match s.plan.criterion {
+            Criterion::IOptimal => "I-optimal (workspace error)",
+            Criterion::DOptimal => "D-optimal",
+        },
+        p.exchange_passes,
+        p.exchanges,
+        if s.plan.tracker_origin.is_some() {
+            "; poses weighted by the tracker's distance-dependent noise"
+        } else {
+            ""
+        }
+    );
+    println!();
+    println!("{:<44}{:>14}{:>14}", "", "planned", "random");
+    println!(
+        "{:<44}{:>14.4}{:>14.4}",
+        "observability index O1 (scaled Jacobian)", p.planned.observability, p.random.observability
+    );
+    println!(
+        "{:<44}{:>14.4}{:>14.4}",
+        "predicted workspace model error, RMS (mm)",
+        p.planned.workspace_rms_mm,
+        p.random.workspace_rms_mm
+    );
+    println!();
+    println!(
+        "Predicted standard deviations at {} mm noise per axis{}, {n} poses each",
+        s.plan.noise_mm,
+        if s.plan.tracker_origin.is_some() {
+            format!(" + {} mm/m", s.plan.noise_per_m)
+        } else {
+            String::new()
+        }
+    );
+    println!(
+        "{:<12}{:>14}{:>14}{:>8}",
+        "parameter", "planned", "random", "unit"
+    );
+    for (i, param) in p.identified.iter().enumerate() {
+        let u = param.unit();
+        println!(
+            "{:<12}{:>14.5}{:>14.5}{:>8}",
+            param.name(),
+            u.from_internal(p.planned.std[i]),
+            u.from_internal(p.random.std[i]),
+            u.as_str()
+        );
+    }
+    println!();
+}
