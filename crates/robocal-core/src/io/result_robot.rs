@@ -33,6 +33,9 @@ pub struct RobotInfo {
     /// The nominal model's tool correction T (mm, deg), when not zero.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool_correction: Option<[f64; 6]>,
+    /// The direction of gravity in the base frame, when not the default `[0, 0, -1]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 3]>,
     /// The joints as the robot file gives them; empty (absent) in results that do not embed
     /// their robot.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -54,6 +57,7 @@ impl RobotInfo {
             base: None,
             tool: None,
             tool_correction: None,
+            gravity: None,
             joints: Vec::new(),
             controller: None,
         }
@@ -70,6 +74,7 @@ impl RobotInfo {
             base: Some(d.base),
             tool: Some(d.tool),
             tool_correction: d.tool_correction,
+            gravity: d.gravity,
             joints: d.joints,
             controller: d.controller,
         }
@@ -91,6 +96,7 @@ impl RobotInfo {
             base: self.base.unwrap_or_default(),
             tool: self.tool.unwrap_or_default(),
             tool_correction: self.tool_correction,
+            gravity: self.gravity,
             joints: self.joints.clone(),
             controller: self.controller.clone(),
         })

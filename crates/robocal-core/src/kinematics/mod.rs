@@ -91,7 +91,14 @@ impl Robot {
     /// [`Robot::deflected`]), with the tool point.
     pub fn pose_frames(&self, q: &[f64]) -> PoseFrames {
         let mut buf = [0.0; MAX_JOINTS];
-        let q = self.deflected(q, &mut buf);
+        let mut ch = self.rigid_pose_frames(self.deflected(q, &mut buf));
+        ch.commanded[..q.len()].copy_from_slice(q);
+        ch
+    }
+
+    /// The frames of one forward pass at exactly the joint values `q`, without any family's
+    /// deflection (what the compliance family's torque basis is computed on).
+    pub fn rigid_pose_frames(&self, q: &[f64]) -> PoseFrames {
         let mut ch = if self.joint_space().any_prismatic() {
             self.chain_with::<true>(q)
         } else {
@@ -99,6 +106,7 @@ impl Robot {
         };
         let f = &ch.flange;
         ch.point = f.rotation * self.tool_frame().translation.vector + f.translation.vector;
+        ch.commanded[..q.len()].copy_from_slice(q);
         ch
     }
 
@@ -110,6 +118,7 @@ impl Robot {
             link: [Frame::identity(); MAX_JOINTS],
             flange: *self.base_frame(),
             point: Vector3::zeros(),
+            commanded: [0.0; MAX_JOINTS],
         };
         let mut f = *self.base_frame();
         let types = self.joint_types();

@@ -66,6 +66,9 @@ pub struct RobotDescription {
     /// The tool correction T (mm, deg), when not zero.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tool_correction: Option<[f64; 6]>,
+    /// The direction of gravity in the base frame, when not the default `[0, 0, -1]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 3]>,
     /// The joints, base to tip.
     pub joints: Vec<JointDescription>,
     /// The controller's axis map, if the robot has one.
@@ -148,6 +151,10 @@ impl RobotDescription {
                 .iter()
                 .any(|v| *v != 0.0)
                 .then(|| frame_degrees(correction)),
+            gravity: {
+                let g = robot.gravity();
+                (g != nalgebra::Vector3::new(0.0, 0.0, -1.0)).then(|| [g.x, g.y, g.z])
+            },
             joints,
             controller: robot.controller().map(|c| ControllerDescription {
                 sign: c.sign().to_vec(),

@@ -104,6 +104,9 @@ pub struct Robot {
     base: [f64; 6],
     tool0: [f64; 6],
     tool: [f64; 6],
+    /// The direction of gravity in the base frame (a unit vector; DESIGN.md robot file key
+    /// `gravity`, default `[0, 0, -1]`: floor mounted).
+    gravity: Vector3<f64>,
     /// Values of the parameter families that are not part of the link table, by family key.
     family_store: std::collections::BTreeMap<String, Vec<f64>>,
     // Caches derived from the above (kept valid by every mutator).
@@ -176,6 +179,7 @@ impl Robot {
             base,
             tool0,
             tool: [0.0; 6],
+            gravity: Vector3::new(0.0, 0.0, -1.0),
             family_store: Default::default(),
             link_const: Vec::new(),
             base_frame: Frame::identity(),
@@ -351,6 +355,28 @@ impl Robot {
     /// The tool correction T (mm, rad).
     pub fn tool_correction(&self) -> &[f64; 6] {
         &self.tool
+    }
+
+    /// The direction of gravity in the base frame (unit vector; default `[0, 0, -1]`).
+    pub fn gravity(&self) -> Vector3<f64> {
+        self.gravity
+    }
+
+    /// Sets the direction of gravity in the base frame: any finite, non-zero vector, stored
+    /// normalized (a robot file's `gravity`). Wall and ceiling mounted robots need it for the
+    /// joint compliance family.
+    pub fn set_gravity(&mut self, g: [f64; 3]) -> Result<()> {
+        let v = Vector3::from(g);
+        let n = v.norm();
+        if !n.is_finite() || n < 1e-9 {
+            return Err(Error::invalid(
+                "gravity",
+                format!("{g:?} is not a direction: give a non-zero vector such as [0, 0, -1]"),
+            ));
+        }
+        self.gravity = v / n;
+        self.refresh_params();
+        Ok(())
     }
 
     /// The base frame `pose(B)`.

@@ -8,6 +8,8 @@
 //! tool = [0, 0, 31, 0, 0, 0]   # nominal tool vector T0, same units (optional, default zero)
 //! tool_correction = [0, 0, 0, 0, 0, 0]  # the tool correction T already in the nominal model
 //!                              # (optional, default zero; what a result's embedded robot carries)
+//! gravity = [0, 0, -1]         # direction of gravity in the base frame (optional, default
+//!                              # floor mounted; used by the joint compliance family)
 //!
 //! [[joints]]                   # one table per joint, base to tip
 //! type = "revolute"            # or "prismatic" (optional, default revolute)
@@ -42,6 +44,7 @@ struct RobotFile {
     base: Option<Spanned<Vec<Spanned<f64>>>>,
     tool: Option<Spanned<Vec<Spanned<f64>>>>,
     tool_correction: Option<Spanned<Vec<Spanned<f64>>>>,
+    gravity: Option<Spanned<Vec<Spanned<f64>>>>,
     joints: Vec<JointEntry>,
     controller: Option<Spanned<ControllerEntry>>,
 }
@@ -279,6 +282,17 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
     }
     for (k, v) in tool_correction.into_iter().enumerate() {
         robot.set(Param::tool(k), v);
+    }
+    if let Some(g) = &file.gravity {
+        let v: Vec<f64> = g.get_ref().iter().map(|x| *x.get_ref()).collect();
+        let bad = |msg: String| err(g.span(), "gravity".to_owned(), msg);
+        let g3: [f64; 3] = v.as_slice().try_into().map_err(|_| {
+            bad(format!(
+                "expected [gx, gy, gz], the direction of gravity in the base frame, got {} numbers",
+                v.len()
+            ))
+        })?;
+        robot.set_gravity(g3).map_err(|e| bad(e.to_string()))?;
     }
     Ok(robot)
 }

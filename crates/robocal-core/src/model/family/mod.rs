@@ -18,12 +18,16 @@
 //! the link table live in the robot's family store ([`Robot::family_values`]).
 //!
 //! The geometric families of the paper's 36-parameter model (section II.B):
-//! [`link`] (alpha, d, a, phi), [`beta`] (Hayati tilts), [`base`] (frame B) and [`tool`] (T).
+//! [`link`] (alpha, d, a, phi), [`beta`] (Hayati tilts), [`base`] (frame B) and [`tool`] (T);
+//! beyond geometry, acting through the joints: [`compliance`] (joint compliance under gravity)
+//! and [`transmission`] (harmonics of the joints' transmission errors).
 
 pub mod base;
 pub mod beta;
+pub mod compliance;
 pub mod link;
 pub mod tool;
+pub mod transmission;
 
 #[cfg(test)]
 mod seam_tests;
@@ -147,15 +151,24 @@ pub fn by_key(key: &str) -> Option<(FamilyId, &'static dyn ParameterFamily)> {
 
 // The registry: a family's `ID` constant is its position here.
 #[cfg(not(test))]
-static REGISTRY: [&dyn ParameterFamily; 4] = [&link::Link, &beta::Beta, &base::Base, &tool::Tool];
-
-// Tests add a family written only against the trait, which proves the seam (`seam_tests`).
-#[cfg(test)]
-static REGISTRY: [&dyn ParameterFamily; 5] = [
+static REGISTRY: [&dyn ParameterFamily; 6] = [
     &link::Link,
     &beta::Beta,
     &base::Base,
     &tool::Tool,
+    &compliance::Compliance,
+    &transmission::Transmission,
+];
+
+// Tests add a family written only against the trait, which proves the seam (`seam_tests`).
+#[cfg(test)]
+static REGISTRY: [&dyn ParameterFamily; 7] = [
+    &link::Link,
+    &beta::Beta,
+    &base::Base,
+    &tool::Tool,
+    &compliance::Compliance,
+    &transmission::Transmission,
     &seam_tests::JointOffsets,
 ];
 
@@ -215,6 +228,10 @@ pub struct PoseFrames {
     pub flange: Frame,
     /// The tool point (mm, ACS).
     pub point: Vector3<f64>,
+    /// The joint values before any family's deflection (the commanded joints), from which
+    /// families that deflect the joints compute `d(dq)/d(theta)`; the frames above are at the
+    /// deflected joints.
+    pub commanded: [f64; MAX_JOINTS],
 }
 
 impl PoseFrames {

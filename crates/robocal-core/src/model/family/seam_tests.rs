@@ -15,7 +15,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 const KEY: &str = "qoffset";
-const ID: FamilyId = FamilyId::new(4);
+const ID: FamilyId = FamilyId::new(6);
 
 /// Constant offsets added to the joint values (a test family).
 pub struct JointOffsets;
@@ -98,6 +98,8 @@ fn the_registry_positions_are_the_families_ids() {
         let mut ps = Vec::new();
         let mut r = offsets(&preset("kuka-kr480-r3330").unwrap(), &[0.0; 6]);
         r.enable_beta(2).unwrap();
+        super::compliance::enable(&mut r, &[1, 2], Some(10.0)).unwrap();
+        super::transmission::enable(&mut r, &[0, 1, 2, 3, 4, 5], 2).unwrap();
         fam.params(&r, &mut ps);
         assert!(!ps.is_empty(), "{}", fam.key());
         for p in ps {
