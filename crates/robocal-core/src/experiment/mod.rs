@@ -26,6 +26,8 @@ mod truth_compare;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod elasto_tests;
 
 pub use truth_compare::{compare_with_truth, TruthComparison};
 
@@ -248,12 +250,15 @@ fn csv_bytes(set: &MeasurementSet, name: &str) -> Result<Vec<u8>> {
 /// work advances (`done` and `total` count steps within the phase).
 pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Result<Experiment> {
     let nominal = &config.nominal;
+    // The cell's robots are geometric (their deflection is the simulator's gravity model); the
+    // nominal model may add the families that deflect the joints, for the calibration.
+    let geometric = nominal.geometric();
     let joints = nominal.joint_space();
 
     // 1. The measurement session, split into the files `simulate --validation-out` writes.
     observer.progress(Stage::Measurement, 0, 1);
     let session = simulate(
-        nominal,
+        &geometric,
         &TruthSpec::Robot(config.truth.clone()),
         &config.session,
         observer,
@@ -352,13 +357,13 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
     //    frame as `simulate --truth cell.truth.json` reads them), against the desired positions.
     let tf: TruthFile = serde_json::from_str(&truth_json)
         .map_err(|e| Error::parse(Path::new(files::CELL_TRUTH), None, None, e.to_string()))?;
-    let truth_again = tf.truth_robot(nominal, Path::new(files::CELL_TRUTH))?;
+    let truth_again = tf.truth_robot(&geometric, Path::new(files::CELL_TRUTH))?;
     let vconfig = SimulationConfig {
         tracker_frame: tf.tracker_frame,
         ..config.verification_session()
     };
     let verification = simulate_joints(
-        nominal,
+        &geometric,
         &TruthSpec::Robot(truth_again),
         &vconfig,
         &commanded,

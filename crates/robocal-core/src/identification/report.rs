@@ -293,6 +293,7 @@ impl Calibration {
             validation: self.validation.as_ref().map(point_entries),
         });
         result.plausibility = Some(self.plausibility.to_section());
+        crate::io::result_payload::record(&mut result, &self.calibrated);
         result
     }
 }

@@ -7,6 +7,7 @@ pub mod joint_limits;
 pub mod json_keys;
 pub mod measurements;
 pub mod result;
+pub mod result_payload;
 pub mod result_robot;
 pub mod result_sections;
 pub mod robot;

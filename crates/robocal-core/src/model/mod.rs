@@ -500,6 +500,19 @@ impl Robot {
         Ok(())
     }
 
+    /// This robot without the families that deflect the joints (its geometric model): what a
+    /// simulated cell's nominal robot and a truth file's parameters describe.
+    pub fn geometric(&self) -> Robot {
+        let mut r = self.clone();
+        for fam in family::all() {
+            if fam.deflects_joints(&r) {
+                r.family_store.remove(fam.key());
+            }
+        }
+        r.refresh_params();
+        r
+    }
+
     /// A mutable view of a family's stored values, for the family's own `set`. The number of
     /// values must not change (the parameter list is derived from it).
     pub fn family_values_mut(&mut self, key: &str) -> Option<&mut [f64]> {
