@@ -31,6 +31,9 @@ const FLAGS: &[(&str, &str)] = &[
     ("identifiability.free", "--free"),
     ("identifiability.rank_tolerance", "--rank-tol"),
     ("robust_scale_mm", "--robust-scale"),
+    ("payload_kg", "--payload-kg"),
+    ("compliance", "--compliance"),
+    ("harmonics", "--harmonics"),
     // compensation::DampedLeastSquares
     ("tolerance_mm", "--tolerance-mm"),
     ("max_iterations", "--max-iterations"),
