@@ -355,7 +355,12 @@ fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) {
     para(&format!(
         "Beyond the paper: the same measurements calibrated with joint compliance under gravity          (the elasto-geometric model: each joint turns by its compliance times the gravity torque          about its axis; coefficients from the chain's geometry, the {payload} kg payload known),          then compensated and verified the same way:"
     ));
-    let val = |e: &Experiment| e.result.errors.validation.map_or(f64::NAN, |v| v.after.mean_mm);
+    let val = |e: &Experiment| {
+        e.result
+            .errors
+            .validation
+            .map_or(f64::NAN, |v| v.after.mean_mm)
+    };
     println!("{:<34} {:>12} {:>18}", "", "Geometric", "Elasto-geometric");
     for (label, a, b) in [
         ("Validation mean (mm)", val(geo), val(el)),

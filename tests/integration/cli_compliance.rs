@@ -81,9 +81,17 @@ fn the_payload_known_compliance_transfers_to_another_payload() {
     assert_eq!(el["payload_kg"], 300.0);
     assert_eq!(el["parameters"]["compliance3"]["unit"], "urad/Nm");
     assert_eq!(el["parameters"]["grav2_o3"]["unit"], "urad/m");
-    assert!(el["parameters"].get("compliance1").is_none(), "joint 1 is vertical");
-    let c3 = el["parameters"]["compliance3"]["calibrated"].as_f64().unwrap();
-    assert!((c3 - 0.02).abs() < 0.004, "compliance3 {c3} µrad/(N·m), true 0.02");
+    assert!(
+        el["parameters"].get("compliance1").is_none(),
+        "joint 1 is vertical"
+    );
+    let c3 = el["parameters"]["compliance3"]["calibrated"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (c3 - 0.02).abs() < 0.004,
+        "compliance3 {c3} µrad/(N·m), true 0.02"
+    );
     let (g, e) = (mean(&geo, "validation"), mean(&el, "validation"));
     assert!(e < 0.25 * g && e < 0.08, "validation {g} -> {e} mm");
 
@@ -108,8 +116,11 @@ fn the_payload_known_compliance_transfers_to_another_payload() {
 
     // Compensation at the other payload, and the errors.
     let joints = d.join("desired.csv");
-    std::fs::write(&joints, "q1,q2,q3,q4,q5,q6\n10,-60,40,20,30,40\n-20,-80,70,0,-40,10\n")
-        .unwrap();
+    std::fs::write(
+        &joints,
+        "q1,q2,q3,q4,q5,q6\n10,-60,40,20,30,40\n-20,-80,70,0,-40,10\n",
+    )
+    .unwrap();
     let comp = |payload: &str| {
         let out = d.join(format!("cmd{payload}.csv"));
         ok(&[
@@ -126,7 +137,11 @@ fn the_payload_known_compliance_transfers_to_another_payload() {
         let (h, rows) = read_csv(&out);
         num(&rows[0][col(&h, "q2")])
     };
-    assert_ne!(comp("100"), comp("300"), "the commanded joints depend on the payload");
+    assert_ne!(
+        comp("100"),
+        comp("300"),
+        "the commanded joints depend on the payload"
+    );
     robocal(&[
         "evaluate",
         "--params",
@@ -163,7 +178,10 @@ fn bad_compliance_flags_are_usage_errors() {
         (&["--payload-kg", "300"][..], "--payload-kg"),
         (&["--compliance", "9"][..], "--compliance: joint 9"),
         (&["--compliance", "two"][..], "--compliance: `two`"),
-        (&["--compliance", "2", "--payload-kg", "0"][..], "--payload-kg"),
+        (
+            &["--compliance", "2", "--payload-kg", "0"][..],
+            "--payload-kg",
+        ),
         (&["--harmonics", "9"][..], "--harmonics 9"),
     ] {
         let out = d.join("r.json");

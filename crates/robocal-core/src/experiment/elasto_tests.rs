@@ -25,11 +25,7 @@ fn experiment(seed: u64, gravity: Option<GravityModel>, nominal: Robot) -> Exper
 /// The mean distance between the measured and the exact readings of the rows in `set`: the
 /// validation error of the true model (the noise floor).
 fn noise_floor(s: &Simulation, set: &str) -> f64 {
-    let col = s
-        .measurements
-        .extra_columns
-        .iter()
-        .position(|c| c == "set");
+    let col = s.measurements.extra_columns.iter().position(|c| c == "set");
     let errs: Vec<f64> = s
         .measurements
         .rows
@@ -80,7 +76,10 @@ fn elasto_geometric_calibration_reaches_the_noise_floor_and_transfers_payloads()
             geometric.verified().mean_mm
         );
         assert!(elasto <= 1.3 * floor, "{elasto} vs floor {floor}");
-        assert!(geo > 2.0 * floor, "the sag shows in the geometric fit: {geo}");
+        assert!(
+            geo > 2.0 * floor,
+            "the sag shows in the geometric fit: {geo}"
+        );
         assert!(verified <= 1.3 * predicted, "{verified} vs {predicted}");
 
         // Payload transfer: the same cell measured with 100 kg.

@@ -25,9 +25,9 @@
 mod truth_compare;
 
 #[cfg(test)]
-mod tests;
-#[cfg(test)]
 mod elasto_tests;
+#[cfg(test)]
+mod tests;
 
 pub use truth_compare::{compare_with_truth, TruthComparison};
 

@@ -74,11 +74,23 @@ impl Robot {
         if !self.deflects_joints() {
             return q;
         }
+        let rigid = self.rigid_pose_frames(q);
+        self.deflect_with(&rigid, q, buf)
+    }
+
+    /// `q + dq` written to `buf`, the families' deflection computed on `rigid`, the forward pass
+    /// at `q` without deflection.
+    fn deflect_with<'a>(
+        &self,
+        rigid: &PoseFrames,
+        q: &[f64],
+        buf: &'a mut [f64; MAX_JOINTS],
+    ) -> &'a [f64] {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut dq = [0.0; MAX_JOINTS];
         for fam in family::all() {
             if fam.deflects_joints(self) {
-                fam.add_joint_deflection(self, q, &mut dq[..q.len()]);
+                fam.add_joint_deflection(self, rigid, &mut dq[..q.len()]);
             }
         }
         for (i, v) in q.iter().enumerate() {
@@ -88,11 +100,18 @@ impl Robot {
     }
 
     /// The frames of one forward pass at joint values `q` (deflected, see
-    /// [`Robot::deflected`]), with the tool point.
+    /// [`Robot::deflected`]), with the tool point; `commanded`, `rigid_axes` and `rigid_point`
+    /// keep the undeflected pass.
     pub fn pose_frames(&self, q: &[f64]) -> PoseFrames {
+        if !self.deflects_joints() {
+            return self.rigid_pose_frames(q);
+        }
+        let rigid = self.rigid_pose_frames(q);
         let mut buf = [0.0; MAX_JOINTS];
-        let mut ch = self.rigid_pose_frames(self.deflected(q, &mut buf));
-        ch.commanded[..q.len()].copy_from_slice(q);
+        let mut ch = self.rigid_pose_frames(self.deflect_with(&rigid, q, &mut buf));
+        ch.commanded = rigid.commanded;
+        ch.rigid_axes = rigid.rigid_axes;
+        ch.rigid_point = rigid.point;
         ch
     }
 
@@ -106,7 +125,11 @@ impl Robot {
         };
         let f = &ch.flange;
         ch.point = f.rotation * self.tool_frame().translation.vector + f.translation.vector;
+        ch.rigid_point = ch.point;
         ch.commanded[..q.len()].copy_from_slice(q);
+        for (r, a) in ch.rigid_axes.iter_mut().zip(&ch.axis[..q.len()]) {
+            *r = (a.rotation.matrix().column(2).into(), a.translation.vector);
+        }
         ch
     }
 
@@ -119,6 +142,8 @@ impl Robot {
             flange: *self.base_frame(),
             point: Vector3::zeros(),
             commanded: [0.0; MAX_JOINTS],
+            rigid_axes: [(Vector3::zeros(), Vector3::zeros()); MAX_JOINTS],
+            rigid_point: Vector3::zeros(),
         };
         let mut f = *self.base_frame();
         let types = self.joint_types();

@@ -117,25 +117,19 @@ fn slot_of(n: usize, p: Param) -> usize {
     slot(n, p.index(), k)
 }
 
-/// Per joint `i`, the lever of every point (mm): `u_i . ((r - o_i) x g)`; `levers[k]` for the
-/// origin of axis frame k (k < n), `levers[n]` for the tool point, at the commanded joints `q`.
-fn levers(robot: &Robot, q: &[f64], i: usize) -> [f64; MAX_JOINTS + 1] {
-    let frames = robot.rigid_pose_frames(q);
-    levers_on(robot, &frames, i)
-}
-
+/// Joint `i`'s lever of every point (mm): `u_i . ((r - o_i) x g)`; entry `k` for the origin of
+/// axis frame k (k < n), entry `n` for the tool point, at the commanded joints (the rigid axes
+/// and point of `frames`).
 fn levers_on(robot: &Robot, frames: &PoseFrames, i: usize) -> [f64; MAX_JOINTS + 1] {
     let n = robot.dof();
     let g = robot.gravity();
-    let f = &frames.axis[i];
-    let u: Vector3<f64> = f.rotation.matrix().column(2).into();
-    let o = f.translation.vector;
+    let (u, o) = frames.rigid_axes[i];
     let lever = |r: &Vector3<f64>| u.dot(&(r - o).cross(&g));
     let mut out = [0.0; MAX_JOINTS + 1];
     for k in i + 1..n {
-        out[k] = lever(&frames.axis[k].translation.vector);
+        out[k] = lever(&frames.rigid_axes[k].1);
     }
-    out[n] = lever(&frames.point);
+    out[n] = lever(&frames.rigid_point);
     out
 }
 
@@ -213,12 +207,11 @@ impl ParameterFamily for Compliance {
             return;
         };
         let n = robot.dof();
-        let rigid = robot.rigid_pose_frames(&pose.commanded[..n]);
         let scale = tool_scale(v);
         let mut cache: [Option<[f64; MAX_JOINTS + 1]>; MAX_JOINTS] = [None; MAX_JOINTS];
         let mut k_out = 0;
         each_param(robot, |_, i, k| {
-            let l = *cache[i].get_or_insert_with(|| levers_on(robot, &rigid, i));
+            let l = *cache[i].get_or_insert_with(|| levers_on(robot, pose, i));
             let b = if k == n { l[n] * scale } else { l[k] };
             let (sv, sw) = pose.joint_screw(robot, i);
             dp[k_out] = sv * b;
@@ -231,12 +224,12 @@ impl ParameterFamily for Compliance {
         robot.family_values(KEY).is_some()
     }
 
-    fn add_joint_deflection(&self, robot: &Robot, q: &[f64], dq: &mut [f64]) {
+    fn add_joint_deflection(&self, robot: &Robot, rigid: &PoseFrames, dq: &mut [f64]) {
         let Some(v) = robot.family_values(KEY) else {
             return;
         };
         let n = robot.dof();
-        let frames = robot.rigid_pose_frames(q);
+        let frames = rigid;
         let scale = tool_scale(v);
         for (i, d) in dq.iter_mut().enumerate().take(n) {
             if v[FLAGS + i] != 1.0 {
@@ -376,7 +369,7 @@ pub fn auto_joints(robot: &Robot) -> Vec<usize> {
 /// Joint `i`'s gravity lever of every lumped point at the commanded joints `q` (mm): entry `k`
 /// for the origin of axis frame `k` (zero for `k <= i`), entry `dof` for the tool point.
 pub fn lever_arms(robot: &Robot, q: &[f64], i: usize) -> Vec<f64> {
-    levers(robot, q, i)[..=robot.dof()].to_vec()
+    levers_on(robot, &robot.rigid_pose_frames(q), i)[..=robot.dof()].to_vec()
 }
 
 /// Sets the coefficient of joint `i` (0-based) for lumped point `k` (the origin of axis frame

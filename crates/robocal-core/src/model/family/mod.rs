@@ -125,9 +125,11 @@ pub trait ParameterFamily: Sync {
         false
     }
 
-    /// Adds the family's joint deflection `dq(q, theta)` at model joint values `q` to `dq`
-    /// (internal units). Forward kinematics evaluates the chain at `q + dq`.
-    fn add_joint_deflection(&self, _robot: &Robot, _q: &[f64], _dq: &mut [f64]) {}
+    /// Adds the family's joint deflection `dq(q, theta)` at the commanded joint values to `dq`
+    /// (internal units). `rigid` holds the forward pass at the commanded joints without any
+    /// deflection (`rigid.commanded` are the joint values). Forward kinematics evaluates the
+    /// chain at `q + dq`.
+    fn add_joint_deflection(&self, _robot: &Robot, _rigid: &PoseFrames, _dq: &mut [f64]) {}
 }
 
 /// Every family, in model order (the order of [`Robot::params`]).
@@ -232,6 +234,11 @@ pub struct PoseFrames {
     /// families that deflect the joints compute `d(dq)/d(theta)`; the frames above are at the
     /// deflected joints.
     pub commanded: [f64; MAX_JOINTS],
+    /// Each joint's axis at the commanded joints, without deflection: its unit direction and
+    /// the origin of its axis frame (equal to `axis[i]`'s when nothing deflects).
+    pub rigid_axes: [(Vector3<f64>, Vector3<f64>); MAX_JOINTS],
+    /// The tool point at the commanded joints, without deflection (mm, ACS).
+    pub rigid_point: Vector3<f64>,
 }
 
 impl PoseFrames {

@@ -149,11 +149,12 @@ impl ParameterFamily for Transmission {
         robot.family_values(KEY).is_some()
     }
 
-    fn add_joint_deflection(&self, robot: &Robot, q: &[f64], dq: &mut [f64]) {
+    fn add_joint_deflection(&self, robot: &Robot, rigid: &PoseFrames, dq: &mut [f64]) {
         let Some(v) = robot.family_values(KEY) else {
             return;
         };
         let n = robot.dof();
+        let q = &rigid.commanded;
         let count = v[COUNT] as usize;
         for i in (0..n).filter(|&i| v[FLAGS + i] == 1.0) {
             for h in 0..count {
@@ -195,7 +196,5 @@ pub fn enable(robot: &mut Robot, joints: &[usize], harmonics: usize) -> Result<(
 
 /// The number of harmonics `robot` models (0 without the family).
 pub fn harmonics(robot: &Robot) -> usize {
-    robot
-        .family_values(KEY)
-        .map_or(0, |v| v[COUNT] as usize)
+    robot.family_values(KEY).map_or(0, |v| v[COUNT] as usize)
 }
