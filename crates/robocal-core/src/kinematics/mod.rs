@@ -14,7 +14,7 @@
 pub mod poe;
 
 use crate::frame::Frame;
-use crate::model::family::{self, PoseFrames};
+use crate::model::family::{self, PoseFrames, RigidPose};
 use crate::model::{mul_rot_z, Convention, JointType, Link, Robot, MAX_JOINTS};
 use nalgebra::{Matrix3, Vector3};
 
@@ -74,19 +74,18 @@ impl Robot {
         if !self.deflects_joints() {
             return q;
         }
-        let rigid = self.rigid_pose_frames(q);
+        let rigid = self.rigid_pose(q);
         self.deflect_with(&rigid, q, buf)
     }
 
-    /// `q + dq` written to `buf`, the families' deflection computed on `rigid`, the forward pass
-    /// at `q` without deflection.
+    /// `q + dq` written to `buf`, the families' deflection computed on `rigid`, the pass at `q`
+    /// without deflection.
     fn deflect_with<'a>(
         &self,
-        rigid: &PoseFrames,
+        rigid: &RigidPose,
         q: &[f64],
         buf: &'a mut [f64; MAX_JOINTS],
     ) -> &'a [f64] {
-        assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut dq = [0.0; MAX_JOINTS];
         for fam in family::all() {
             if fam.deflects_joints(self) {
@@ -100,23 +99,21 @@ impl Robot {
     }
 
     /// The frames of one forward pass at joint values `q` (deflected, see
-    /// [`Robot::deflected`]), with the tool point; `commanded`, `rigid_axes` and `rigid_point`
-    /// keep the undeflected pass.
+    /// [`Robot::deflected`]), with the tool point; when a family deflects the joints, `rigid`
+    /// keeps the pass at `q` without deflection.
     pub fn pose_frames(&self, q: &[f64]) -> PoseFrames {
         if !self.deflects_joints() {
             return self.rigid_pose_frames(q);
         }
-        let rigid = self.rigid_pose_frames(q);
+        let rigid = self.rigid_pose(q);
         let mut buf = [0.0; MAX_JOINTS];
         let mut ch = self.rigid_pose_frames(self.deflect_with(&rigid, q, &mut buf));
-        ch.commanded = rigid.commanded;
-        ch.rigid_axes = rigid.rigid_axes;
-        ch.rigid_point = rigid.point;
+        ch.rigid = rigid;
         ch
     }
 
     /// The frames of one forward pass at exactly the joint values `q`, without any family's
-    /// deflection (what the compliance family's torque basis is computed on).
+    /// deflection (`rigid` left empty).
     pub fn rigid_pose_frames(&self, q: &[f64]) -> PoseFrames {
         let mut ch = if self.joint_space().any_prismatic() {
             self.chain_with::<true>(q)
@@ -125,12 +122,37 @@ impl Robot {
         };
         let f = &ch.flange;
         ch.point = f.rotation * self.tool_frame().translation.vector + f.translation.vector;
-        ch.rigid_point = ch.point;
-        ch.commanded[..q.len()].copy_from_slice(q);
-        for (r, a) in ch.rigid_axes.iter_mut().zip(&ch.axis[..q.len()]) {
-            *r = (a.rotation.matrix().column(2).into(), a.translation.vector);
-        }
         ch
+    }
+
+    /// The joint axes and the tool point at exactly the joint values `q`, without deflection: a
+    /// lean forward pass for the families that deflect the joints.
+    pub fn rigid_pose(&self, q: &[f64]) -> RigidPose {
+        assert_eq!(q.len(), self.dof(), "joint vector length");
+        let mut out = RigidPose::default();
+        out.commanded[..q.len()].copy_from_slice(q);
+        let mixed = self.joint_space().any_prismatic();
+        let mut f = *self.base_frame();
+        let types = self.joint_types();
+        for (i, &qi) in q.iter().enumerate() {
+            let l = &self.links()[i];
+            let c = self.link_constant(i);
+            let (s, co, d) = if mixed {
+                joint_motion::<true>(types, i, l, qi)
+            } else {
+                joint_motion::<false>(types, i, l, qi)
+            };
+            if self.convention() == Convention::Mdh {
+                f *= c;
+            }
+            out.axes[i] = (f.rotation.matrix().column(2).into(), f.translation.vector);
+            rotate_z_translate(&mut f, s, co, d);
+            if self.convention() == Convention::Dh {
+                f *= c;
+            }
+        }
+        out.point = f.rotation * self.tool_frame().translation.vector + f.translation.vector;
+        out
     }
 
     #[inline(always)]
@@ -141,9 +163,7 @@ impl Robot {
             link: [Frame::identity(); MAX_JOINTS],
             flange: *self.base_frame(),
             point: Vector3::zeros(),
-            commanded: [0.0; MAX_JOINTS],
-            rigid_axes: [(Vector3::zeros(), Vector3::zeros()); MAX_JOINTS],
-            rigid_point: Vector3::zeros(),
+            rigid: RigidPose::default(),
         };
         let mut f = *self.base_frame();
         let types = self.joint_types();

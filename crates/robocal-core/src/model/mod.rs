@@ -18,7 +18,7 @@ pub mod presets;
 pub mod robot_file;
 
 pub use controller::{Controller, Coupling};
-pub use family::{FamilyId, ParameterFamily, PoseFrames};
+pub use family::{FamilyId, ParameterFamily, PoseFrames, RigidPose};
 pub use joints::{JointSpace, JointType};
 pub use params::{Param, Unit};
 

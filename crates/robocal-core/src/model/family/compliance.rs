@@ -30,7 +30,7 @@
 //! (a spherical wrist), points on the joint's own axis and the tool point of a tool on the last
 //! axis give duplicate or zero columns, fixed with their reasons.
 
-use super::{put, FamilyId, ParameterFamily, PoseFrames};
+use super::{put, FamilyId, ParameterFamily, PoseFrames, RigidPose};
 use crate::error::{Error, Result};
 use crate::model::{JointType, Param, Robot, Unit, MAX_JOINTS};
 use nalgebra::Vector3;
@@ -120,16 +120,16 @@ fn slot_of(n: usize, p: Param) -> usize {
 /// Joint `i`'s lever of every point (mm): `u_i . ((r - o_i) x g)`; entry `k` for the origin of
 /// axis frame k (k < n), entry `n` for the tool point, at the commanded joints (the rigid axes
 /// and point of `frames`).
-fn levers_on(robot: &Robot, frames: &PoseFrames, i: usize) -> [f64; MAX_JOINTS + 1] {
+fn levers_on(robot: &Robot, rigid: &RigidPose, i: usize) -> [f64; MAX_JOINTS + 1] {
     let n = robot.dof();
     let g = robot.gravity();
-    let (u, o) = frames.rigid_axes[i];
+    let (u, o) = rigid.axes[i];
     let lever = |r: &Vector3<f64>| u.dot(&(r - o).cross(&g));
     let mut out = [0.0; MAX_JOINTS + 1];
     for k in i + 1..n {
-        out[k] = lever(&frames.rigid_axes[k].1);
+        out[k] = lever(&rigid.axes[k].1);
     }
-    out[n] = lever(&frames.rigid_point);
+    out[n] = lever(&rigid.point);
     out
 }
 
@@ -211,7 +211,7 @@ impl ParameterFamily for Compliance {
         let mut cache: [Option<[f64; MAX_JOINTS + 1]>; MAX_JOINTS] = [None; MAX_JOINTS];
         let mut k_out = 0;
         each_param(robot, |_, i, k| {
-            let l = *cache[i].get_or_insert_with(|| levers_on(robot, pose, i));
+            let l = *cache[i].get_or_insert_with(|| levers_on(robot, &pose.rigid, i));
             let b = if k == n { l[n] * scale } else { l[k] };
             let (sv, sw) = pose.joint_screw(robot, i);
             dp[k_out] = sv * b;
@@ -224,7 +224,7 @@ impl ParameterFamily for Compliance {
         robot.family_values(KEY).is_some()
     }
 
-    fn add_joint_deflection(&self, robot: &Robot, rigid: &PoseFrames, dq: &mut [f64]) {
+    fn add_joint_deflection(&self, robot: &Robot, rigid: &RigidPose, dq: &mut [f64]) {
         let Some(v) = robot.family_values(KEY) else {
             return;
         };
@@ -369,7 +369,7 @@ pub fn auto_joints(robot: &Robot) -> Vec<usize> {
 /// Joint `i`'s gravity lever of every lumped point at the commanded joints `q` (mm): entry `k`
 /// for the origin of axis frame `k` (zero for `k <= i`), entry `dof` for the tool point.
 pub fn lever_arms(robot: &Robot, q: &[f64], i: usize) -> Vec<f64> {
-    levers_on(robot, &robot.rigid_pose_frames(q), i)[..=robot.dof()].to_vec()
+    levers_on(robot, &robot.rigid_pose(q), i)[..=robot.dof()].to_vec()
 }
 
 /// Sets the coefficient of joint `i` (0-based) for lumped point `k` (the origin of axis frame

@@ -33,7 +33,7 @@ fn the_family_agrees_with_the_simulated_gravity_physics() {
             for q in poses(&nominal, 40, 3) {
                 let want = g.deflection(&nominal, &q);
                 let mut dq = vec![0.0; 6];
-                Compliance.add_joint_deflection(&r, &r.rigid_pose_frames(&q), &mut dq);
+                Compliance.add_joint_deflection(&r, &r.rigid_pose(&q), &mut dq);
                 for i in 0..6 {
                     let tol = 1e-12 + 1e-9 * want[i].abs();
                     assert!(

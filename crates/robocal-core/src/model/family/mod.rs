@@ -129,7 +129,7 @@ pub trait ParameterFamily: Sync {
     /// (internal units). `rigid` holds the forward pass at the commanded joints without any
     /// deflection (`rigid.commanded` are the joint values). Forward kinematics evaluates the
     /// chain at `q + dq`.
-    fn add_joint_deflection(&self, _robot: &Robot, _rigid: &PoseFrames, _dq: &mut [f64]) {}
+    fn add_joint_deflection(&self, _robot: &Robot, _rigid: &RigidPose, _dq: &mut [f64]) {}
 }
 
 /// Every family, in model order (the order of [`Robot::params`]).
@@ -230,15 +230,32 @@ pub struct PoseFrames {
     pub flange: Frame,
     /// The tool point (mm, ACS).
     pub point: Vector3<f64>,
-    /// The joint values before any family's deflection (the commanded joints), from which
-    /// families that deflect the joints compute `d(dq)/d(theta)`; the frames above are at the
-    /// deflected joints.
+    /// The forward pass at the commanded joints without deflection, filled when some family
+    /// deflects the joints (the frames above are then at the deflected joints); families that
+    /// deflect the joints compute `d(dq)/d(theta)` from it.
+    pub rigid: RigidPose,
+}
+
+/// The forward pass at the commanded joints without any family's deflection: what a family that
+/// deflects the joints computes its deflection from ([`ParameterFamily::add_joint_deflection`]).
+#[derive(Clone, Copy)]
+pub struct RigidPose {
+    /// The commanded joint values (internal units).
     pub commanded: [f64; MAX_JOINTS],
-    /// Each joint's axis at the commanded joints, without deflection: its unit direction and
-    /// the origin of its axis frame (equal to `axis[i]`'s when nothing deflects).
-    pub rigid_axes: [(Vector3<f64>, Vector3<f64>); MAX_JOINTS],
-    /// The tool point at the commanded joints, without deflection (mm, ACS).
-    pub rigid_point: Vector3<f64>,
+    /// Each joint's axis: its unit direction and the origin of its axis frame (ACS).
+    pub axes: [(Vector3<f64>, Vector3<f64>); MAX_JOINTS],
+    /// The tool point (mm, ACS).
+    pub point: Vector3<f64>,
+}
+
+impl Default for RigidPose {
+    fn default() -> Self {
+        RigidPose {
+            commanded: [0.0; MAX_JOINTS],
+            axes: [(Vector3::zeros(), Vector3::zeros()); MAX_JOINTS],
+            point: Vector3::zeros(),
+        }
+    }
 }
 
 impl PoseFrames {

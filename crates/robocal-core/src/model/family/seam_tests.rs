@@ -71,7 +71,7 @@ impl ParameterFamily for JointOffsets {
         robot.family_values(KEY).is_some()
     }
 
-    fn add_joint_deflection(&self, robot: &Robot, _rigid: &PoseFrames, dq: &mut [f64]) {
+    fn add_joint_deflection(&self, robot: &Robot, _rigid: &super::RigidPose, dq: &mut [f64]) {
         if let Some(v) = robot.family_values(KEY) {
             for (d, o) in dq.iter_mut().zip(v) {
                 *d += o;

@@ -136,7 +136,7 @@ impl ParameterFamily for Transmission {
     ) {
         let mut k = 0;
         each_param(robot, |_, i, h, sine| {
-            let x = (h + 1) as f64 * pose.commanded[i];
+            let x = (h + 1) as f64 * pose.rigid.commanded[i];
             let b = if sine { x.sin() } else { x.cos() };
             let (sv, sw) = pose.joint_screw(robot, i);
             dp[k] = sv * b;
@@ -149,7 +149,7 @@ impl ParameterFamily for Transmission {
         robot.family_values(KEY).is_some()
     }
 
-    fn add_joint_deflection(&self, robot: &Robot, rigid: &PoseFrames, dq: &mut [f64]) {
+    fn add_joint_deflection(&self, robot: &Robot, rigid: &super::RigidPose, dq: &mut [f64]) {
         let Some(v) = robot.family_values(KEY) else {
             return;
         };
