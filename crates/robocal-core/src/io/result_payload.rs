@@ -42,7 +42,7 @@ pub fn apply(result: &CalibrationResult, robot: &mut Robot, path: &Path) -> Resu
             let m = v
                 .as_f64()
                 .ok_or_else(|| bad(format!("{v} is not a number of kg")))?;
-            if !(m > 0.0) {
+            if m.is_nan() || m <= 0.0 {
                 return Err(bad(format!("{m} kg: the payload must be positive")));
             }
             compliance::set_payload_kg(robot, m).map_err(|e| bad(e.to_string()))

@@ -229,13 +229,12 @@ impl ParameterFamily for Compliance {
             return;
         };
         let n = robot.dof();
-        let frames = rigid;
         let scale = tool_scale(v);
         for (i, d) in dq.iter_mut().enumerate().take(n) {
             if v[FLAGS + i] != 1.0 {
                 continue;
             }
-            let l = levers_on(robot, &frames, i);
+            let l = levers_on(robot, rigid, i);
             let mut s: f64 = (i + 1..n).map(|k| v[slot(n, i, k)] * l[k]).sum();
             s += v[slot(n, i, n)] * l[n] * scale;
             *d += s;
