@@ -165,6 +165,27 @@ fn the_payload_known_compliance_transfers_to_another_payload() {
     ])
     .assert_code(2);
     assert!(!d.join("x.csv").exists());
+
+    // The result's `payload_kg` belongs to its compliances: missing, or on a geometric result,
+    // the file is bad input (exit 3) naming the key.
+    let edit = |src: &str, dst: &str, f: &dyn Fn(&mut serde_json::Value)| {
+        let mut j = read_json(&d.join(src));
+        f(&mut j);
+        let out = d.join(dst);
+        std::fs::write(&out, serde_json::to_string_pretty(&j).unwrap()).unwrap();
+        out
+    };
+    let no_payload = edit("el.json", "no_payload.json", &|j| {
+        j.as_object_mut().unwrap().remove("payload_kg");
+    });
+    let stray = edit("geo.json", "stray.json", &|j| {
+        j["payload_kg"] = serde_json::json!(300.0);
+    });
+    for bad in [no_payload, stray] {
+        let o = robocal(&["evaluate", "--params", p(&bad), "--data", p(&light)]);
+        o.assert_code(3);
+        assert!(o.stderr().contains("payload_kg"), "{}", o.stderr());
+    }
 }
 
 /// Bad flag values are usage errors naming the flag, and nothing is written.

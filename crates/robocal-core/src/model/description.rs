@@ -202,7 +202,8 @@ pub const NOMINAL_TOLERANCE: f64 = 1e-9;
 
 /// The first difference between two nominal robots that makes a result of one wrong for the
 /// other, or `None`: joint count, joint types, convention, every nominal parameter (and the
-/// nominal tool T0) within [`NOMINAL_TOLERANCE`] (mm or degrees), the controller map. Names and
+/// nominal tool T0) within [`NOMINAL_TOLERANCE`] (mm or degrees), the gravity direction, the
+/// controller map. Names and
 /// joint limits may differ.
 pub fn nominal_difference(a: &Robot, b: &Robot) -> Option<String> {
     if a.dof() != b.dof() {
@@ -232,6 +233,13 @@ pub fn nominal_difference(a: &Robot, b: &Robot) -> Option<String> {
             let u = p.unit().as_str();
             return Some(format!("nominal {} = {x} {u} against {y} {u}", p.name()));
         }
+    }
+    let (ga, gb) = (a.gravity(), b.gravity());
+    if (ga - gb).amax() > NOMINAL_TOLERANCE {
+        return Some(format!(
+            "gravity [{}, {}, {}] against [{}, {}, {}]",
+            ga.x, ga.y, ga.z, gb.x, gb.y, gb.z
+        ));
     }
     let (ta, tb) = (frame_degrees(a.tool0()), frame_degrees(b.tool0()));
     for (k, axis) in ["x", "y", "z", "a", "b", "c"].iter().enumerate() {

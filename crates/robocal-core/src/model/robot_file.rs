@@ -292,7 +292,10 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
                 v.len()
             ))
         })?;
-        robot.set_gravity(g3).map_err(|e| bad(e.to_string()))?;
+        robot.set_gravity(g3).map_err(|e| match e {
+            Error::Invalid { message, .. } => bad(message),
+            other => bad(other.to_string()),
+        })?;
     }
     Ok(robot)
 }

@@ -176,3 +176,32 @@ fn auto_joints_names_and_units() {
     assert_eq!(joints(&fresh), vec![2]);
     assert!(payload_kg(&fresh).is_some());
 }
+
+/// The robot file's `gravity`: read, normalized, written back into the description (and so
+/// into a result's embedded robot), compared by `nominal_difference`; a bad one names the key.
+#[test]
+fn the_robot_files_gravity_direction() {
+    use crate::model::description::{nominal_difference, RobotDescription};
+    use crate::model::robot_file::parse_robot_toml;
+    let path = std::path::Path::new("wall.toml");
+    let text = |g: &str| {
+        format!(
+            "convention = \"mdh\"\n{g}\n[[joints]]\nalpha = 0\nd = 0\na = 0\n\
+             [[joints]]\nalpha = 90\nd = 0\na = 500\n"
+        )
+    };
+    let floor = parse_robot_toml(&text(""), path).unwrap();
+    assert_eq!(floor.gravity(), Vector3::new(0.0, 0.0, -1.0));
+    let wall = parse_robot_toml(&text("gravity = [0, -9.81, 0]"), path).unwrap();
+    assert!((wall.gravity() - Vector3::new(0.0, -1.0, 0.0)).norm() < 1e-15);
+    assert_eq!(auto_joints(&wall), vec![0, 1]);
+    let back = RobotDescription::of(&wall).to_robot(path).unwrap();
+    assert_eq!(back.gravity(), wall.gravity());
+    assert!(nominal_difference(&floor, &wall)
+        .unwrap()
+        .starts_with("gravity"));
+    for bad in ["gravity = [0, 0]", "gravity = [0, 0, 0]"] {
+        let e = parse_robot_toml(&text(bad), path).unwrap_err().to_string();
+        assert!(e.contains("wall.toml:2: field `gravity`"), "{bad}: {e}");
+    }
+}
