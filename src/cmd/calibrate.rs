@@ -62,6 +62,21 @@ pub struct CalibrateArgs {
     /// one), a list of joint numbers (e.g. `3`), or `none`.
     #[arg(long, default_value = "none", value_name = "parallel|none|J,..")]
     beta: String,
+    /// Joint compliance under gravity (each joint turns by its compliance times the gravity
+    /// torque about its axis, from lumped coefficients of the chain's geometry): `auto` (every
+    /// revolute joint whose axis is not always parallel to the robot's `gravity`), a list of
+    /// joint numbers (e.g. `2,3`), or `none`.
+    #[arg(long, default_value = "none", value_name = "auto|none|J,..")]
+    compliance: String,
+    /// The payload (kg) the data were measured with: the compliances' payload part becomes a
+    /// physical compliance (`compliance{j}`, µrad/(N·m)), so `evaluate` and `compensate` can
+    /// predict another payload. Needs --compliance.
+    #[arg(long, value_name = "KG")]
+    payload_kg: Option<f64>,
+    /// Joint transmission errors: the first N harmonics of every revolute joint's angle error
+    /// (0 to 8).
+    #[arg(long, default_value_t = 0, value_name = "N")]
+    harmonics: usize,
     /// Also fit the paper's 12-parameter affine Tr (eq. 8-11) and report it (the tracker frame
     /// stays rigid).
     #[arg(long)]
@@ -207,6 +222,58 @@ fn apply_beta(robot: &mut Robot, arg: &str) -> anyhow::Result<Vec<usize>> {
     }
 }
 
+/// Applies `--compliance`, `--payload-kg` and `--harmonics`; returns the compliant joints
+/// (0-based).
+fn apply_joint_families(robot: &mut Robot, a: &CalibrateArgs) -> anyhow::Result<Vec<usize>> {
+    use robocal_core::model::family::{compliance, transmission};
+    let joints = match a.compliance.trim() {
+        "none" | "" => Vec::new(),
+        "auto" => compliance::auto_joints(robot),
+        list => {
+            let mut out = Vec::new();
+            for part in list.split(',') {
+                let j: usize = part.trim().parse().map_err(|_| {
+                    exit::usage(format!(
+                        "--compliance: `{part}` is not `auto`, `none` or a joint number"
+                    ))
+                })?;
+                if j == 0 || j > robot.dof() {
+                    return Err(exit::usage(format!(
+                        "--compliance: joint {j} does not exist (robot `{}` has joints 1..{})",
+                        robot.name(),
+                        robot.dof()
+                    )));
+                }
+                if !out.contains(&(j - 1)) {
+                    out.push(j - 1);
+                }
+            }
+            out.sort_unstable();
+            out
+        }
+    };
+    if a.payload_kg.is_some() && joints.is_empty() {
+        return Err(exit::usage(
+            "--payload-kg: the payload makes the joint compliances physical; give --compliance              auto or a list of joints too",
+        ));
+    }
+    if !joints.is_empty() {
+        compliance::enable(robot, &joints, a.payload_kg)
+            .map_err(|e| exit::usage(super::flags::cli_text(&e)))?;
+    }
+    if a.harmonics > transmission::MAX_HARMONICS {
+        return Err(exit::usage(format!(
+            "--harmonics {}: at most {} harmonics per joint",
+            a.harmonics,
+            transmission::MAX_HARMONICS
+        )));
+    }
+    let all: Vec<usize> = (0..robot.dof()).collect();
+    transmission::enable(robot, &all, a.harmonics)
+        .map_err(|e| exit::usage(super::flags::cli_text(&e)))?;
+    Ok(joints)
+}
+
 /// Reads a measurement file and sorts its rows (see `split_measurements`). Rows outside the
 /// robot's joint limits are an error, or with --nominal-limits a warning, and are added to
 /// `outside`.
@@ -265,6 +332,13 @@ impl TryFrom<&CalibrateArgs> for Settings {
         }
         let mut robot = common::robot(&a.robot)?;
         let betas = apply_beta(&mut robot, &a.beta)?;
+        let compliant = apply_joint_families(&mut robot, a)?;
+        if compliant.is_empty() && a.compliance.trim() == "auto" {
+            eprintln!(
+                "note: --compliance auto: no joint of robot `{}` turns under gravity (every axis                  is parallel to its `gravity`); no compliance added",
+                robot.name()
+            );
+        }
         if betas.is_empty() && a.beta.trim() == "parallel" {
             eprintln!(
                 "note: --beta parallel: robot `{}` has no pair of consecutive parallel axes; no \

@@ -179,3 +179,14 @@ pub fn check_limits(
         ))),
     }
 }
+
+/// Applies `--payload-kg` of `evaluate` and `compensate` to the calibrated model: the payload
+/// now carried, for a calibration whose joint compliances were identified at a known payload
+/// (`calibrate --payload-kg`). Without the flag the model keeps the calibration's payload.
+pub fn apply_payload(calibrated: &mut Robot, payload_kg: Option<f64>) -> anyhow::Result<()> {
+    let Some(m) = payload_kg else {
+        return Ok(());
+    };
+    robocal_core::model::family::compliance::set_payload_kg(calibrated, m)
+        .map_err(|e| crate::exit::usage(crate::cmd::flags::cli_text(&e)))
+}

@@ -22,6 +22,12 @@ pub struct CompensateArgs {
     /// The calibration result (`robocal calibrate --out`).
     #[arg(long)]
     params: PathBuf,
+    /// The payload (kg) the robot will carry at the commanded poses, for a calibration whose
+    /// joint compliances were identified at a known payload (`calibrate --payload-kg`): the
+    /// commanded joints then account for the deflection at this payload [default: the
+    /// calibration's payload].
+    #[arg(long, value_name = "KG")]
+    payload_kg: Option<f64>,
     /// Desired joint values: CSV with q1..qn (model joint values: degrees, mm for a prismatic
     /// joint) or axis1..axisN (controller values, through the robot's [controller]). Each row's
     /// target is its nominal tool position (eq. 13); the solve starts from the row's joints.
@@ -104,7 +110,8 @@ impl TryFrom<&CompensateArgs> for Settings {
             .input_opt("--targets", a.targets.as_deref())
             .output_or_stdout("--out", &a.out)
             .check()?;
-        let (nominal, calibrated, res) = calibrated_model(a.robot.as_deref(), &a.params)?;
+        let (nominal, mut calibrated, res) = calibrated_model(a.robot.as_deref(), &a.params)?;
+        super::common::apply_payload(&mut calibrated, a.payload_kg)?;
         if let Some(why) = res.partial_reason() {
             return Err(exit::input(format!(
                 "--params {}: a partial result, not a calibration ({why}); compensation refuses \

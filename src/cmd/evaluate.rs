@@ -44,6 +44,11 @@ pub struct EvaluateArgs {
     /// listing the lines instead of an error (exit code 3).
     #[arg(long)]
     nominal_limits: bool,
+    /// The payload (kg) the robot carried when these data were measured, for a calibration whose
+    /// joint compliances were identified at a known payload (`calibrate --payload-kg`)
+    /// [default: the calibration's payload].
+    #[arg(long, value_name = "KG")]
+    payload_kg: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -100,7 +105,8 @@ impl TryFrom<&EvaluateArgs> for Settings {
             plan.output_or_stdout("--per-point", p);
         }
         let outputs = plan.check()?;
-        let (nominal, calibrated, result) = calibrated_model(a.robot.as_deref(), &a.params)?;
+        let (nominal, mut calibrated, result) = calibrated_model(a.robot.as_deref(), &a.params)?;
+        common::apply_payload(&mut calibrated, a.payload_kg)?;
         common::warn_not_calibrated(&result, &a.params);
         let against = match a.against {
             AgainstArg::Auto => Against::Auto,
@@ -141,7 +147,8 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         .with_context(context)?;
     let header = reader.header();
     let frame = res.tracker_frame();
-    let ev = Evaluator::new(&nominal, &cal, &frame, &header, against)?;
+    let ev = Evaluator::new(&nominal, &cal, &frame, &header, against)?
+        .with_nominal_frame(res.nominal_frame());
     let names = ev.series();
     let mut per_point = match &per_point_path {
         Some(p) => Some(PerPointWriter::to_output(

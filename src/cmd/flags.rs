@@ -38,6 +38,9 @@ const FLAGS: &[(&str, &str)] = &[
     ("candidates", "--candidates"),
     ("include", "--include"),
     ("tracker_range", "--range-mm"),
+    ("payload_kg", "--payload-kg"),
+    ("compliance", "--compliance"),
+    ("harmonics", "--harmonics"),
     // compensation::DampedLeastSquares
     ("tolerance_mm", "--tolerance-mm"),
     ("max_iterations", "--max-iterations"),

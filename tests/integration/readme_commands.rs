@@ -151,6 +151,7 @@ fn every_command_and_flag_is_documented() {
         &["calibrate"],
         &["evaluate"],
         &["compensate"],
+        &["plan"],
         &["report"],
         &["demo"],
         &["completions"],

@@ -1,6 +1,9 @@
 //! Whole identification (registration, identifiability, sum-of-norms solve, covariance, error
 //! tables) on simulated KR 480 data: truth = the paper's Table III, tracker noise
 //! 0.010 mm + 0.005 mm/m. Targets (issue 4): 75 poses under 10 ms, 20,000 poses under 1 s.
+//! And the elasto-geometric calibration (joint compliance under gravity, `auto` joints, the
+//! payload known) of 1000 simulated UR5 poses sagging under gravity: target (issue 13) under
+//! 50 ms.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::SeedableRng;
@@ -32,6 +35,58 @@ fn data(truth: &Robot, n: usize, seed: u64) -> Observations {
     obs
 }
 
+/// 1000 poses of the UR5 example sagging under gravity (about the UR5's masses, harmonic-drive
+/// compliances), and the nominal model with compliance on its `auto` joints at the 2 kg payload.
+fn ur5_elasto(c: &mut Criterion) {
+    use robocal_core::model::family::compliance;
+    use robocal_core::simulation::GravityModel;
+    let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/ur5.toml");
+    let nominal = robocal_core::load_robot_file(std::path::Path::new(file)).unwrap();
+    let g = GravityModel::new(
+        vec![0.0, 2e-6, 3e-6, 5e-6, 5e-6, 5e-6],
+        vec![3.7, 8.4, 2.3, 1.2, 1.2, 0.25],
+        2.0,
+    );
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let sampler = PoseSampler {
+        floor_z_mm: -2000.0,
+        footprint_radius_mm: 150.0,
+        max_tries_per_pose: 10_000,
+    };
+    let qs = random_poses(&nominal, 1000, &sampler, &mut rng).unwrap();
+    let tracker = Tracker::new(TrackerFrame::identity(), 0.010, 0.005).unwrap();
+    let mut obs = Observations::new(nominal.dof());
+    for (i, q) in qs.iter().enumerate() {
+        let p = nominal.tool_position(&g.deflected(&nominal, q));
+        obs.push(q, tracker.measure(&p, &mut rng), i + 2).unwrap();
+    }
+    let mut model = nominal.clone();
+    let joints = compliance::auto_joints(&model);
+    compliance::enable(&mut model, &joints, Some(2.0)).unwrap();
+    let settings = CalibrationSettings::default();
+    let mut grp = c.benchmark_group("identification");
+    grp.sample_size(20);
+    for (name, model) in [("elasto-geometric", &model), ("geometric", &nominal)] {
+        grp.bench_function(format!("ur5 {name} 1000 poses"), |b| {
+            b.iter(|| {
+                let cal = calibrate(
+                    model,
+                    CalibrationData {
+                        calibration: black_box(&obs),
+                        plane: None,
+                        validation: None,
+                    },
+                    &settings,
+                    &(),
+                )
+                .unwrap();
+                black_box(cal.calibration.after_stats())
+            })
+        });
+    }
+    grp.finish();
+}
+
 fn bench(c: &mut Criterion) {
     let truth = preset("kuka-kr480-r3330-table3").unwrap();
     let nominal = preset("kuka-kr480-r3330").unwrap();
@@ -60,5 +115,5 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench);
+criterion_group!(benches, bench, ur5_elasto);
 criterion_main!(benches);

@@ -91,6 +91,26 @@ pub fn evaluate(
     data: &MeasurementSet,
     against: Against,
 ) -> Result<Evaluation> {
+    evaluate_framed(
+        nominal,
+        calibrated,
+        [tracker_frame, tracker_frame],
+        data,
+        against,
+    )
+}
+
+/// [`evaluate`] with the nominal series in a frame of its own: `frames` are the nominal model's
+/// (a result's registration frame, that of Table II) and the calibrated model's (the result's
+/// `tracker_frame`).
+pub fn evaluate_framed(
+    nominal: &Robot,
+    calibrated: &Robot,
+    frames: [&TrackerFrame; 2],
+    data: &MeasurementSet,
+    against: Against,
+) -> Result<Evaluation> {
+    let tracker_frame = frames[1];
     if nominal.dof() != data.dof() || calibrated.dof() != data.dof() {
         return Err(Error::invalid(
             data.path.display().to_string(),
@@ -101,7 +121,8 @@ pub fn evaluate(
             ),
         ));
     }
-    let ev = Evaluator::new(nominal, calibrated, tracker_frame, data, against)?;
+    let ev = Evaluator::new(nominal, calibrated, tracker_frame, data, against)?
+        .with_nominal_frame(*frames[0]);
     let mut errors = [
         Vec::with_capacity(data.rows.len()),
         Vec::with_capacity(data.rows.len()),

@@ -87,6 +87,26 @@ pub const SIZE_DEG: Range = Range {
     why: "10 turns",
 };
 
+/// Identified joint compliances and their uncertainties (display µrad/(N·m)): ±1e6 µrad/(N·m),
+/// [`COMPLIANCE`]'s bound of 1 rad per N·m; real joints have 0.01 to 10 µrad/(N·m).
+pub const COMPLIANCE_UNITS: Range = Range {
+    min: -1e6,
+    max: 1e6,
+    unit: "urad/Nm",
+    what: "a compliance",
+    why: "1 rad per N·m",
+};
+
+/// Lumped gravity coefficients (display µrad per metre of lever arm): ±1e9 µrad/m, a joint
+/// turned by 1 rad per mm of lever; real arms have 1 to 1e4 µrad/m.
+pub const LUMPED_GRAVITY: Range = Range {
+    min: -1e9,
+    max: 1e9,
+    unit: "urad/m",
+    what: "a lumped gravity coefficient",
+    why: "1 rad per mm of lever arm",
+};
+
 /// Distance-proportional tracker noise (mm per metre of distance): up to 1000 mm/m, a noise as
 /// large as the distance itself; real trackers have 0.005 mm/m.
 pub const NOISE_PER_M: Range = Range {
@@ -122,19 +142,25 @@ pub const COMPLIANCE: Range = Range {
 pub const LIMIT_TOLERANCE_DEG: f64 = 1e-6;
 
 impl Range {
-    /// The range of a model parameter's display value: [`LENGTH`] for mm, [`ANGLE`] for deg.
+    /// The range of a model parameter's display value: [`LENGTH`] for mm, [`ANGLE`] for deg,
+    /// [`COMPLIANCE_UNITS`] and [`LUMPED_GRAVITY`] for the compliance family's coefficients.
     pub fn for_unit(unit: Unit) -> &'static Range {
         match unit {
             Unit::Mm => &LENGTH,
             Unit::Deg => &ANGLE,
+            Unit::MicroradPerNm => &COMPLIANCE_UNITS,
+            Unit::MicroradPerM => &LUMPED_GRAVITY,
         }
     }
 
-    /// The range of a non-negative size in `unit` ([`SIZE_MM`] or [`SIZE_DEG`]).
+    /// The range of a non-negative size in `unit` ([`SIZE_MM`] or [`SIZE_DEG`]; the
+    /// coefficients' own bound for the compliance family's units).
     pub fn size_for_unit(unit: Unit) -> &'static Range {
         match unit {
             Unit::Mm => &SIZE_MM,
             Unit::Deg => &SIZE_DEG,
+            Unit::MicroradPerNm => &COMPLIANCE_UNITS,
+            Unit::MicroradPerM => &LUMPED_GRAVITY,
         }
     }
 

@@ -117,10 +117,7 @@ impl Cell {
     fn truth_error(&self, c: &Calibration, qs: &[Vec<f64>]) -> f64 {
         qs.iter()
             .map(|q| {
-                let cal = c
-                    .registration
-                    .frame
-                    .to_tracker(&c.calibrated.tool_position(q));
+                let cal = c.tracker_frame().to_tracker(&c.calibrated.tool_position(q));
                 let tru = self.tracker.frame.to_tracker(&self.truth.tool_position(q));
                 (cal - tru).norm()
             })

@@ -1,6 +1,7 @@
 //! The units of values at robocal's interfaces (files, reports): millimetres and degrees, stored
-//! internally as millimetres and radians. At the ground floor so that the model and the range
-//! checks below it can both use it.
+//! internally as millimetres and radians; and the units of the non-geometric coefficients (joint
+//! compliance, [`crate::model::family::compliance`]). At the ground floor so that the model and
+//! the range checks below it can both use it.
 
 /// The unit a parameter is shown in at the interfaces.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -11,6 +12,13 @@ pub enum Unit {
     /// Degrees (stored as radians).
     #[serde(rename = "deg")]
     Deg,
+    /// A joint compliance, microradians per newton metre (stored as rad/(N·m)).
+    #[serde(rename = "urad/Nm")]
+    MicroradPerNm,
+    /// A lumped gravity coefficient: the joint's deflection per metre of lever arm of a lumped
+    /// mass's weight, microradians per metre (stored as rad/mm).
+    #[serde(rename = "urad/m")]
+    MicroradPerM,
 }
 
 impl Unit {
@@ -19,6 +27,8 @@ impl Unit {
         match self {
             Unit::Mm => v,
             Unit::Deg => v.to_degrees(),
+            Unit::MicroradPerNm => v * 1e6,
+            Unit::MicroradPerM => v * 1e9,
         }
     }
 
@@ -27,14 +37,23 @@ impl Unit {
         match self {
             Unit::Mm => v,
             Unit::Deg => v.to_radians(),
+            Unit::MicroradPerNm => v * 1e-6,
+            Unit::MicroradPerM => v * 1e-9,
         }
     }
 
-    /// `"mm"` or `"deg"`.
+    /// `"mm"`, `"deg"`, `"urad/Nm"` or `"urad/m"`.
     pub fn as_str(self) -> &'static str {
         match self {
             Unit::Mm => "mm",
             Unit::Deg => "deg",
+            Unit::MicroradPerNm => "urad/Nm",
+            Unit::MicroradPerM => "urad/m",
         }
+    }
+
+    /// Whether values in this unit are angles (degrees), which wrap around a full turn.
+    pub fn is_angle(self) -> bool {
+        self == Unit::Deg
     }
 }

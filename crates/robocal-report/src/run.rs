@@ -5,7 +5,7 @@ use crate::build::{before_after_histogram, paper_tables};
 use crate::data::{
     HistogramSeries, Note, PointDetail, PointError, PointSet, ReachKind, ReportData,
 };
-use robocal_core::evaluation::{evaluate, Against, Evaluation};
+use robocal_core::evaluation::{evaluate_framed, Against, Evaluation};
 use robocal_core::io::result::BeforeAfter;
 use robocal_core::io::{CalibrationResult, MeasurementSet, SetLabel};
 use robocal_core::{ErrorStats, Result, Robot};
@@ -69,7 +69,14 @@ fn reach_of(v: nalgebra::Vector3<f64>) -> f64 {
 /// (verification: `before` is not available and left NaN).
 fn evaluated(run: &RunData, set: &MeasurementSet, against: Against) -> Result<Evaluated> {
     let frame = run.result.tracker_frame();
-    let ev: Evaluation = evaluate(run.nominal, run.calibrated, &frame, set, against)?;
+    let nominal_frame = run.result.nominal_frame();
+    let ev: Evaluation = evaluate_framed(
+        run.nominal,
+        run.calibrated,
+        [&nominal_frame, &frame],
+        set,
+        against,
+    )?;
     let desired = against == Against::Desired;
     let joints = run.nominal.joint_space();
     let arr = |v: nalgebra::Vector3<f64>| [v.x, v.y, v.z];

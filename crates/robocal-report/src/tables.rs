@@ -104,6 +104,8 @@ fn unit_str(u: Unit) -> &'static str {
     match u {
         Unit::Mm => "mm",
         Unit::Deg => "°",
+        Unit::MicroradPerNm => "µrad/(N·m)",
+        Unit::MicroradPerM => "µrad/m",
     }
 }
 

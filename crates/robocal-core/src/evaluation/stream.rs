@@ -25,6 +25,10 @@ pub struct Evaluator<'a> {
     header: &'a MeasurementSet,
     reference: Reference,
     desired: Option<DesiredSource>,
+    /// The frame of the nominal series (Table II's registration frame; by default the
+    /// calibrated model's).
+    nominal_frame: TrackerFrame,
+    extras: crate::io::row_extras::ExtrasLayout,
 }
 
 impl<'a> Evaluator<'a> {
@@ -70,7 +74,16 @@ impl<'a> Evaluator<'a> {
             header,
             reference,
             desired,
+            nominal_frame: *tracker_frame,
+            extras: crate::io::row_extras::ExtrasLayout::of(header)?,
         })
+    }
+
+    /// Evaluates the nominal series in `frame` (a result's registration frame: the nominal
+    /// model's Table II frame) instead of the calibrated model's tracker frame.
+    pub fn with_nominal_frame(mut self, frame: TrackerFrame) -> Self {
+        self.nominal_frame = frame;
+        self
     }
 
     /// The reference chosen.
@@ -108,12 +121,25 @@ impl<'a> Evaluator<'a> {
                 "no measured position (x,y,z)",
             ));
         };
+        let t = self.extras.read(self.header, r)?.target;
+        let targets = self
+            .nominal
+            .target_count()
+            .min(self.calibrated.target_count());
+        if t >= targets {
+            return Err(Error::parse(
+                &self.header.path,
+                Some(r.line),
+                Some(crate::io::row_extras::TARGET_COLUMN),
+                format!("target {} of a robot with {targets} tool vector(s)", t + 1),
+            ));
+        }
         let actual = self.tracker_frame.to_base(&m);
         let first = match &self.desired {
-            None => self.nominal.tool_position(&r.q),
-            Some(source) => source.position(self.header, r, self.nominal)?,
+            None => self.nominal_frame.to_base(&m) - self.nominal.target_position(&r.q, t),
+            Some(source) => actual - source.position(self.header, r, self.nominal)?,
         };
-        Ok([actual - first, actual - self.calibrated.tool_position(&r.q)])
+        Ok([first, actual - self.calibrated.target_position(&r.q, t)])
     }
 }
 

@@ -25,6 +25,8 @@
 mod truth_compare;
 
 #[cfg(test)]
+mod elasto_tests;
+#[cfg(test)]
 mod tests;
 
 pub use truth_compare::{compare_with_truth, TruthComparison};
@@ -252,12 +254,15 @@ fn csv_bytes(set: &MeasurementSet, name: &str) -> Result<Vec<u8>> {
 /// work advances (`done` and `total` count steps within the phase).
 pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Result<Experiment> {
     let nominal = &config.nominal;
+    // The cell's robots are geometric (their deflection is the simulator's gravity model); the
+    // nominal model may add the families that deflect the joints, for the calibration.
+    let geometric = nominal.geometric();
     let joints = nominal.joint_space();
 
     // 1. The measurement session, split into the files `simulate --validation-out` writes.
     observer.progress(Stage::Measurement, 0, 1);
     let session = simulate(
-        nominal,
+        &geometric,
         &TruthSpec::Robot(config.truth.clone()),
         &config.session,
         observer,
@@ -356,13 +361,13 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
     //    frame as `simulate --truth cell.truth.json` reads them), against the desired positions.
     let tf: TruthFile = serde_json::from_str(&truth_json)
         .map_err(|e| Error::parse(Path::new(files::CELL_TRUTH), None, None, e.to_string()))?;
-    let truth_again = tf.truth_robot(nominal, Path::new(files::CELL_TRUTH))?;
+    let truth_again = tf.truth_robot(&geometric, Path::new(files::CELL_TRUTH))?;
     let vconfig = SimulationConfig {
         tracker_frame: tf.tracker_frame,
         ..config.verification_session()
     };
     let verification = simulate_joints(
-        nominal,
+        &geometric,
         &TruthSpec::Robot(truth_again),
         &vconfig,
         &commanded,

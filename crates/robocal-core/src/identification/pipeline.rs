@@ -423,8 +423,7 @@ pub fn calibrate(
                 _ => ROBUST_SCALE_SIGMAS,
             };
             let scale_of = |r: &Robot| {
-                (sigmas * robust_sigma(&problem.fit_norms(r), rows))
-                    .max(SUM_OF_NORMS_SMOOTHING_MM)
+                (sigmas * robust_sigma(&problem.fit_norms(r), rows)).max(SUM_OF_NORMS_SMOOTHING_MM)
             };
             let mut c = settings.robust_scale_mm.unwrap_or_else(|| scale_of(&robot));
             let mut loss = make(c);

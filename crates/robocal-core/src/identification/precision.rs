@@ -20,11 +20,13 @@ use crate::model::{Param, Robot, Unit};
 use nalgebra::DMatrix;
 
 /// The limit of a parameter's predicted standard deviation (display unit): a third of the
-/// plausibility gate's largest move.
-pub fn std_limit(robot: &Robot, p: Param) -> f64 {
+/// plausibility gate's largest move, for lengths and angles; `None` for parameters of other
+/// units (compliances), which the gate does not bound.
+pub fn std_limit(robot: &Robot, p: Param) -> Option<f64> {
     match p.unit() {
-        Unit::Mm => LENGTH_MOVE_LIMIT * robot.reach_mm() / 3.0,
-        _ => ANGLE_MOVE_LIMIT_DEG / 3.0,
+        Unit::Mm => Some(LENGTH_MOVE_LIMIT * robot.reach_mm() / 3.0),
+        Unit::Deg => Some(ANGLE_MOVE_LIMIT_DEG / 3.0),
+        _ => None,
     }
 }
 
@@ -63,10 +65,10 @@ pub fn undetermined(
         let inv = ch.inverse();
         let worst = (0..k)
             .filter(|&r| !keep_always.contains(&params[keep[r]]))
-            .map(|r| {
+            .filter_map(|r| {
                 let p = params[keep[r]];
                 let std = sigma0_mm * inv[(r, r)].max(0.0).sqrt() * p.unit().from_internal(1.0);
-                (r, std, std_limit(start, p))
+                std_limit(start, p).map(|limit| (r, std, limit))
             })
             .filter(|(_, std, limit)| std > limit)
             .max_by(|a, b| (a.1 / a.2).total_cmp(&(b.1 / b.2)));

@@ -17,15 +17,12 @@ use crate::io::result_sections::{
     Points, Registration, RegistrationObjectiveName, Settings, Solver, StageEntry, Uncertainty,
 };
 use crate::io::CalibrationResult;
-use crate::model::{Param, Unit};
+use crate::model::Param;
 use crate::registration::{InitialFrame, RegistrationObjective};
 
 /// Display-unit factor of a parameter (1 for mm, degrees per radian for angles).
 fn unit_factor(p: Param) -> f64 {
-    match p.unit() {
-        Unit::Mm => 1.0,
-        Unit::Deg => 180.0 / std::f64::consts::PI,
-    }
+    p.unit().from_internal(1.0)
 }
 
 fn loss_entry(l: &Loss) -> LossEntry {
@@ -331,6 +328,7 @@ impl Calibration {
             }
         });
         result.prediction = self.prediction.as_ref().map(Into::into);
+        crate::io::result_payload::record(&mut result, &self.calibrated);
         result
     }
 }

@@ -100,6 +100,8 @@ fn random_truth(rng: &mut ChaCha8Rng) -> Robot {
         let dv = match p.unit() {
             crate::model::Unit::Mm => rng.gen_range(-len..len),
             crate::model::Unit::Deg => rng.gen_range(-ang..ang),
+            // The geometric robots of these tests have no other units.
+            _ => 0.0,
         };
         r.set(p, r.get(p) + dv);
     }
@@ -652,6 +654,8 @@ fn noise_free_tracked_robot_with_random_errors_is_reproduced_exactly() {
             let dv = match p.unit() {
                 crate::model::Unit::Mm => rng.gen_range(-1.0..1.0),
                 crate::model::Unit::Deg => rng.gen_range(-0.05f64..0.05).to_radians(),
+                // The geometric robots of these tests have no other units.
+                _ => 0.0,
             };
             truth.set(p, truth.get(p) + dv);
         }

@@ -355,6 +355,14 @@ impl CalibrationResult {
         self.tracker_frame.to_tracker_frame()
     }
 
+    /// The frame of the nominal model's errors (Table II): the registration's frame when the
+    /// result records it, else [`CalibrationResult::tracker_frame`].
+    pub fn nominal_frame(&self) -> TrackerFrame {
+        self.registration
+            .as_ref()
+            .map_or_else(|| self.tracker_frame(), |r| r.frame.to_tracker_frame())
+    }
+
     /// Applies the calibrated values to `nominal` (the robot given on the command line), checking
     /// that the result was made for a robot of the same shape. `path` names the result file in
     /// errors. Parameters like `beta2` that the result has and the robot lacks are enabled.
@@ -402,6 +410,7 @@ impl CalibrationResult {
             }
             r.set_display(p, e.calibrated);
         }
+        crate::io::result_payload::apply(self, &mut r, path)?;
         for name in self.parameters.keys() {
             if r.param_by_name(name).is_err() {
                 return Err(bad(

@@ -36,6 +36,9 @@ pub struct RobotInfo {
     /// The nominal tool vectors of every target (mm, deg), when the robot carries several.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tools: Option<Vec<[f64; 6]>>,
+    /// The direction of gravity in the base frame, when not the default `[0, 0, -1]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 3]>,
     /// The joints as the robot file gives them; empty (absent) in results that do not embed
     /// their robot.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -58,6 +61,7 @@ impl RobotInfo {
             tool: None,
             tool_correction: None,
             tools: None,
+            gravity: None,
             joints: Vec::new(),
             controller: None,
         }
@@ -75,6 +79,7 @@ impl RobotInfo {
             tool: Some(d.tool),
             tool_correction: d.tool_correction,
             tools: d.tools,
+            gravity: d.gravity,
             joints: d.joints,
             controller: d.controller,
         }
@@ -97,6 +102,7 @@ impl RobotInfo {
             tool: self.tool.unwrap_or_default(),
             tool_correction: self.tool_correction,
             tools: self.tools.clone(),
+            gravity: self.gravity,
             joints: self.joints.clone(),
             controller: self.controller.clone(),
         })

@@ -14,7 +14,7 @@
 pub mod poe;
 
 use crate::frame::Frame;
-use crate::model::family::{self, PoseFrames};
+use crate::model::family::{self, PoseFrames, RigidPose};
 use crate::model::{mul_rot_z, Convention, JointType, Link, Robot, MAX_JOINTS};
 use nalgebra::{Matrix3, Vector3};
 
@@ -86,11 +86,22 @@ impl Robot {
         if !self.deflects_joints() {
             return q;
         }
-        assert_eq!(q.len(), self.dof(), "joint vector length");
+        let rigid = self.rigid_pose(q);
+        self.deflect_with(&rigid, q, buf)
+    }
+
+    /// `q + dq` written to `buf`, the families' deflection computed on `rigid`, the pass at `q`
+    /// without deflection.
+    fn deflect_with<'a>(
+        &self,
+        rigid: &RigidPose,
+        q: &[f64],
+        buf: &'a mut [f64; MAX_JOINTS],
+    ) -> &'a [f64] {
         let mut dq = [0.0; MAX_JOINTS];
         for fam in family::all() {
             if fam.deflects_joints(self) {
-                fam.add_joint_deflection(self, q, &mut dq[..q.len()]);
+                fam.add_joint_deflection(self, rigid, &mut dq[..q.len()]);
             }
         }
         for (i, v) in q.iter().enumerate() {
@@ -100,15 +111,27 @@ impl Robot {
     }
 
     /// The frames of one forward pass at joint values `q` (deflected, see
-    /// [`Robot::deflected`]), with the tool point.
+    /// [`Robot::deflected`]), with the tool point; when a family deflects the joints, `rigid`
+    /// keeps the pass at `q` without deflection.
     pub fn pose_frames(&self, q: &[f64]) -> PoseFrames {
         self.pose_frames_target(q, 0)
     }
 
     /// [`Robot::pose_frames`] with the point of target `t` (0-based) as the tool point.
     pub fn pose_frames_target(&self, q: &[f64], t: usize) -> PoseFrames {
+        if !self.deflects_joints() {
+            return self.rigid_pose_frames(q, t);
+        }
+        let rigid = self.rigid_pose(q);
         let mut buf = [0.0; MAX_JOINTS];
-        let q = self.deflected(q, &mut buf);
+        let mut ch = self.rigid_pose_frames(self.deflect_with(&rigid, q, &mut buf), t);
+        ch.rigid = rigid;
+        ch
+    }
+
+    /// The frames of one forward pass at exactly the joint values `q`, without any family's
+    /// deflection (`rigid` left empty), with the point of target `t` (0-based).
+    pub fn rigid_pose_frames(&self, q: &[f64], t: usize) -> PoseFrames {
         let mut ch = if self.joint_space().any_prismatic() {
             self.chain_with::<true>(q)
         } else {
@@ -120,6 +143,36 @@ impl Robot {
         ch
     }
 
+    /// The joint axes and the tool point at exactly the joint values `q`, without deflection: a
+    /// lean forward pass for the families that deflect the joints.
+    pub fn rigid_pose(&self, q: &[f64]) -> RigidPose {
+        assert_eq!(q.len(), self.dof(), "joint vector length");
+        let mut out = RigidPose::default();
+        out.commanded[..q.len()].copy_from_slice(q);
+        let mixed = self.joint_space().any_prismatic();
+        let mut f = *self.base_frame();
+        let types = self.joint_types();
+        for (i, &qi) in q.iter().enumerate() {
+            let l = &self.links()[i];
+            let c = self.link_constant(i);
+            let (s, co, d) = if mixed {
+                joint_motion::<true>(types, i, l, qi)
+            } else {
+                joint_motion::<false>(types, i, l, qi)
+            };
+            if self.convention() == Convention::Mdh {
+                f *= c;
+            }
+            out.axes[i] = (f.rotation.matrix().column(2).into(), f.translation.vector);
+            rotate_z_translate(&mut f, s, co, d);
+            if self.convention() == Convention::Dh {
+                f *= c;
+            }
+        }
+        out.point = f.rotation * self.tool_frame().translation.vector + f.translation.vector;
+        out
+    }
+
     #[inline(always)]
     fn chain_with<const MIXED: bool>(&self, q: &[f64]) -> PoseFrames {
         assert_eq!(q.len(), self.dof(), "joint vector length");
@@ -129,6 +182,7 @@ impl Robot {
             flange: *self.base_frame(),
             point: Vector3::zeros(),
             target: 0,
+            rigid: RigidPose::default(),
         };
         let mut f = *self.base_frame();
         let types = self.joint_types();

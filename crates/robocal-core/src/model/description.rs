@@ -70,6 +70,9 @@ pub struct RobotDescription {
     /// carries several.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tools: Option<Vec<[f64; 6]>>,
+    /// The direction of gravity in the base frame, when not the default `[0, 0, -1]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gravity: Option<[f64; 3]>,
     /// The joints, base to tip.
     pub joints: Vec<JointDescription>,
     /// The controller's axis map, if the robot has one.
@@ -154,6 +157,10 @@ impl RobotDescription {
                 .then(|| frame_degrees(correction)),
             tools: (robot.target_count() > 1)
                 .then(|| robot.target_tools0().iter().map(frame_degrees).collect()),
+            gravity: {
+                let g = robot.gravity();
+                (g != nalgebra::Vector3::new(0.0, 0.0, -1.0)).then(|| [g.x, g.y, g.z])
+            },
             joints,
             controller: robot.controller().map(|c| ControllerDescription {
                 sign: c.sign().to_vec(),
@@ -201,7 +208,8 @@ pub const NOMINAL_TOLERANCE: f64 = 1e-9;
 
 /// The first difference between two nominal robots that makes a result of one wrong for the
 /// other, or `None`: joint count, joint types, convention, every nominal parameter (and the
-/// nominal tool T0) within [`NOMINAL_TOLERANCE`] (mm or degrees), the controller map. Names and
+/// nominal tool T0) within [`NOMINAL_TOLERANCE`] (mm or degrees), the gravity direction, the
+/// controller map. Names and
 /// joint limits may differ.
 pub fn nominal_difference(a: &Robot, b: &Robot) -> Option<String> {
     if a.dof() != b.dof() {
@@ -231,6 +239,13 @@ pub fn nominal_difference(a: &Robot, b: &Robot) -> Option<String> {
             let u = p.unit().as_str();
             return Some(format!("nominal {} = {x} {u} against {y} {u}", p.name()));
         }
+    }
+    let (ga, gb) = (a.gravity(), b.gravity());
+    if (ga - gb).amax() > NOMINAL_TOLERANCE {
+        return Some(format!(
+            "gravity [{}, {}, {}] against [{}, {}, {}]",
+            ga.x, ga.y, ga.z, gb.x, gb.y, gb.z
+        ));
     }
     if a.target_count() != b.target_count() {
         return Some(format!(

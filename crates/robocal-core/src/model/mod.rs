@@ -19,7 +19,7 @@ pub mod robot_file;
 mod targets;
 
 pub use controller::{Controller, Coupling};
-pub use family::{FamilyId, ParameterFamily, PoseFrames};
+pub use family::{FamilyId, ParameterFamily, PoseFrames, RigidPose};
 pub use joints::{JointSpace, JointType};
 pub use params::{Param, Unit};
 
@@ -107,6 +107,9 @@ pub struct Robot {
     tool: [f64; 6],
     /// Targets 2..k (further reflectors on the flange), see [`Robot::set_target_tools`].
     targets: Vec<targets::TargetTool>,
+    /// The direction of gravity in the base frame (a unit vector; DESIGN.md robot file key
+    /// `gravity`, default `[0, 0, -1]`: floor mounted).
+    gravity: Vector3<f64>,
     /// Values of the parameter families that are not part of the link table, by family key.
     family_store: std::collections::BTreeMap<String, Vec<f64>>,
     // Caches derived from the above (kept valid by every mutator).
@@ -180,6 +183,7 @@ impl Robot {
             tool0,
             tool: [0.0; 6],
             targets: Vec::new(),
+            gravity: Vector3::new(0.0, 0.0, -1.0),
             family_store: Default::default(),
             link_const: Vec::new(),
             base_frame: Frame::identity(),
@@ -357,6 +361,28 @@ impl Robot {
         &self.tool
     }
 
+    /// The direction of gravity in the base frame (unit vector; default `[0, 0, -1]`).
+    pub fn gravity(&self) -> Vector3<f64> {
+        self.gravity
+    }
+
+    /// Sets the direction of gravity in the base frame: any finite, non-zero vector, stored
+    /// normalized (a robot file's `gravity`). Wall and ceiling mounted robots need it for the
+    /// joint compliance family.
+    pub fn set_gravity(&mut self, g: [f64; 3]) -> Result<()> {
+        let v = Vector3::from(g);
+        let n = v.norm();
+        if !n.is_finite() || n < 1e-9 {
+            return Err(Error::invalid(
+                "gravity",
+                format!("{g:?} is not a direction: give a non-zero vector such as [0, 0, -1]"),
+            ));
+        }
+        self.gravity = v / n;
+        self.refresh_params();
+        Ok(())
+    }
+
     /// The base frame `pose(B)`.
     pub fn base_frame(&self) -> &Frame {
         &self.base_frame
@@ -476,6 +502,19 @@ impl Robot {
         }
         self.refresh_params();
         Ok(())
+    }
+
+    /// This robot without the families that deflect the joints (its geometric model): what a
+    /// simulated cell's nominal robot and a truth file's parameters describe.
+    pub fn geometric(&self) -> Robot {
+        let mut r = self.clone();
+        for fam in family::all() {
+            if fam.deflects_joints(&r) {
+                r.family_store.remove(fam.key());
+            }
+        }
+        r.refresh_params();
+        r
     }
 
     /// A mutable view of a family's stored values, for the family's own `set`. The number of

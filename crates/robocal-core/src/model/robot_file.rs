@@ -11,6 +11,8 @@
 //! tools = [[0, 0, 31, 0, 0, 0], [40, 0, 25, 0, 0, 0]]  # several targets (reflectors): one
 //!                              # nominal tool vector per `target` of the data (optional; the
 //!                              # first is `tool`, which may then be left out)
+//! gravity = [0, 0, -1]         # direction of gravity in the base frame (optional, default
+//!                              # floor mounted; used by the joint compliance family)
 //!
 //! [[joints]]                   # one table per joint, base to tip
 //! type = "revolute"            # or "prismatic" (optional, default revolute)
@@ -49,6 +51,7 @@ struct RobotFile {
     tool: Option<Spanned<Vec<Spanned<f64>>>>,
     tool_correction: Option<Spanned<Vec<Spanned<f64>>>>,
     tools: Option<Spanned<Vec<FrameEntry>>>,
+    gravity: Option<Spanned<Vec<Spanned<f64>>>>,
     joints: Vec<JointEntry>,
     controller: Option<Spanned<ControllerEntry>>,
 }
@@ -316,6 +319,20 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
     }
     for (k, v) in tool_correction.into_iter().enumerate() {
         robot.set(Param::tool(k), v);
+    }
+    if let Some(g) = &file.gravity {
+        let v: Vec<f64> = g.get_ref().iter().map(|x| *x.get_ref()).collect();
+        let bad = |msg: String| err(g.span(), "gravity".to_owned(), msg);
+        let g3: [f64; 3] = v.as_slice().try_into().map_err(|_| {
+            bad(format!(
+                "expected [gx, gy, gz], the direction of gravity in the base frame, got {} numbers",
+                v.len()
+            ))
+        })?;
+        robot.set_gravity(g3).map_err(|e| match e {
+            Error::Invalid { message, .. } => bad(message),
+            other => bad(other.to_string()),
+        })?;
     }
     Ok(robot)
 }

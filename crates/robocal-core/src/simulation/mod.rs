@@ -38,6 +38,7 @@
 mod cell;
 mod config;
 mod gravity;
+mod gravity_equivalent;
 mod monte_carlo;
 mod outliers;
 mod plane;

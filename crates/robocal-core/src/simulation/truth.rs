@@ -74,6 +74,8 @@ impl GeometricErrors {
             let sigma = match p.unit() {
                 Unit::Mm => self.length_sigma_mm,
                 Unit::Deg => self.angle_sigma_deg.to_radians(),
+                // Non-geometric coefficients are not geometric errors.
+                Unit::MicroradPerNm | Unit::MicroradPerM => 0.0,
             };
             let z: f64 = StandardNormal.sample(rng);
             r.set(p, r.get(p) + sigma * z);
@@ -188,6 +190,7 @@ mod tests {
                 match p.unit() {
                     Unit::Mm => lengths.push(d),
                     Unit::Deg => angles.push(d),
+                    _ => {}
                 }
             }
         }

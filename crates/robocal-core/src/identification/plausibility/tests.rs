@@ -36,6 +36,8 @@ fn truth_of(nominal: &Robot, seed: u64) -> Robot {
         let dv = match p.unit() {
             Unit::Mm => rng.gen_range(-0.5..0.5),
             Unit::Deg => rng.gen_range(-0.03f64..0.03).to_radians(),
+            // The geometric robots of these tests have no other units.
+            _ => 0.0,
         };
         r.set(p, r.get(p) + dv);
     }

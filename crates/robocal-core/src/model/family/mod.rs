@@ -18,13 +18,17 @@
 //! the link table live in the robot's family store ([`Robot::family_values`]).
 //!
 //! The geometric families of the paper's 36-parameter model (section II.B):
-//! [`link`] (alpha, d, a, phi), [`beta`] (Hayati tilts), [`base`] (frame B) and [`tool`] (T).
+//! [`link`] (alpha, d, a, phi), [`beta`] (Hayati tilts), [`base`] (frame B) and [`tool`] (T);
+//! beyond geometry, acting through the joints: [`compliance`] (joint compliance under gravity)
+//! and [`transmission`] (harmonics of the joints' transmission errors).
 
 pub mod base;
 pub mod beta;
+pub mod compliance;
 pub mod link;
 pub mod reflector;
 pub mod tool;
+pub mod transmission;
 
 #[cfg(test)]
 mod seam_tests;
@@ -124,9 +128,11 @@ pub trait ParameterFamily: Sync {
         false
     }
 
-    /// Adds the family's joint deflection `dq(q, theta)` at model joint values `q` to `dq`
-    /// (internal units). Forward kinematics evaluates the chain at `q + dq`.
-    fn add_joint_deflection(&self, _robot: &Robot, _q: &[f64], _dq: &mut [f64]) {}
+    /// Adds the family's joint deflection `dq(q, theta)` at the commanded joint values to `dq`
+    /// (internal units). `rigid` holds the forward pass at the commanded joints without any
+    /// deflection (`rigid.commanded` are the joint values). Forward kinematics evaluates the
+    /// chain at `q + dq`.
+    fn add_joint_deflection(&self, _robot: &Robot, _rigid: &RigidPose, _dq: &mut [f64]) {}
 }
 
 /// Every family, in model order (the order of [`Robot::params`]).
@@ -150,22 +156,26 @@ pub fn by_key(key: &str) -> Option<(FamilyId, &'static dyn ParameterFamily)> {
 
 // The registry: a family's `ID` constant is its position here.
 #[cfg(not(test))]
-static REGISTRY: [&dyn ParameterFamily; 5] = [
+static REGISTRY: [&dyn ParameterFamily; 7] = [
     &link::Link,
     &beta::Beta,
     &base::Base,
     &tool::Tool,
     &reflector::Reflector,
+    &compliance::Compliance,
+    &transmission::Transmission,
 ];
 
 // Tests add a family written only against the trait, which proves the seam (`seam_tests`).
 #[cfg(test)]
-static REGISTRY: [&dyn ParameterFamily; 6] = [
+static REGISTRY: [&dyn ParameterFamily; 8] = [
     &link::Link,
     &beta::Beta,
     &base::Base,
     &tool::Tool,
     &reflector::Reflector,
+    &compliance::Compliance,
+    &transmission::Transmission,
     &seam_tests::JointOffsets,
 ];
 
@@ -228,6 +238,32 @@ pub struct PoseFrames {
     /// Which target's point `point` is (0-based; 0 is the tool of the paper, see
     /// [`Robot::target_count`]). Families of one target's tool give zero columns for another's.
     pub target: usize,
+    /// The forward pass at the commanded joints without deflection, filled when some family
+    /// deflects the joints (the frames above are then at the deflected joints); families that
+    /// deflect the joints compute `d(dq)/d(theta)` from it.
+    pub rigid: RigidPose,
+}
+
+/// The forward pass at the commanded joints without any family's deflection: what a family that
+/// deflects the joints computes its deflection from ([`ParameterFamily::add_joint_deflection`]).
+#[derive(Clone, Copy)]
+pub struct RigidPose {
+    /// The commanded joint values (internal units).
+    pub commanded: [f64; MAX_JOINTS],
+    /// Each joint's axis: its unit direction and the origin of its axis frame (ACS).
+    pub axes: [(Vector3<f64>, Vector3<f64>); MAX_JOINTS],
+    /// The tool point (mm, ACS).
+    pub point: Vector3<f64>,
+}
+
+impl Default for RigidPose {
+    fn default() -> Self {
+        RigidPose {
+            commanded: [0.0; MAX_JOINTS],
+            axes: [(Vector3::zeros(), Vector3::zeros()); MAX_JOINTS],
+            point: Vector3::zeros(),
+        }
+    }
 }
 
 impl PoseFrames {

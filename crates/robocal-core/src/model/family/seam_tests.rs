@@ -15,7 +15,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 const KEY: &str = "qoffset";
-const ID: FamilyId = FamilyId::new(5);
+const ID: FamilyId = FamilyId::new(7);
 
 /// Constant offsets added to the joint values (a test family).
 pub struct JointOffsets;
@@ -71,7 +71,7 @@ impl ParameterFamily for JointOffsets {
         robot.family_values(KEY).is_some()
     }
 
-    fn add_joint_deflection(&self, robot: &Robot, _q: &[f64], dq: &mut [f64]) {
+    fn add_joint_deflection(&self, robot: &Robot, _rigid: &super::RigidPose, dq: &mut [f64]) {
         if let Some(v) = robot.family_values(KEY) {
             for (d, o) in dq.iter_mut().zip(v) {
                 *d += o;
@@ -101,6 +101,8 @@ fn the_registry_positions_are_the_families_ids() {
         let t0 = *r.tool0();
         r.set_target_tools(&[t0, [50.0, 0.0, 20.0, 0.0, 0.0, 0.0]])
             .unwrap();
+        super::compliance::enable(&mut r, &[1, 2], Some(10.0)).unwrap();
+        super::transmission::enable(&mut r, &[0, 1, 2, 3, 4, 5], 2).unwrap();
         fam.params(&r, &mut ps);
         assert!(!ps.is_empty(), "{}", fam.key());
         for p in ps {
