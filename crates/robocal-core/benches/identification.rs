@@ -3,7 +3,8 @@
 //! 0.010 mm + 0.005 mm/m. Targets (issue 4): 75 poses under 10 ms, 20,000 poses under 1 s.
 //! And the elasto-geometric calibration (joint compliance under gravity, `auto` joints, the
 //! payload known) of 1000 simulated UR5 poses sagging under gravity: target (issue 13) under
-//! 50 ms.
+//! 50 ms. And several reflectors (issue 12): 1000 KR 480 poses each measured through three
+//! reflectors (3000 points), target under 50 ms.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::SeedableRng;
@@ -115,5 +116,63 @@ fn bench(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench, ur5_elasto);
+/// 1000 poses of the KR 480 (truth: Table III) each measured through three reflectors.
+fn reflectors(c: &mut Criterion) {
+    use robocal_core::observations::RowExtras;
+    let mut truth = preset("kuka-kr480-r3330-table3").unwrap();
+    let mut nominal = preset("kuka-kr480-r3330").unwrap();
+    let t0 = *nominal.tool0();
+    let mut t2 = t0;
+    t2[0] += 180.0;
+    let mut t3 = t0;
+    t3[1] += 160.0;
+    nominal.set_target_tools(&[t0, t2, t3]).unwrap();
+    truth.set_target_tools(&[t0, t2, t3]).unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let tracker = Tracker::new(
+        TrackerFrame::new(pose(&[3900.0, -2200.0, -350.0, 2.65, 0.007, -0.012])),
+        0.010,
+        0.005,
+    )
+    .unwrap();
+    let sampler = PoseSampler {
+        floor_z_mm: 0.0,
+        footprint_radius_mm: 800.0,
+        max_tries_per_pose: 10_000,
+    };
+    let qs = random_poses(&truth, 1000, &sampler, &mut rng).unwrap();
+    let mut obs = Observations::new(truth.dof());
+    for (i, q) in qs.iter().enumerate() {
+        for t in 0..3 {
+            let m = tracker.measure(&truth.target_position(q, t), &mut rng);
+            let extras = RowExtras {
+                target: t,
+                ..Default::default()
+            };
+            obs.push_with(q, m, extras, 3 * i + t + 2).unwrap();
+        }
+    }
+    let settings = CalibrationSettings::default();
+    let mut g = c.benchmark_group("identification");
+    g.sample_size(20);
+    g.bench_function("kr480 1000 poses x 3 reflectors", |b| {
+        b.iter(|| {
+            let cal = calibrate(
+                &nominal,
+                CalibrationData {
+                    calibration: black_box(&obs),
+                    plane: None,
+                    validation: None,
+                },
+                &settings,
+                &(),
+            )
+            .unwrap();
+            black_box(cal.calibration.after_stats())
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench, ur5_elasto, reflectors);
 criterion_main!(benches);

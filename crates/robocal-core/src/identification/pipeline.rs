@@ -172,6 +172,9 @@ pub struct Calibration {
     /// II with the fitted tool); its frame is the one the identification holds, the result's
     /// tracker frame.
     pub tool_fit: ToolFit,
+    /// The frame the identification held (the tool fit's when it was applied, else the
+    /// registration's): the result's `tracker_frame`.
+    pub frame: crate::frame::TrackerFrame,
     /// Which parameters were identified, which fixed and why.
     pub identifiability: Identifiability,
     /// The solver runs, in order (robust objectives start from a sum-of-norms fit).
@@ -204,7 +207,7 @@ impl Calibration {
     /// The tracker frame of the calibrated model (the frame the identification held): a
     /// measured point m maps to `tracker_frame().to_base(m)`.
     pub fn tracker_frame(&self) -> &crate::frame::TrackerFrame {
-        &self.tool_fit.frame
+        &self.frame
     }
 
     /// The last solver run.
@@ -300,18 +303,33 @@ pub fn calibrate(
         ..Default::default()
     };
     let registration = register(nominal, cal, data.plane, &reg_opts)?;
-    let tool_fit = fit_tools(nominal, cal, &registration.frame)?;
+    let mut tool_fit = fit_tools(nominal, cal, &registration.frame)?;
+    // Only where the nominal geometry with the fitted tools fits the data as a calibration's
+    // start can (the gate's nominal-error limit): on data in the wrong unit or of another robot
+    // the fitted tools mean nothing, and the gate names the cause.
+    tool_fit.applied = tool_fit.converged
+        && tool_fit.stats.rms_mm
+            <= plausibility::NOMINAL_ERROR_LIMIT * plausibility::reach_mm(nominal);
     // The identification starts from the nominal geometry with the fitted tools, in the frame
     // fitted with them: neither it nor the identifiability depends on the nominal tool's guess.
-    let start = tool_fit.apply(nominal);
+    let (start, frame) = if tool_fit.applied {
+        (tool_fit.apply(nominal), tool_fit.frame)
+    } else {
+        (nominal.clone(), registration.frame)
+    };
 
     observer.progress(progress::Stage::Identifiability, 0, 1);
     let mut ident = analyze(&start, cal, idopts)?;
     // Parameters independent in principle that these data cannot pin (precision.rs).
-    let sigma0 = tool_fit.stats.rms_mm / 3f64.sqrt();
+    // Only with the tools fitted (see above): otherwise the bound means nothing.
+    let sigma0 = if tool_fit.applied {
+        tool_fit.stats.rms_mm / 3f64.sqrt()
+    } else {
+        0.0
+    };
     let undetermined = precision::undetermined(
         &start,
-        &Problem::new(&start, &ident.identified, cal, &tool_fit.frame),
+        &Problem::new(&start, &ident.identified, cal, &frame),
         sigma0,
         &idopts.free,
     );
@@ -367,7 +385,7 @@ pub fn calibrate(
         )));
     }
 
-    let problem = Problem::new(&start, &ident.identified, cal, &tool_fit.frame);
+    let problem = Problem::new(&start, &ident.identified, cal, &frame);
     let mut robot = start.clone();
     let mut stages = Vec::new();
     let run = |robot: &mut Robot, loss: Loss, stages: &mut Vec<Stage>| -> Result<()> {
@@ -451,7 +469,8 @@ pub fn calibrate(
         covariance.mark_unavailable(why);
     }
 
-    let frame = &tool_fit.frame;
+    let held = frame;
+    let frame = &held;
     let calibration = SetErrors::new(cal, &registration, nominal, frame, &robot);
     // Points beyond the robust threshold are outliers, not noise a new measurement shares.
     let threshold = robust_scale.unwrap_or_else(|| {
@@ -509,6 +528,7 @@ pub fn calibrate(
         calibrated: robot,
         registration,
         tool_fit,
+        frame: held,
         identifiability: ident,
         stages,
         covariance,

@@ -11,7 +11,9 @@
 //! errors, so the prediction is conservative). A parameter whose predicted standard deviation
 //! exceeds a third of the largest move the plausibility gate accepts (3 sigma beyond it: 5% of
 //! the reach for lengths, 10 degrees for angles) is fixed, the worst first, and the others are
-//! predicted again without it, until every identified parameter is within its limit.
+//! predicted again without it, until every identified parameter is within its limit. The pass
+//! is skipped when the nominal model misses the data by more than the gate's nominal-error limit
+//! (wrong units, another robot): the bound then means nothing and the gate names the cause.
 
 use crate::identification::objective::Loss;
 use crate::identification::plausibility::{ANGLE_MOVE_LIMIT_DEG, LENGTH_MOVE_LIMIT};

@@ -180,6 +180,7 @@ impl Calibration {
                     .collect(),
                 iterations: self.tool_fit.iterations,
                 converged: self.tool_fit.converged,
+                applied: self.tool_fit.applied,
                 stats: self.tool_fit.stats,
             }),
             validation_frame: self

@@ -66,6 +66,10 @@ pub struct ToolFitEntry {
     pub iterations: usize,
     /// Whether they converged.
     pub converged: bool,
+    /// Whether the calibration started from them (not when the nominal geometry misses the
+    /// data by more than the plausibility gate's nominal-error limit).
+    #[serde(default)]
+    pub applied: bool,
     /// Errors of the nominal geometry with the fitted tools (Table II with the fitted tool).
     pub stats: ErrorStats,
 }

@@ -3,23 +3,23 @@
 //! guess (often zeros for a reflector nobody measured), and neither the identifiability
 //! analysis nor the starting point of the identification should depend on it. With the frame F
 //! and the flange poses `(o_i, R_i)` of the nominal chain, target k's point on the flange is
-//! `t_k = mean R_i^T (F m_i - o_i)` over its observations, and F is the rigid fit of the measured
-//! points to `o_i + R_i t_k`: the two least-squares steps alternate to convergence (each step
-//! lowers the same sum of squares, so the alternation cannot diverge).
+//! `t_k`, the frame and the points are fitted together: `sum |F m_i - (o_i + R_i t_k)|^2` is
+//! minimized by Gauss-Newton over F's rotation and translation and every `t_k` (6 + 3k unknowns,
+//! linear but for F's rotation, so a few iterations converge from the registration's frame).
 
-use super::rigid::fit_rigid;
 use crate::error::Result;
 use crate::frame::{self, Frame, TrackerFrame};
 use crate::model::{Param, Robot};
 use crate::observations::Observations;
 use crate::stats::ErrorStats;
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
 
-/// Most alternations of [`fit_tools`].
-pub const MAX_ALTERNATIONS: usize = 2000;
+/// Most Gauss-Newton iterations of [`fit_tools`].
+pub const MAX_ALTERNATIONS: usize = 50;
 
-/// Convergence of [`fit_tools`]: the largest change of a tool point in one alternation (mm).
-pub const TOOL_TOLERANCE_MM: f64 = 1e-10;
+/// Convergence of [`fit_tools`]: the largest change of a tool point or of the frame's origin in
+/// one iteration (mm).
+pub const TOOL_TOLERANCE_MM: f64 = 1e-9;
 
 /// The outcome of [`fit_tools`].
 #[derive(Debug, Clone, PartialEq)]
@@ -29,10 +29,13 @@ pub struct ToolFit {
     /// Each target's fitted tool vector (mm, rad; the orientation is the nominal one unless the
     /// data are 6-DoF).
     pub tools: Vec<[f64; 6]>,
-    /// Alternations run.
+    /// Gauss-Newton iterations run.
     pub iterations: usize,
-    /// Whether the alternation converged to [`TOOL_TOLERANCE_MM`].
+    /// Whether the iterations converged to [`TOOL_TOLERANCE_MM`].
     pub converged: bool,
+    /// Whether the calibration started from the fitted tools (set by the caller: the
+    /// calibration does when the fit converged and fits the data as a calibration's start can).
+    pub applied: bool,
     /// Error norms of the nominal geometry with the fitted tools and frame (mm).
     pub residuals: Vec<f64>,
     /// Their statistics (Table II with the fitted tool).
@@ -84,33 +87,83 @@ pub fn fit_tools(robot: &Robot, obs: &Observations, start: &TrackerFrame) -> Res
             }
         })
         .collect();
-    let mut model = vec![Vector3::zeros(); n];
+    let np = 6 + 3 * k;
     let mut iterations = 0;
     let mut converged = false;
     while iterations < MAX_ALTERNATIONS {
         iterations += 1;
-        let mut sum = vec![Vector3::zeros(); k];
+        // r_i = F m_i - (o_i + R_i t_k); d r / d(rotation of F) = -[F m_i - t_F]x, d r / d t_F =
+        // I, d r / d t_k = -R_i.
+        let mut a = DMatrix::<f64>::zeros(np, np);
+        let mut b = DVector::<f64>::zeros(np);
+        let tf = frame.origin();
         for (i, f) in flanges.iter().enumerate() {
-            let b = frame.to_base(obs.m(i));
-            sum[obs.target(i)] += f.rotation.inverse() * (b - f.translation.vector);
-        }
-        let mut change: f64 = 0.0;
-        for t in 0..k {
-            if count[t] > 0 {
-                let new = sum[t] / count[t] as f64;
-                change = change.max((new - tools[t]).norm());
-                tools[t] = new;
+            let t = obs.target(i);
+            let p = frame.to_base(obs.m(i));
+            let r = p - (f.translation.vector + f.rotation * tools[t]);
+            let mut j = nalgebra::SMatrix::<f64, 3, 9>::zeros();
+            j.fixed_view_mut::<3, 3>(0, 0)
+                .copy_from(&(-(p - tf).cross_matrix()));
+            j.fixed_view_mut::<3, 3>(0, 3)
+                .copy_from(&Matrix3::identity());
+            j.fixed_view_mut::<3, 3>(0, 6)
+                .copy_from(&(-f.rotation.matrix()));
+            let jtj = j.transpose() * j;
+            let jtr = j.transpose() * r;
+            let idx = |c: usize| if c < 6 { c } else { 6 + 3 * t + (c - 6) };
+            for x in 0..9 {
+                b[idx(x)] += jtr[x];
+                for y in 0..9 {
+                    a[(idx(x), idx(y))] += jtj[(x, y)];
+                }
             }
         }
-        for (i, f) in flanges.iter().enumerate() {
-            model[i] = f.rotation * tools[obs.target(i)] + f.translation.vector;
+        for (t, c) in count.iter().enumerate() {
+            if *c == 0 {
+                // A target no observation measures keeps its tool.
+                for x in 0..3 {
+                    a[(6 + 3 * t + x, 6 + 3 * t + x)] = 1.0;
+                }
+            }
         }
-        frame = fit_rigid(obs.measured(), &model, None)?;
+        let step =
+            match a.clone().cholesky() {
+                Some(ch) => ch.solve(&(-&b)),
+                None => return Err(crate::error::Error::Numerical(
+                    "the tool points cannot be fitted: the poses do not turn the flange enough \
+                     to tell the tools from the tracker frame"
+                        .into(),
+                )),
+            };
+        let rot = nalgebra::Rotation3::new(Vector3::new(step[0], step[1], step[2]));
+        let origin = tf + Vector3::new(step[3], step[4], step[5]);
+        let pose = frame.pose();
+        let new_rot = rot * pose.rotation;
+        // The origin moves by the step; the rotation turns about it.
+        frame = TrackerFrame::new(frame::frame(
+            *new_rot.matrix(),
+            origin + rot * (pose.translation.vector - tf),
+        ));
+        let mut change = Vector3::new(step[3], step[4], step[5]).norm();
+        for (t, tool) in tools.iter_mut().enumerate() {
+            let d = Vector3::new(step[6 + 3 * t], step[7 + 3 * t], step[8 + 3 * t]);
+            if count[t] > 0 {
+                *tool += d;
+            }
+            change = change.max(d.norm());
+        }
+        // A rotation step, as the motion it causes 1 m away.
+        change = change.max(1e3 * rot.angle());
         if change <= TOOL_TOLERANCE_MM {
             converged = true;
             break;
         }
     }
+    let model: Vec<Vector3<f64>> = flanges
+        .iter()
+        .enumerate()
+        .map(|(i, f)| f.rotation * tools[obs.target(i)] + f.translation.vector)
+        .collect();
     // Orientations: for 6-DoF data, the rotation closest to the mean of R_i^T R_F R_meas,i.
     let mut out: Vec<[f64; 6]> = (0..k)
         .map(|t| {
@@ -153,6 +206,7 @@ pub fn fit_tools(robot: &Robot, obs: &Observations, start: &TrackerFrame) -> Res
         tools: out,
         iterations,
         converged,
+        applied: false,
         residuals,
         stats,
     })

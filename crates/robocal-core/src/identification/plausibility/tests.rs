@@ -313,7 +313,11 @@ fn parameter_move_checks_catch_lengths_and_angles_beyond_calibration() {
     let assess_with = |cal: &Robot| {
         assess(&Fit {
             nominal: &c.nominal,
-            start: &c.tool_fit.apply(&c.nominal),
+            start: &if c.tool_fit.applied {
+                c.tool_fit.apply(&c.nominal)
+            } else {
+                c.nominal.clone()
+            },
             calibrated: cal,
             identified: &c.identifiability.identified,
             calibration: &obs,
