@@ -698,6 +698,32 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
             &before_cols
         )
     );
+    let tf = &c.tool_fit;
+    let tools: Vec<String> = tf
+        .tools
+        .iter()
+        .map(|t| format!("({:.3}, {:.3}, {:.3})", t[0], t[1], t[2]))
+        .collect();
+    println!(
+        "with the fitted tool{} {} (mm, flange frame): mean {:.4} mm, RMS {:.4} mm, max {:.4} mm{}",
+        if tools.len() > 1 { "s" } else { "" },
+        tools.join(", "),
+        tf.stats.mean_mm,
+        tf.stats.rms_mm,
+        tf.stats.max_mm,
+        if tf.applied {
+            ""
+        } else {
+            " (not used: the nominal geometry misses the data even so)"
+        }
+    );
+    if let Some(o) = &c.calibration.orientation_deg {
+        let (b, a) = (ErrorStats::from_norms(&o.0), ErrorStats::from_norms(&o.1));
+        println!(
+            "orientation error (deg): before mean {:.4}, max {:.4}; after mean {:.4}, max {:.4}",
+            b.mean_mm, b.max_mm, a.mean_mm, a.max_mm
+        );
+    }
     if let Some(af) = &reg.affine {
         let sv = af.tr.singular_values();
         println!(

@@ -198,6 +198,7 @@ fn three_reflectors_beat_single_reflector_calibrations() {
     }
     let mean_single = singles.iter().sum::<f64>() / 3.0;
     let j = validation_mean(&joint);
+    eprintln!("three reflectors: joint {j:.5} mm, single {singles:.5?} mm");
     assert!(
         j < mean_single,
         "joint {j:.5} mm against single-reflector {singles:?} (mean {mean_single:.5})"
@@ -324,6 +325,7 @@ fn six_dof_recovers_the_tool_orientation() {
     let (pc, pv) = (positions_only(&cal), positions_only(&val));
     let three = calibrate(&nominal, data(&pc, &pv), &ls(), &()).unwrap();
     let (a, b) = (validation_mean(&six), validation_mean(&three));
+    eprintln!("6-DoF: validation {a:.5} mm, position-only {b:.5} mm");
     assert!(
         a <= b * 1.02,
         "6-DoF {a:.5} mm against position-only {b:.5} mm"
@@ -360,6 +362,7 @@ fn a_zero_nominal_tool_gives_the_same_calibration_as_a_good_one() {
         .zip(vb)
         .map(|(x, y)| (x - y).abs())
         .fold(0.0, f64::max);
+    eprintln!("zero nominal tool: validation differs by at most {worst:.2e} mm");
     assert!(worst < 1e-3, "validation differs by {worst} mm");
     // The fitted tool is the good one, whatever the guess.
     for k in 0..3 {
@@ -431,6 +434,10 @@ fn weighting_by_the_tracker_model_is_efficient_and_honest() {
     // 40 seeds: the sample std's own relative uncertainty is 1/sqrt(2*39) = 11%; 20% is about
     // two of those.
     let ratio = predicted / spread;
+    eprintln!(
+        "weighting: weighted {vw:.5} mm, unweighted {vu:.5} mm against the truth; std of a2 \
+         predicted {predicted:.3e}, Monte Carlo {spread:.3e} (ratio {ratio:.3})"
+    );
     assert!(
         (0.8..1.25).contains(&ratio),
         "predicted std {predicted:e} against Monte Carlo spread {spread:e} (ratio {ratio:.3})"
