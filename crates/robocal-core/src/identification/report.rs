@@ -170,7 +170,7 @@ impl Calibration {
                 iterations: a.iterations,
                 stats: a.stats,
             }),
-            tool_fit: Some(crate::io::result_cell::ToolFitEntry {
+            tool_fit: Some(crate::io::result_sections::ToolFitEntry {
                 frame: FrameVec::from_tracker_frame(&self.tool_fit.frame),
                 tools: self
                     .tool_fit

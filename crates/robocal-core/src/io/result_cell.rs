@@ -1,8 +1,7 @@
-//! Result sections for what a real cell adds (issue: several reflectors, 6-DoF data, new
-//! stations): orientation errors of 6-DoF data, the tool points fitted before identification
-//! (Table II with the fitted tool) and the frame validation points fitted of their own.
+//! Result sections for 6-DoF data: orientation errors (deg). (The tool points fitted before
+//! identification and the validation's own frame belong to the registration section,
+//! [`super::result_sections::Registration`].)
 
-use crate::io::result_sections::FrameVec;
 use crate::stats::ErrorStats;
 use serde::{Deserialize, Serialize};
 
@@ -52,24 +51,4 @@ pub struct OrientationErrors {
     /// On the validation points.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub validation: Option<AngleBeforeAfter>,
-}
-
-/// `registration.tool_fit`: the frame and tool vectors fitted to the nominal geometry before
-/// identification.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ToolFitEntry {
-    /// The frame fitted with the tools (the result's `tracker_frame`).
-    pub frame: FrameVec,
-    /// Every target's fitted tool vector (mm, deg).
-    pub tools: Vec<[f64; 6]>,
-    /// Alternations run.
-    pub iterations: usize,
-    /// Whether they converged.
-    pub converged: bool,
-    /// Whether the calibration started from them (not when the nominal geometry misses the
-    /// data by more than the plausibility gate's nominal-error limit).
-    #[serde(default)]
-    pub applied: bool,
-    /// Errors of the nominal geometry with the fitted tools (Table II with the fitted tool).
-    pub stats: ErrorStats,
 }

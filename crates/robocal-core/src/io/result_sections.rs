@@ -249,7 +249,7 @@ pub struct Registration {
     pub affine: Option<AffineEntry>,
     /// The frame and tools fitted to the nominal geometry before identification.
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub tool_fit: Option<super::result_cell::ToolFitEntry>,
+    pub tool_fit: Option<ToolFitEntry>,
     /// The frame the validation points were given of their own (another tracker station).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub validation_frame: Option<FrameVec>,
@@ -569,4 +569,24 @@ impl FrameVec {
     pub fn to_tracker_frame(&self) -> TrackerFrame {
         TrackerFrame::from_vector_deg(&[self.x, self.y, self.z, self.a, self.b, self.c])
     }
+}
+
+/// `registration.tool_fit`: the frame and tool vectors fitted to the nominal geometry before
+/// identification.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ToolFitEntry {
+    /// The frame fitted with the tools (the result's `tracker_frame`).
+    pub frame: FrameVec,
+    /// Every target's fitted tool vector (mm, deg).
+    pub tools: Vec<[f64; 6]>,
+    /// Alternations run.
+    pub iterations: usize,
+    /// Whether they converged.
+    pub converged: bool,
+    /// Whether the calibration started from them (not when the nominal geometry misses the
+    /// data by more than the plausibility gate's nominal-error limit).
+    #[serde(default)]
+    pub applied: bool,
+    /// Errors of the nominal geometry with the fitted tools (Table II with the fitted tool).
+    pub stats: ErrorStats,
 }

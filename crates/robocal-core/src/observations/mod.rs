@@ -36,6 +36,8 @@ pub struct Observations {
     /// Weight of orientation rows: mm of position error one radian of orientation error
     /// counts as (see [`Weighting`]).
     mm_per_rad: f64,
+    /// The sum of `sigma` (kept with it).
+    sigma_sum: f64,
 }
 
 impl Default for Observations {
@@ -71,6 +73,7 @@ impl Observations {
             rotation: None,
             sigma: None,
             mm_per_rad: DEFAULT_MM_PER_DEG.to_degrees(),
+            sigma_sum: 0.0,
         }
     }
 
@@ -208,6 +211,7 @@ impl Observations {
                 Some(v) => v[i] = s,
                 None => self.sigma = Some(vec![s]),
             }
+            self.sigma_sum += s;
         }
         Ok(())
     }
@@ -261,6 +265,7 @@ impl Observations {
                 ));
             }
         }
+        self.sigma_sum = sigma.as_ref().map_or(0.0, |s| s.iter().sum());
         self.sigma = sigma;
         Ok(())
     }
@@ -292,9 +297,11 @@ impl Observations {
         }
     }
 
+    /// The mean uncertainty (mm), 1 without uncertainties: the sum is kept as the sigmas are
+    /// set, so [`Observations::weight`] costs O(1) in the hot loop.
     fn sigma_mean(&self) -> f64 {
         match &self.sigma {
-            Some(s) if !s.is_empty() => s.iter().sum::<f64>() / s.len() as f64,
+            Some(s) if !s.is_empty() => self.sigma_sum / s.len() as f64,
             _ => 1.0,
         }
     }
