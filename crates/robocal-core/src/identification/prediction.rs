@@ -16,10 +16,11 @@ use crate::observations::Observations;
 use crate::simulation::{random_poses, PoseSampler};
 use nalgebra::{DMatrix, Matrix3, SymmetricEigen, Vector3};
 use rand::SeedableRng;
-use rand_distr::{Distribution, StandardNormal};
 
-/// Standard normal samples behind every expected norm (deterministic, see the module docs).
-const SAMPLES: usize = 8192;
+/// Directions behind every expected norm (a Fibonacci sphere; see [`NormExpectation`]). 512
+/// average a smooth function of the direction to well under 0.5%; 8192 random normal samples
+/// (the first version) took about 12 ms of a 14 ms 75-pose calibration.
+const SAMPLES: usize = 512;
 
 /// Most poses averaged over: larger sets are thinned evenly (the mean changes by far less than
 /// the prediction's own uncertainty).
@@ -85,15 +86,18 @@ struct NormExpectation {
 }
 
 impl NormExpectation {
+    /// `e = r u` with `r ~ chi(3)` and `u` uniform on the sphere, independent: `E|e|` for
+    /// `e ~ N(0, diag(l))` is `E[r] E_u sqrt(u^T diag(l) u)`, `E[r] = 2 sqrt(2/pi)`. The
+    /// directions are a Fibonacci sphere (deterministic, evenly spread), each scaled by `E[r]`.
     fn new() -> Self {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x5EED);
+        let er = 2.0 * (2.0 / std::f64::consts::PI).sqrt();
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
         let z = (0..SAMPLES)
-            .map(|_| {
-                let mut v = [0.0; 3];
-                for x in &mut v {
-                    *x = StandardNormal.sample(&mut rng);
-                }
-                v
+            .map(|i| {
+                let y = 1.0 - (2.0 * i as f64 + 1.0) / SAMPLES as f64;
+                let r = (1.0 - y * y).max(0.0).sqrt();
+                let t = golden * i as f64;
+                [er * r * t.cos(), er * y, er * r * t.sin()]
             })
             .collect();
         NormExpectation { z }
