@@ -3,42 +3,18 @@
 
 use super::pipeline::{calibrate, CalibrationData, CalibrationSettings};
 use super::Observations;
-use crate::frame::{pose, TrackerFrame};
 use crate::identification::objective::Objective;
 use crate::model::family::reflector;
 use crate::model::presets::preset;
 use crate::model::{Param, Robot};
 use crate::observations::{RowExtras, TrackerSigma, Weighting};
-use crate::simulation::{random_poses, PoseSampler, Tracker};
+use crate::simulation::{random_poses, Tracker};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-fn tracker(sigma_mm: f64, per_m: f64) -> Tracker {
-    let deg = |v: f64| v.to_radians();
-    Tracker::new(
-        TrackerFrame::new(pose(&[
-            3900.0,
-            -2200.0,
-            -350.0,
-            deg(152.0),
-            deg(0.4),
-            deg(-0.7),
-        ])),
-        sigma_mm,
-        per_m,
-    )
-    .unwrap()
-}
-
-fn sampler() -> PoseSampler {
-    PoseSampler {
-        floor_z_mm: 0.0,
-        footprint_radius_mm: 800.0,
-        max_tries_per_pose: 10_000,
-    }
-}
+use super::tests::{sampler, tracker};
 
 /// Three reflectors on the KUKA's tool plate (nominal tool vectors, mm and rad).
 fn tools(robot: &Robot) -> Vec<[f64; 6]> {
@@ -102,6 +78,21 @@ fn measure_all(
     obs
 }
 
+/// Calibrates `nominal` on `cal`, validated on `val`.
+fn run(
+    nominal: &Robot,
+    cal: &Observations,
+    val: &Observations,
+    settings: &CalibrationSettings,
+) -> super::pipeline::Calibration {
+    let data = CalibrationData {
+        calibration: cal,
+        plane: None,
+        validation: Some(val),
+    };
+    calibrate(nominal, data, settings, &()).unwrap()
+}
+
 fn ls() -> CalibrationSettings {
     CalibrationSettings {
         objective: Objective::LeastSquares,
@@ -125,17 +116,7 @@ fn three_reflectors_noise_free_are_recovered_exactly() {
     let val = measure_all(&truth, &tr, &vq, &[0, 1, 2], &mut rng);
     // Stacked targets are one pose seen three times, not duplicated poses.
     cal.check_no_duplicate_poses().unwrap();
-    let c = calibrate(
-        &nominal,
-        CalibrationData {
-            calibration: &cal,
-            plane: None,
-            validation: Some(&val),
-        },
-        &ls(),
-        &(),
-    )
-    .unwrap();
+    let c = run(&nominal, &cal, &val, &ls());
     let v = c.validation.as_ref().unwrap().after_stats();
     assert!(v.max_mm < 1e-6, "validation max {} mm", v.max_mm);
     for t in 1..3 {
@@ -159,17 +140,7 @@ fn three_reflectors_beat_single_reflector_calibrations() {
     let vq = random_poses(&truth, 60, &sampler(), &mut rng).unwrap();
     let cal = measure_all(&truth, &tr, &qs, &[0, 1, 2], &mut rng);
     let val = measure_all(&truth, &tr, &vq, &[0, 1, 2], &mut rng);
-    let joint = calibrate(
-        &nominal,
-        CalibrationData {
-            calibration: &cal,
-            plane: None,
-            validation: Some(&val),
-        },
-        &ls(),
-        &(),
-    )
-    .unwrap();
+    let joint = run(&nominal, &cal, &val, &ls());
     // Each reflector on its own: a one-target robot whose tool is that reflector's.
     let mut singles = Vec::new();
     for t in 0..3 {
@@ -183,17 +154,7 @@ fn three_reflectors_beat_single_reflector_calibrations() {
             out
         };
         let (c1, v1) = (pick(&cal), pick(&val));
-        let c = calibrate(
-            &one,
-            CalibrationData {
-                calibration: &c1,
-                plane: None,
-                validation: Some(&v1),
-            },
-            &ls(),
-            &(),
-        )
-        .unwrap();
+        let c = run(&one, &c1, &v1, &ls());
         singles.push(validation_mean(&c));
     }
     let mean_single = singles.iter().sum::<f64>() / 3.0;
@@ -277,17 +238,7 @@ fn six_dof_recovers_the_tool_orientation() {
     let cal = measure_frames(&truth, &tr0, &qs, 0.0, &mut rng);
     let val = measure_frames(&truth, &tr0, &vq, 0.0, &mut rng);
     assert_eq!(cal.kind().key(), "pose6");
-    let c = calibrate(
-        &nominal,
-        CalibrationData {
-            calibration: &cal,
-            plane: None,
-            validation: Some(&val),
-        },
-        &ls(),
-        &(),
-    )
-    .unwrap();
+    let c = run(&nominal, &cal, &val, &ls());
     for k in 3..6 {
         let p = Param::tool(k);
         assert!(

@@ -10,7 +10,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 /// A tracker about 4 m from the base, turned about its vertical axis and slightly tilted.
-fn tracker(sigma_mm: f64, per_m: f64) -> Tracker {
+pub(super) fn tracker(sigma_mm: f64, per_m: f64) -> Tracker {
     let deg = |v: f64| v.to_radians();
     Tracker::new(
         TrackerFrame::new(pose(&[
@@ -27,7 +27,7 @@ fn tracker(sigma_mm: f64, per_m: f64) -> Tracker {
     .unwrap()
 }
 
-fn sampler() -> PoseSampler {
+pub(super) fn sampler() -> PoseSampler {
     PoseSampler {
         floor_z_mm: 0.0,
         footprint_radius_mm: 800.0,
