@@ -294,9 +294,20 @@ pub fn analyze(
     obs: &Observations,
     opts: &IdentifiabilityOptions,
 ) -> Result<Identifiability> {
+    analyze_reduced(robot, obs, opts, &jacobian_r(robot, obs))
+}
+
+/// [`analyze`] from the reduced Jacobian `reduced` of `robot` at the poses of `obs`
+/// ([`jacobian_r`]), for a second analysis of the same data with other options.
+pub fn analyze_reduced(
+    robot: &Robot,
+    obs: &Observations,
+    opts: &IdentifiabilityOptions,
+    reduced: &Reduced,
+) -> Result<Identifiability> {
     let all = robot.param_list();
     let n = all.len();
-    let Reduced { r, angular } = jacobian_r(robot, obs);
+    let Reduced { r, angular } = reduced;
     let blind = obs.kind().blind_to_orientation();
     let npts = obs.len().max(1) as f64;
     let norms: Vec<f64> = (0..n).map(|j| r.column(j).norm()).collect();

@@ -12,8 +12,8 @@
 use crate::error::{Error, Result};
 use crate::identification::covariance::Covariance;
 use crate::identification::identifiability::{
-    analyze, FixReason, Identifiability, IdentifiabilityOptions, MAX_CONDITION_NUMBER,
-    MIN_RANK_TOLERANCE,
+    analyze_reduced, jacobian_r, FixReason, Identifiability, IdentifiabilityOptions,
+    MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
 };
 use crate::identification::objective::{
     robust_sigma, Loss, Objective, RobustLoss, ADAPTIVE_THRESHOLD_SIGMAS, ROBUST_SCALE_SIGMAS,
@@ -319,7 +319,8 @@ pub fn calibrate(
     };
 
     observer.progress(progress::Stage::Identifiability, 0, 1);
-    let mut ident = analyze(&start, cal, idopts)?;
+    let reduced = jacobian_r(&start, cal);
+    let mut ident = analyze_reduced(&start, cal, idopts, &reduced)?;
     // Parameters independent in principle that these data cannot pin (precision.rs).
     // Only with the tools fitted (see above): otherwise the bound means nothing.
     let sigma0 = if tool_fit.applied {
@@ -336,7 +337,7 @@ pub fn calibrate(
     if !undetermined.is_empty() {
         let mut opts = idopts.clone();
         opts.fix.extend(undetermined.iter().map(|u| u.param));
-        ident = analyze(&start, cal, &opts)?;
+        ident = analyze_reduced(&start, cal, &opts, &reduced)?;
         for f in &mut ident.fixed {
             if let Some(u) = undetermined.iter().find(|u| u.param == f.param) {
                 f.reason = FixReason::Undetermined {

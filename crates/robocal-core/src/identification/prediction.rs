@@ -5,8 +5,8 @@
 //! seen through the tool point's Jacobian `J(q)` of the identified parameters, plus the new
 //! measurement's own noise `eps` (per-axis standard deviation `sigma`, estimated from the
 //! calibration residuals). So `e` is Gaussian with covariance `Sigma(q) = J C J^T + sigma^2 I`,
-//! and the expected error norm at q is `E|e|`, computed from `Sigma`'s eigenvalues with a fixed
-//! set of standard normal samples (deterministic; the error of the expectation is below 0.5%).
+//! and the expected error norm at q is `E|e|`, computed from `Sigma`'s eigenvalues (closed form)
+//! by a fixed Gauss quadrature over the sphere (deterministic; exact to about 1e-6).
 //! Averaged over the calibration poses, that is the expected mean error at new poses spread like
 //! them ([`Prediction::mean_mm`]), the figure a validation set measures.
 
@@ -14,13 +14,13 @@ use crate::identification::covariance::Covariance;
 use crate::model::{Param, Robot};
 use crate::observations::Observations;
 use crate::simulation::{random_poses, PoseSampler};
-use nalgebra::{DMatrix, Matrix3, SymmetricEigen, Vector3};
+use nalgebra::{DMatrix, Matrix3, Vector3};
 use rand::SeedableRng;
 
-/// Directions behind every expected norm (a Fibonacci sphere; see [`NormExpectation`]). 512
-/// average a smooth function of the direction to well under 0.5%; 8192 random normal samples
-/// (the first version) took about 12 ms of a 14 ms 75-pose calibration.
-const SAMPLES: usize = 512;
+/// Gauss-Legendre nodes per coordinate of the sphere's octant ([`NormExpectation`]): 12 x 12
+/// = 144 evaluations per pose, against 512 directions of a Fibonacci sphere (0.5%) and 8192
+/// random normals (the first version, 12 ms of a 14 ms 75-pose calibration) before.
+const QUADRATURE_NODES: usize = 12;
 
 /// Most poses averaged over: larger sets are thinned evenly (the mean changes by far less than
 /// the prediction's own uncertainty).
@@ -80,39 +80,124 @@ pub fn point_jacobian(
     p
 }
 
-/// Expected norms of zero-mean Gaussian vectors of given covariances: one fixed sample set.
+/// Expected norms of zero-mean Gaussian vectors of given covariances, by quadrature.
+///
+/// For `e ~ N(0, Sigma)` with eigenvalues `l` of `Sigma`, `e = r u` in `Sigma`'s eigenbasis with
+/// `r ~ chi(3)` and `u` uniform on the sphere, independent (in the whitened coordinates), so
+/// `E|e| = E[r] E_u sqrt(l_0 u_0^2 + l_1 u_1^2 + l_2 u_2^2)`, `E[r] = 2 sqrt(2/pi)`. The integrand is
+/// even in every coordinate: the mean over the sphere is the mean over one octant, where it is
+/// smooth (no kink at `u_i = 0`), and a product Gauss-Legendre rule in the polar angle and the
+/// azimuth (area element `sin(theta) dtheta dphi`) integrates it to about 1e-6 relative.
 struct NormExpectation {
-    z: Vec<[f64; 3]>,
+    /// Nodes `(u_0^2, u_1^2, u_2^2)` and weights (summing to `E[r]`).
+    nodes: Vec<([f64; 3], f64)>,
 }
 
 impl NormExpectation {
-    /// `e = r u` with `r ~ chi(3)` and `u` uniform on the sphere, independent: `E|e|` for
-    /// `e ~ N(0, diag(l))` is `E[r] E_u sqrt(u^T diag(l) u)`, `E[r] = 2 sqrt(2/pi)`. The
-    /// directions are a Fibonacci sphere (deterministic, evenly spread), each scaled by `E[r]`.
     fn new() -> Self {
         let er = 2.0 * (2.0 / std::f64::consts::PI).sqrt();
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        let z = (0..SAMPLES)
-            .map(|i| {
-                let y = 1.0 - (2.0 * i as f64 + 1.0) / SAMPLES as f64;
-                let r = (1.0 - y * y).max(0.0).sqrt();
-                let t = golden * i as f64;
-                [er * r * t.cos(), er * y, er * r * t.sin()]
-            })
-            .collect();
-        NormExpectation { z }
+        let (x, w) = gauss_legendre(QUADRATURE_NODES);
+        let mut nodes = Vec::with_capacity(x.len() * x.len());
+        let quarter_pi = 0.25 * std::f64::consts::PI;
+        for (&xt, &wt) in x.iter().zip(&w) {
+            // Polar angle theta and azimuth phi, both in [0, pi/2].
+            let (st, ct) = (quarter_pi * (xt + 1.0)).sin_cos();
+            for (&xp, &wp) in x.iter().zip(&w) {
+                let (sp, cp) = (quarter_pi * (xp + 1.0)).sin_cos();
+                // The octant's mean: (2 / pi) of the integral of f sin(theta), each rule
+                // scaled by pi / 4.
+                let weight = er * 0.125 * std::f64::consts::PI * wt * wp * st;
+                nodes.push(([st * st * cp * cp, st * st * sp * sp, ct * ct], weight));
+            }
+        }
+        NormExpectation { nodes }
     }
 
     /// `E|e|` for `e ~ N(0, s)`.
     fn mean_norm(&self, s: &Matrix3<f64>) -> f64 {
-        let ev = SymmetricEigen::new(*s).eigenvalues;
+        let ev = sym3_eigenvalues(s);
         let l = [ev[0].max(0.0), ev[1].max(0.0), ev[2].max(0.0)];
-        let sum: f64 = self
-            .z
+        self.nodes
             .iter()
-            .map(|z| (l[0] * z[0] * z[0] + l[1] * z[1] * z[1] + l[2] * z[2] * z[2]).sqrt())
-            .sum();
-        sum / self.z.len() as f64
+            .map(|(u, w)| w * (l[0] * u[0] + l[1] * u[1] + l[2] * u[2]).sqrt())
+            .sum()
+    }
+}
+
+/// Nodes and weights of the `n`-point Gauss-Legendre rule on [-1, 1] (Newton's iteration on the
+/// Legendre polynomial from the usual cosine guesses; a dozen nodes, computed once per
+/// prediction: a quadrature crate would be a dependency for twenty lines).
+fn gauss_legendre(n: usize) -> (Vec<f64>, Vec<f64>) {
+    let mut x = vec![0.0; n];
+    let mut w = vec![0.0; n];
+    for i in 0..n {
+        let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            // P_n(z) and its derivative by the three-term recurrence.
+            let (mut p0, mut p1) = (1.0, z);
+            for m in 2..=n {
+                let m = m as f64;
+                let p2 = ((2.0 * m - 1.0) * z * p1 - (m - 1.0) * p0) / m;
+                p0 = p1;
+                p1 = p2;
+            }
+            let pn = if n == 0 { 1.0 } else { p1 };
+            let pm = if n <= 1 { 1.0 } else { p0 };
+            dp = n as f64 * (z * pn - pm) / (z * z - 1.0);
+            let dz = pn / dp;
+            z -= dz;
+            if dz.abs() < 1e-15 {
+                break;
+            }
+        }
+        x[i] = z;
+        w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
+    }
+    (x, w)
+}
+
+/// Eigenvalues of a symmetric 3 x 3 matrix in closed form (the trigonometric solution of the
+/// characteristic cubic), largest first. Absolute accuracy about 1e-15 of the matrix's norm,
+/// which is what the expected norms need; nalgebra's iterative solver took a tenth of a
+/// prediction's time.
+fn sym3_eigenvalues(m: &Matrix3<f64>) -> [f64; 3] {
+    let p1 = m[(0, 1)].powi(2) + m[(0, 2)].powi(2) + m[(1, 2)].powi(2);
+    let q = m.trace() / 3.0;
+    let d = [m[(0, 0)] - q, m[(1, 1)] - q, m[(2, 2)] - q];
+    let p2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + 2.0 * p1;
+    if p2 <= f64::MIN_POSITIVE {
+        return [q, q, q];
+    }
+    let p = (p2 / 6.0).sqrt();
+    let b = (m - Matrix3::identity() * q) / p;
+    let r = (b.determinant() / 2.0).clamp(-1.0, 1.0);
+    let phi = r.acos() / 3.0;
+    let e1 = q + 2.0 * p * phi.cos();
+    let e3 = q + 2.0 * p * (phi + 2.0 * std::f64::consts::PI / 3.0).cos();
+    [e1, 3.0 * q - e1 - e3, e3]
+}
+
+/// From this many poses, the per-pose work of a prediction runs on several threads (each pose's
+/// figures are computed on their own and summed in order: the same bits on any thread count).
+const PARALLEL_MIN_POSES: usize = 256;
+
+/// `f(i)` for `i` in `0..n`, in order; on several threads for large `n`. `scratch` makes each
+/// thread's (or the single loop's) reusable buffers.
+fn map_poses<T: Send, S>(
+    n: usize,
+    scratch: impl Fn() -> S + Sync + Send,
+    f: impl Fn(&mut S, usize) -> T + Sync + Send,
+) -> Vec<T> {
+    use rayon::prelude::*;
+    if n >= PARALLEL_MIN_POSES {
+        (0..n)
+            .into_par_iter()
+            .map_init(&scratch, |s, i| f(s, i))
+            .collect()
+    } else {
+        let mut s = scratch();
+        (0..n).map(|i| f(&mut s, i)).collect()
     }
 }
 
@@ -121,9 +206,17 @@ impl NormExpectation {
 pub struct Predictor<'a> {
     robot: &'a Robot,
     index: Vec<usize>,
-    cov: &'a DMatrix<f64>,
+    /// The covariance, row-major (k x k).
+    cov: Vec<f64>,
     sigma: f64,
     norms: NormExpectation,
+}
+
+/// Reusable buffers of one thread's predictions.
+struct Scratch {
+    jp: Vec<Vector3<f64>>,
+    j: Vec<f64>,
+    x: Vec<f64>,
 }
 
 impl<'a> Predictor<'a> {
@@ -137,42 +230,90 @@ impl<'a> Predictor<'a> {
             .iter()
             .map(|p: &Param| robot.param_position(*p))
             .collect::<Option<Vec<_>>>()?;
+        let k = index.len();
+        let cov = (0..k * k).map(|i| cov.matrix[(i / k, i % k)]).collect();
         Some(Predictor {
             robot,
             index,
-            cov: &cov.matrix,
+            cov,
             sigma: noise_sigma_mm,
             norms: NormExpectation::new(),
         })
     }
 
+    fn scratch(&self) -> Scratch {
+        let k = self.index.len();
+        Scratch {
+            jp: vec![Vector3::zeros(); self.robot.param_count()],
+            j: vec![0.0; 3 * k],
+            x: vec![0.0; 3 * k],
+        }
+    }
+
+    /// `J C J^T` for the 3 x k rows `j` (row-major); `x` is scratch of 3 k.
+    fn model_covariance(&self, j: &[f64], x: &mut [f64]) -> Matrix3<f64> {
+        let k = self.index.len();
+        // x = J C (C symmetric, read by rows).
+        for r in 0..3 {
+            let jr = &j[r * k..(r + 1) * k];
+            let xr = &mut x[r * k..(r + 1) * k];
+            xr.fill(0.0);
+            for (a, &ja) in jr.iter().enumerate() {
+                if ja != 0.0 {
+                    for (xv, cv) in xr.iter_mut().zip(&self.cov[a * k..(a + 1) * k]) {
+                        *xv += ja * cv;
+                    }
+                }
+            }
+        }
+        let mut m = Matrix3::zeros();
+        for r in 0..3 {
+            for c in r..3 {
+                let v: f64 = x[r * k..(r + 1) * k]
+                    .iter()
+                    .zip(&j[c * k..(c + 1) * k])
+                    .map(|(a, b)| a * b)
+                    .sum();
+                m[(r, c)] = v;
+                m[(c, r)] = v;
+            }
+        }
+        m
+    }
+
+    /// The expected error norm of a measurement whose model error has covariance `model`.
+    fn mean_norm(&self, model: &Matrix3<f64>) -> f64 {
+        self.norms
+            .mean_norm(&(model + Matrix3::identity() * (self.sigma * self.sigma)))
+    }
+
+    /// Tool point of target `t` and `J C J^T` at joints `q`.
+    fn model_at(&self, s: &mut Scratch, q: &[f64], t: usize) -> (Vector3<f64>, Matrix3<f64>) {
+        let p = target_jacobian(self.robot, &self.index, q, t, &mut s.jp, &mut s.j);
+        (p, self.model_covariance(&s.j, &mut s.x))
+    }
+
     /// At joints `q`: the tool point, the covariance of the model's error `J C J^T` (mm^2) and
     /// the expected error norm of a measurement.
     pub fn at(&self, q: &[f64]) -> (Vector3<f64>, Matrix3<f64>, f64) {
-        let k = self.index.len();
-        let mut jp = vec![Vector3::zeros(); self.robot.param_count()];
-        let mut j = vec![0.0; 3 * k];
-        let p = point_jacobian(self.robot, &self.index, q, &mut jp, &mut j);
-        let jm = DMatrix::from_row_slice(3, k, &j);
-        let m = &jm * self.cov * jm.transpose();
-        let model = Matrix3::from_fn(|r, c| 0.5 * (m[(r, c)] + m[(c, r)]));
-        let total = model + Matrix3::identity() * (self.sigma * self.sigma);
-        (p, model, self.norms.mean_norm(&total))
+        let (p, model) = self.model_at(&mut self.scratch(), q, 0);
+        (p, model, self.mean_norm(&model))
     }
 
-    /// The prediction over poses `qs` (the calibration poses) and the workspace map.
-    pub fn predict(&self, qs: &[&[f64]], floor_z_mm: f64) -> Prediction {
-        let stride = qs.len().div_ceil(MAX_POSES).max(1);
-        let (mut sum, mut sum_sq, mut model_sq, mut n) = (0.0, 0.0, 0.0, 0usize);
-        for q in qs.iter().step_by(stride) {
-            let (_, model, mean) = self.at(q);
+    /// The prediction from the model-error covariances `J C J^T` of the poses averaged over (the
+    /// calibration poses), and the workspace map.
+    fn predict_from(&self, models: &[Matrix3<f64>], floor_z_mm: f64) -> Prediction {
+        let stride = models.len().div_ceil(MAX_POSES).max(1);
+        let picked: Vec<&Matrix3<f64>> = models.iter().step_by(stride).collect();
+        let means = map_poses(picked.len(), || (), |_, i| self.mean_norm(picked[i]));
+        let (mut sum, mut sum_sq, mut model_sq) = (0.0, 0.0, 0.0);
+        for (model, mean) in picked.iter().zip(&means) {
             let tr = model.trace();
             sum += mean;
             sum_sq += tr + 3.0 * self.sigma * self.sigma;
             model_sq += tr;
-            n += 1;
         }
-        let nf = n.max(1) as f64;
+        let nf = picked.len().max(1) as f64;
         let mean_mm = sum / nf;
         let ms = sum_sq / nf;
         Prediction {
@@ -183,6 +324,16 @@ impl<'a> Predictor<'a> {
             model_rms_mm: (model_sq / nf).sqrt(),
             map: self.map(floor_z_mm),
         }
+    }
+
+    /// The prediction over poses `qs` (the calibration poses) and the workspace map.
+    pub fn predict(&self, qs: &[&[f64]], floor_z_mm: f64) -> Prediction {
+        let models = map_poses(
+            qs.len(),
+            || self.scratch(),
+            |s, i| self.model_at(s, qs[i], 0).1,
+        );
+        self.predict_from(&models, floor_z_mm)
     }
 
     /// [`MAP_POSES`] random poses within the joint limits, tool no lower than `floor_z_mm`
@@ -198,17 +349,38 @@ impl<'a> Predictor<'a> {
         let Ok(qs) = random_poses(self.robot, MAP_POSES, &sampler, &mut rng) else {
             return Vec::new();
         };
-        qs.iter()
-            .map(|q| {
-                let (position, model, mean_mm) = self.at(q);
+        map_poses(
+            qs.len(),
+            || self.scratch(),
+            |s, i| {
+                let (position, model) = self.model_at(s, &qs[i], 0);
                 MapPoint {
                     position,
-                    mean_mm,
+                    mean_mm: self.mean_norm(&model),
                     model_mm: model.trace().max(0.0).sqrt(),
                 }
-            })
-            .collect()
+            },
+        )
     }
+}
+
+/// [`point_jacobian`] for target `t` (0-based) of the robot's targets.
+fn target_jacobian(
+    robot: &Robot,
+    index: &[usize],
+    q: &[f64],
+    t: usize,
+    jp: &mut [Vector3<f64>],
+    out: &mut [f64],
+) -> Vector3<f64> {
+    let k = index.len();
+    let (p, _) = robot.target_screws(q, t, None, Some(jp), None);
+    for (c, &i) in index.iter().enumerate() {
+        for r in 0..3 {
+            out[r * k + c] = jp[i][r];
+        }
+    }
+    p
 }
 
 /// The per-axis noise of the calibration residuals `norms` (mm) over `rows` rows each: the
@@ -242,28 +414,54 @@ pub fn noise_sigma(
     (sum / kept.len() as f64).sqrt()
 }
 
-/// The leverages `h_i = tr(J_i S^-1 J_i^T)` of points `kept` (Jacobian blocks `jac`, `rows x k`
-/// row-major each), `S = sum J^T J` over them; `None` when `S` is singular.
-fn leverages(jac: &[Vec<f64>], k: usize, rows: usize, kept: &[usize]) -> Option<Vec<f64>> {
-    let mut s = DMatrix::zeros(k, k);
+/// The leverages `h_i = tr(J_i S^-1 J_i^T)` of points `kept` (Jacobian blocks of `rows x k`,
+/// row-major, point i's at `jac[i * rows * k..]`), `S = sum J^T J` over them; `None` when `S` is
+/// singular. With `S = L L^T`, `h_i` is the squared norm of `L^-1 J_i^T`, by forward
+/// substitution row by row.
+fn leverages(jac: &[f64], k: usize, rows: usize, kept: &[usize]) -> Option<Vec<f64>> {
+    let block = rows * k;
+    let mut upper = vec![0.0; k * k];
     for &i in kept {
-        let j = DMatrix::from_row_slice(rows, k, &jac[i]);
-        s += j.transpose() * &j;
+        let j = &jac[i * block..(i + 1) * block];
+        for r in 0..rows {
+            let jr = &j[r * k..(r + 1) * k];
+            for a in 0..k {
+                if jr[a] != 0.0 {
+                    let row = &mut upper[a * k..(a + 1) * k];
+                    for b in a..k {
+                        row[b] += jr[a] * jr[b];
+                    }
+                }
+            }
+        }
     }
-    let ch = s.cholesky()?;
-    Some(
-        kept.iter()
-            .map(|&i| {
-                let j = DMatrix::from_row_slice(rows, k, &jac[i]);
-                let x = ch.solve(&j.transpose());
-                (&j * x).trace()
-            })
-            .collect(),
-    )
+    let s = DMatrix::from_fn(k, k, |r, c| upper[r.min(c) * k + r.max(c)]);
+    let l = s.cholesky()?.unpack();
+    let l: Vec<f64> = (0..k * k).map(|i| l[(i / k, i % k)]).collect();
+    let h = map_poses(
+        kept.len(),
+        || vec![0.0; k],
+        |y, n| {
+            let j = &jac[kept[n] * block..(kept[n] + 1) * block];
+            let mut h = 0.0;
+            for r in 0..rows {
+                let jr = &j[r * k..(r + 1) * k];
+                for a in 0..k {
+                    let la = &l[a * k..a * k + a];
+                    let dot: f64 = la.iter().zip(&y[..a]).map(|(u, v)| u * v).sum();
+                    y[a] = (jr[a] - dot) / l[a * k + a];
+                    h += y[a] * y[a];
+                }
+            }
+            h
+        },
+    );
+    Some(h)
 }
 
 /// The prediction of a calibrated model from its calibration points (see the module docs);
-/// `None` when the covariance is unavailable or too few points leave no noise estimate.
+/// `None` when the covariance is unavailable or too few points leave no noise estimate. Each
+/// point's Jacobian is that of the target it measures.
 pub fn predict(
     calibrated: &Robot,
     covariance: &Covariance,
@@ -272,30 +470,36 @@ pub fn predict(
     threshold_mm: Option<f64>,
 ) -> Option<Prediction> {
     let rows = calibration.kind().rows();
-    let index = covariance
-        .params
-        .iter()
-        .map(|p| calibrated.param_position(*p))
-        .collect::<Option<Vec<_>>>()?;
-    let k = index.len();
-    let mut jp = vec![Vector3::zeros(); calibrated.param_count()];
-    let jac: Vec<Vec<f64>> = (0..calibration.len())
-        .map(|i| {
-            let mut j = vec![0.0; 3 * k];
-            point_jacobian(calibrated, &index, calibration.q(i), &mut jp, &mut j);
-            j
-        })
-        .collect();
+    // The noise is not known yet: a predictor of zero noise gives the Jacobians' model parts.
+    let pred = Predictor::new(calibrated, covariance, 0.0)?;
+    let k = pred.index.len();
+    let n = calibration.len();
+    let per_pose = map_poses(
+        n,
+        || pred.scratch(),
+        |s, i| {
+            let q = calibration.q(i);
+            let (p, model) = pred.model_at(s, q, calibration.target(i));
+            (s.j.clone(), model, p.z)
+        },
+    );
+    let mut jac = Vec::with_capacity(n * 3 * k);
+    let mut models = Vec::with_capacity(n);
+    let mut floor = f64::INFINITY;
+    for (j, m, z) in per_pose {
+        jac.extend_from_slice(&j);
+        models.push(m);
+        floor = floor.min(z);
+    }
     // (The leverages come from the tool point's rows: exact for point measurements.)
     let sigma = noise_sigma(residual_norms, rows, threshold_mm, &|kept| {
         leverages(&jac, k, 3, kept)
     });
-    let pred = Predictor::new(calibrated, covariance, sigma)?;
-    let qs: Vec<&[f64]> = (0..calibration.len()).map(|i| calibration.q(i)).collect();
-    let floor = (0..calibration.len())
-        .map(|i| calibrated.tool_position(calibration.q(i)).z)
-        .fold(f64::INFINITY, f64::min);
-    Some(pred.predict(&qs, floor))
+    if !sigma.is_finite() {
+        return None;
+    }
+    let pred = Predictor { sigma, ..pred };
+    Some(pred.predict_from(&models, floor))
 }
 
 #[cfg(test)]
@@ -310,12 +514,89 @@ mod tests {
         let s = 0.3;
         let iso = n.mean_norm(&(Matrix3::identity() * s * s));
         let exact = s * (8.0 / std::f64::consts::PI).sqrt();
-        assert!((iso / exact - 1.0).abs() < 0.005, "{iso} vs {exact}");
+        assert!((iso / exact - 1.0).abs() < 1e-12, "{iso} vs {exact}");
         let mut one = Matrix3::zeros();
         one[(1, 1)] = s * s;
         let line = n.mean_norm(&one);
         let exact = s * (2.0 / std::f64::consts::PI).sqrt();
-        assert!((line / exact - 1.0).abs() < 0.01, "{line} vs {exact}");
+        assert!((line / exact - 1.0).abs() < 1e-6, "{line} vs {exact}");
+        // A plane: Rayleigh, E = s sqrt(pi / 2).
+        let mut plane = Matrix3::identity() * s * s;
+        plane[(2, 2)] = 0.0;
+        let flat = n.mean_norm(&plane);
+        let exact = s * (std::f64::consts::FRAC_PI_2).sqrt();
+        assert!((flat / exact - 1.0).abs() < 1e-6, "{flat} vs {exact}");
+    }
+
+    /// Anisotropic covariances, rotated: the quadrature against a fine midpoint rule over the
+    /// whole sphere (800 x 1600 cells in polar angle and azimuth, no symmetry used).
+    #[test]
+    fn expected_norms_match_a_fine_reference() {
+        use nalgebra::Rotation3;
+        let n = NormExpectation::new();
+        let er = 2.0 * (2.0 / std::f64::consts::PI).sqrt();
+        for (l, axis) in [
+            ([1.0, 0.3, 0.01], Vector3::new(0.3, -0.5, 0.8)),
+            ([4.0, 1.0, 1.0], Vector3::new(1.0, 0.0, 0.2)),
+            ([1e-4, 2e-4, 9e-4], Vector3::new(-0.2, 0.7, 0.1)),
+        ] {
+            let r = Rotation3::new(axis).into_inner();
+            let s = r * Matrix3::from_diagonal(&Vector3::from(l)) * r.transpose();
+            let (nt, np) = (800, 1600);
+            let (mut sum, mut area) = (0.0, 0.0);
+            for it in 0..nt {
+                let theta = std::f64::consts::PI * (it as f64 + 0.5) / nt as f64;
+                let (st, ct) = theta.sin_cos();
+                for ip in 0..np {
+                    let phi = std::f64::consts::TAU * (ip as f64 + 0.5) / np as f64;
+                    let u = Vector3::new(st * phi.cos(), st * phi.sin(), ct);
+                    sum += st * u.dot(&(s * u)).max(0.0).sqrt();
+                    area += st;
+                }
+            }
+            let reference = er * sum / area;
+            let got = n.mean_norm(&s);
+            assert!(
+                (got / reference - 1.0).abs() < 1e-5,
+                "{l:?}: {got} vs {reference}"
+            );
+        }
+    }
+
+    #[test]
+    fn closed_form_eigenvalues_match_nalgebra() {
+        use rand::Rng;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for _ in 0..200 {
+            let a = Matrix3::from_fn(|_, _| rng.gen_range(-1.0..1.0));
+            let s = a * a.transpose() + Matrix3::identity() * rng.gen_range(0.0..0.1);
+            let mut want: Vec<f64> = nalgebra::SymmetricEigen::new(s)
+                .eigenvalues
+                .iter()
+                .copied()
+                .collect();
+            want.sort_by(|x, y| y.total_cmp(x));
+            let got = sym3_eigenvalues(&s);
+            for (g, w) in got.iter().zip(&want) {
+                assert!((g - w).abs() < 1e-12 * s.norm(), "{got:?} vs {want:?}");
+            }
+        }
+        let d = Matrix3::from_diagonal(&Vector3::new(2.0, 2.0, 2.0));
+        assert_eq!(sym3_eigenvalues(&d), [2.0, 2.0, 2.0]);
+    }
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_exactly() {
+        let (x, w) = gauss_legendre(QUADRATURE_NODES);
+        for p in 0..2 * QUADRATURE_NODES {
+            let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(p as i32)).sum();
+            let want = if p % 2 == 1 {
+                0.0
+            } else {
+                2.0 / (p as f64 + 1.0)
+            };
+            assert!((got - want).abs() < 1e-14, "x^{p}: {got} vs {want}");
+        }
     }
 
     #[test]

@@ -135,6 +135,8 @@ pub fn solve(
     let s = first.s.as_ref().expect("full pass");
     let col_rms: Vec<f64> = (0..k).map(|j| (s[(j, j)] / n).sqrt()).collect();
     let mut acc = first;
+    // The objective at `robot`'s current values.
+    let mut f_cur = acc.objective;
     let mut report = SolverReport {
         termination: Termination::MaxIterations,
         iterations: 0,
@@ -179,6 +181,7 @@ pub fn solve(
             // majorizer: reliable far from it and for exact fits).
             let mut best_step = f64::INFINITY;
             let mut accepted = false;
+            let mut f_new_accepted = f64::NAN;
             let mut small_change = false;
             for use_newton in [true, false] {
                 let model = match (use_newton, &acc.h) {
@@ -214,11 +217,13 @@ pub fn solve(
                     small_change = acc.objective - f_new <= tol && pred <= tol;
                     lambda *= (1.0 - (2.0 * gain - 1.0).powi(3)).max(1.0 / 3.0);
                     accepted = true;
+                    f_new_accepted = f_new;
                     break;
                 }
                 problem.apply(&mut trial, &x);
             }
             if accepted {
+                f_cur = f_new_accepted;
                 x.copy_from(&x_new);
                 problem.apply(robot, &x);
                 nu = 2.0;
@@ -253,7 +258,7 @@ pub fn solve(
             }
         }
     }
-    report.final_objective = problem.objective(robot, loss);
+    report.final_objective = f_cur;
     report
 }
 

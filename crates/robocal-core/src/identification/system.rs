@@ -7,8 +7,9 @@
 //! respect to the identified parameters. With the loss weight `w_i` of `|e_i|` (see [`Loss`]),
 //! the solver needs `A = sum w_i J_i^T J_i` and `b = sum w_i J_i^T e_i`. They are accumulated
 //! per observation (k x k and k numbers; the stacked Jacobian is never formed) with per-thread
-//! buffers allocated once per pass, so the per-observation work allocates nothing. Large sets are
-//! split across threads with rayon.
+//! buffers allocated once per pass, so the per-observation work allocates nothing. Passes run in
+//! fixed chunks, on several threads from a few hundred observations, with the same result bits
+//! on any number of threads ([`chunked`]).
 
 use crate::frame::TrackerFrame;
 use crate::identification::kinds::{self, MeasurementKind, ToolState};
@@ -22,8 +23,38 @@ use rayon::prelude::*;
 /// plus base and tool).
 pub const MAX_PARAMS: usize = 5 * MAX_JOINTS + 12;
 
-/// Below this many observations the passes run on one thread.
-const PARALLEL_MIN_POINTS: usize = 2048;
+/// Observations per chunk of a pass: each chunk is summed on its own and the chunks' sums are
+/// added in order, so a pass gives the same bits on any number of threads.
+const CHUNK: usize = 256;
+
+/// From this many observations the chunks of a pass run on several threads.
+const PARALLEL_MIN_POINTS: usize = 2 * CHUNK;
+
+/// One pass over observations `0..n`: `add` each into its chunk's state (from `new`), the
+/// chunks in parallel from [`PARALLEL_MIN_POINTS`] on, then `merge` the chunks' states in order.
+/// Deterministic: the grouping depends on `n` only, never on the threads (rayon's own `fold`
+/// splits by work stealing, so its sums would differ in the last bits from run to run).
+pub(crate) fn chunked<T: Send>(
+    n: usize,
+    new: impl Fn() -> T + Sync,
+    add: impl Fn(&mut T, usize) + Sync,
+    merge: impl Fn(T, T) -> T,
+) -> T {
+    let chunk = |c: usize| {
+        let mut t = new();
+        for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+            add(&mut t, i);
+        }
+        t
+    };
+    let chunks = n.div_ceil(CHUNK);
+    if n >= PARALLEL_MIN_POINTS {
+        let parts: Vec<T> = (0..chunks).into_par_iter().map(chunk).collect();
+        parts.into_iter().reduce(merge).unwrap_or_else(new)
+    } else {
+        (0..chunks).map(chunk).reduce(merge).unwrap_or_else(new)
+    }
+}
 
 /// The identification problem: which parameters are unknown, the measurement kind and the
 /// observations' measured values in the ACS.
@@ -185,42 +216,33 @@ impl Acc {
         for (x, v) in we.iter_mut().zip(e) {
             *x = w * v;
         }
-        let mut wa = [0.0; kinds::MAX_ROWS];
         for a in 0..k {
             let mut s = 0.0;
             for rr in 0..rows {
                 s += jr[rr * k + a] * we[rr];
             }
             self.b[a] += s;
-            for rr in 0..rows {
-                wa[rr] = w * jr[rr * k + a];
-            }
-            let row = &mut self.a[a * k..(a + 1) * k];
-            for b in a..k {
-                let mut s = 0.0;
-                for rr in 0..rows {
-                    s += wa[rr] * jr[rr * k + b];
-                }
-                row[b] += s;
-            }
         }
+        add_gram(&mut self.a, jr, rows, k, w);
         if self.full {
             let psi = w * r;
             self.psi_sq += psi * psi;
-            for a in 0..k {
-                let row = &mut self.s[a * k..(a + 1) * k];
-                for b in a..k {
-                    let mut s = 0.0;
-                    for rr in 0..rows {
-                        s += jr[rr * k + a] * jr[rr * k + b];
-                    }
-                    row[b] += s;
-                }
+            // `S = A + sum (1 - w) J^T J`: only the points the loss down-weights add work
+            // (every point of a least-squares pass, and the inliers of the adaptive loss, have
+            // w = 1 exactly).
+            let cw = 1.0 - w;
+            if cw != 0.0 {
+                add_gram(&mut self.s, jr, rows, k, cw);
             }
         }
-        // Radial correction of the Hessian: (l'' - w) (J^T u)(J^T u)^T.
-        if self.newton && r > 0.0 {
-            let c = loss.radial_curvature(r) - w;
+        // Radial correction of the Hessian: (l'' - w) (J^T u)(J^T u)^T; none where the loss
+        // is quadratic (l'' = w).
+        let c = if self.newton && r > 0.0 {
+            loss.radial_curvature(r) - w
+        } else {
+            0.0
+        };
+        if c != 0.0 {
             let mut ue = [0.0; kinds::MAX_ROWS];
             for (x, v) in ue.iter_mut().zip(e) {
                 *x = v / r;
@@ -239,6 +261,42 @@ impl Acc {
                     row[b] += ca * self.u[b];
                 }
             }
+        }
+    }
+}
+
+/// Adds the upper triangle of `scale J^T J` to `m` (k x k, row-major), `J` being `rows x k`
+/// row-major. Point rows (3) take a loop over contiguous row slices that the compiler
+/// vectorizes; the sums are those of the general loop, in the same order.
+#[inline(always)]
+fn add_gram(m: &mut [f64], jr: &[f64], rows: usize, k: usize, scale: f64) {
+    if rows == 3 {
+        let (j0, rest) = jr.split_at(k);
+        let (j1, j2) = rest.split_at(k);
+        for a in 0..k {
+            let (w0, w1, w2) = (scale * j0[a], scale * j1[a], scale * j2[a]);
+            if w0 == 0.0 && w1 == 0.0 && w2 == 0.0 {
+                continue;
+            }
+            let row = &mut m[a * k + a..(a + 1) * k];
+            for (((x, y0), y1), y2) in row.iter_mut().zip(&j0[a..]).zip(&j1[a..]).zip(&j2[a..k]) {
+                *x += w0 * y0 + w1 * y1 + w2 * y2;
+            }
+        }
+        return;
+    }
+    let mut wa = [0.0; kinds::MAX_ROWS];
+    for a in 0..k {
+        for rr in 0..rows {
+            wa[rr] = scale * jr[rr * k + a];
+        }
+        let row = &mut m[a * k..(a + 1) * k];
+        for b in a..k {
+            let mut s = 0.0;
+            for rr in 0..rows {
+                s += wa[rr] * jr[rr * k + b];
+            }
+            row[b] += s;
         }
     }
 }
@@ -497,16 +555,12 @@ impl<'a> Problem<'a> {
 
     /// The objective `sum l(|e_i|)` (forward kinematics only).
     pub fn objective(&self, robot: &Robot, loss: &Loss) -> f64 {
-        let f = |i: usize| loss.value(self.fit_norm(robot, i));
-        if self.len() >= PARALLEL_MIN_POINTS {
-            (0..self.len())
-                .into_par_iter()
-                .with_min_len(512)
-                .map(f)
-                .sum()
-        } else {
-            (0..self.len()).map(f).sum()
-        }
+        chunked(
+            self.len(),
+            || 0.0,
+            |sum, i| *sum += loss.value(self.fit_norm(robot, i)),
+            |a, b| a + b,
+        )
     }
 
     /// One pass over the observations: objective and IRLS normal equations, and what `level`
@@ -516,25 +570,14 @@ impl<'a> Problem<'a> {
         let np = robot.param_count();
         let rows = self.kind.rows();
         let angular = self.angular;
-        let new = || Acc::new(k, rows, np, angular, level);
-        let acc = if self.len() >= PARALLEL_MIN_POINTS {
-            (0..self.len())
-                .into_par_iter()
-                .with_min_len(512)
-                .fold(new, |mut acc, i| {
-                    acc.add_observation(self, robot, loss, i);
-                    acc
-                })
-                .reduce(new, Acc::merge)
-        } else {
-            let mut acc = new();
-            for i in 0..self.len() {
-                acc.add_observation(self, robot, loss, i);
-            }
-            acc
-        };
+        let acc = chunked(
+            self.len(),
+            || Acc::new(k, rows, np, angular, level),
+            |acc, i| acc.add_observation(self, robot, loss, i),
+            Acc::merge,
+        );
         let a = symmetric(k, &acc.a);
-        let s = (level == Level::Full).then(|| symmetric(k, &acc.s));
+        let s = (level == Level::Full).then(|| &a + symmetric(k, &acc.s));
         let h = (level >= Level::Newton).then(|| &a + symmetric(k, &acc.h));
         Accumulated {
             objective: acc.objective,
@@ -603,6 +646,92 @@ mod tests {
             // The Hessian is symmetric positive semi-definite and never above A radially.
             let h = acc.h.unwrap();
             assert!((&h - h.transpose()).amax() <= 1e-9 * h.amax());
+        }
+    }
+
+    fn kr480_problem_data(n: usize, noise_mm: f64) -> (Robot, Observations) {
+        use rand_distr::{Distribution, Normal};
+        let truth = preset("kuka-kr480-r3330-table3").unwrap();
+        let nominal = preset("kuka-kr480-r3330").unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let qs = random_poses(&truth, n, &PoseSampler::default(), &mut rng).unwrap();
+        let noise = Normal::new(0.0, noise_mm).unwrap();
+        let mut obs = Observations::new(6);
+        for q in &qs {
+            let p = truth.tool_position(q);
+            let m = p + Vector3::from_fn(|_, _| noise.sample(&mut rng));
+            obs.push(q, m, 0).unwrap();
+        }
+        (nominal, obs)
+    }
+
+    /// `S` (the full pass's unweighted Gram matrix, accumulated as `A` plus the down-weighted
+    /// points' share) equals `sum J^T J` formed directly, with a loss that leaves some points at
+    /// full weight and down-weights the others.
+    #[test]
+    fn full_pass_gram_matrix_is_the_unweighted_sum() {
+        let (nominal, obs) = kr480_problem_data(200, 0.0);
+        let params = nominal.params();
+        let p = Problem::new(&nominal, &params, &obs, &TrackerFrame::identity());
+        let norms = p.fit_norms(&nominal);
+        let mut sorted = norms.clone();
+        sorted.sort_by(f64::total_cmp);
+        let loss = Loss::Huber {
+            k: sorted[sorted.len() / 2],
+        };
+        let full_weight = norms.iter().filter(|&&r| loss.weight(r) == 1.0).count();
+        assert!(full_weight > 50 && full_weight < 150, "{full_weight}");
+        let acc = p.accumulate(&nominal, &loss, Level::Full);
+        let k = params.len();
+        let (mut jp, mut jr) = (
+            vec![Vector3::zeros(); nominal.param_count()],
+            vec![0.0; 3 * k],
+        );
+        let mut want = DMatrix::<f64>::zeros(k, k);
+        for i in 0..obs.len() {
+            let mut e = [0.0; 3];
+            p.observation_rows(&nominal, i, &mut jp, None, &mut e, &mut jr);
+            let j = DMatrix::from_row_slice(3, k, &jr);
+            want += j.transpose() * j;
+        }
+        let s = acc.s.unwrap();
+        assert!(
+            (&s - &want).amax() <= 1e-10 * want.amax(),
+            "{}",
+            (&s - &want).amax()
+        );
+    }
+
+    /// A pass gives the same bits on one thread and on four.
+    #[test]
+    fn passes_are_deterministic_across_thread_counts() {
+        let (nominal, obs) = kr480_problem_data(3 * CHUNK + 17, 0.05);
+        let params = nominal.params();
+        let p = Problem::new(&nominal, &params, &obs, &TrackerFrame::identity());
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let acc = p.accumulate(&nominal, &Loss::SumOfNorms { delta: 1e-6 }, Level::Full);
+                let f = p.objective(&nominal, &Loss::Squared);
+                (
+                    acc.a,
+                    acc.b,
+                    acc.s.unwrap(),
+                    acc.h.unwrap(),
+                    acc.objective,
+                    f,
+                )
+            })
+        };
+        let one = run(1);
+        for _ in 0..3 {
+            let four = run(4);
+            assert!(one.0 == four.0 && one.1 == four.1 && one.2 == four.2 && one.3 == four.3);
+            assert_eq!(one.4.to_bits(), four.4.to_bits());
+            assert_eq!(one.5.to_bits(), four.5.to_bits());
         }
     }
 }

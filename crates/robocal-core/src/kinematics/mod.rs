@@ -38,16 +38,15 @@ impl Robot {
         let types = self.joint_types();
         for (i, &qi) in q.iter().enumerate() {
             let l = &self.links()[i];
-            let c = self.link_constant(i);
             let (s, co, d) = joint_motion::<MIXED>(types, i, l, qi);
             match self.convention() {
                 Convention::Mdh => {
-                    f *= c;
+                    self.apply_link_constant(i, &mut f);
                     rotate_z_translate(&mut f, s, co, d);
                 }
                 Convention::Dh => {
                     rotate_z_translate(&mut f, s, co, d);
-                    f *= c;
+                    self.apply_link_constant(i, &mut f);
                 }
             }
         }
@@ -154,19 +153,18 @@ impl Robot {
         let types = self.joint_types();
         for (i, &qi) in q.iter().enumerate() {
             let l = &self.links()[i];
-            let c = self.link_constant(i);
             let (s, co, d) = if mixed {
                 joint_motion::<true>(types, i, l, qi)
             } else {
                 joint_motion::<false>(types, i, l, qi)
             };
             if self.convention() == Convention::Mdh {
-                f *= c;
+                self.apply_link_constant(i, &mut f);
             }
             out.axes[i] = (f.rotation.matrix().column(2).into(), f.translation.vector);
             rotate_z_translate(&mut f, s, co, d);
             if self.convention() == Convention::Dh {
-                f *= c;
+                self.apply_link_constant(i, &mut f);
             }
         }
         out.point = f.rotation * self.tool_frame().translation.vector + f.translation.vector;
@@ -188,12 +186,11 @@ impl Robot {
         let types = self.joint_types();
         for (i, &qi) in q.iter().enumerate() {
             let l = &self.links()[i];
-            let c = self.link_constant(i);
             let (s, co, d) = joint_motion::<MIXED>(types, i, l, qi);
             match self.convention() {
                 Convention::Mdh => {
                     ch.link[i] = f;
-                    f *= c;
+                    self.apply_link_constant(i, &mut f);
                     ch.axis[i] = f;
                     rotate_z_translate(&mut f, s, co, d);
                 }
@@ -201,7 +198,7 @@ impl Robot {
                     ch.axis[i] = f;
                     rotate_z_translate(&mut f, s, co, d);
                     ch.link[i] = f;
-                    f *= c;
+                    self.apply_link_constant(i, &mut f);
                 }
             }
         }

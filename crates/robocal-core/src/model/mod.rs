@@ -114,6 +114,9 @@ pub struct Robot {
     family_store: std::collections::BTreeMap<String, Vec<f64>>,
     // Caches derived from the above (kept valid by every mutator).
     link_const: Vec<Frame>,
+    /// Per link without a Hayati tilt, `(sin alpha, cos alpha, a)`: its constant part is then
+    /// applied by column operations ([`Robot::apply_link_constant`]).
+    link_rx: Vec<Option<[f64; 3]>>,
     base_frame: Frame,
     tool_frame: Frame,
     /// Every parameter, in model order (ascending `Param` order).
@@ -186,6 +189,7 @@ impl Robot {
             gravity: Vector3::new(0.0, 0.0, -1.0),
             family_store: Default::default(),
             link_const: Vec::new(),
+            link_rx: Vec::new(),
             base_frame: Frame::identity(),
             tool_frame: Frame::identity(),
             param_list: Vec::new(),
@@ -198,6 +202,7 @@ impl Robot {
 
     fn refresh(&mut self) {
         self.link_const = self.links.iter().map(link_constant).collect();
+        self.link_rx = self.links.iter().map(link_rx).collect();
         self.base_frame = frame::pose(&self.base);
         self.refresh_tool();
         self.refresh_params();
@@ -206,6 +211,7 @@ impl Robot {
     /// Recomputes link `i`'s constant part after one of its parameters changed.
     fn refresh_link(&mut self, i: usize) {
         self.link_const[i] = link_constant(&self.links[i]);
+        self.link_rx[i] = link_rx(&self.links[i]);
     }
 
     /// Recomputes the tool frame after T changed.
@@ -393,10 +399,27 @@ impl Robot {
         &self.tool_frame
     }
 
-    /// The constant part of link i's transform: `Rx(alpha) Tx(a) Ry(beta)` (MDH, applied before
-    /// the joint rotation) or `Tx(a) Rx(alpha) Ry(beta)` (DH, applied after it).
-    pub(crate) fn link_constant(&self, i: usize) -> &Frame {
-        &self.link_const[i]
+    /// `f = f * C_i` with `C_i` link `i`'s constant part (`link_constant`). Without a
+    /// tilt, `C_i = Rx(alpha) Tx(a)` is applied to the columns of `f` (a dozen products instead
+    /// of a full 3 x 3 product: forward kinematics is the identification's inner loop); the
+    /// result is the same up to the rounding of the skipped zero terms, which is none.
+    #[inline(always)]
+    pub(crate) fn apply_link_constant(&self, i: usize, f: &mut Frame) {
+        match self.link_rx[i] {
+            Some([sa, ca, a]) => {
+                let m = f.rotation.matrix();
+                let (c0, c1, c2) = (m.column(0), m.column(1), m.column(2));
+                f.translation.vector += c0 * a;
+                let n1 = c1 * ca + c2 * sa;
+                let n2 = c1 * (-sa) + c2 * ca;
+                f.rotation = nalgebra::Rotation3::from_matrix_unchecked(Matrix3::from_columns(&[
+                    c0.into(),
+                    n1,
+                    n2,
+                ]));
+            }
+            None => *f *= self.link_const[i],
+        }
     }
 
     /// Whether the Hayati tilt of joint `i` (0-based) is a parameter.
@@ -659,11 +682,21 @@ fn check_limits(limits: &[JointLimit], joints: &JointSpace) -> Result<()> {
     Ok(())
 }
 
-/// The constant part of a link transform (see [`Robot::link_constant`]).
+/// The constant part of a link transform (see `link_constant`).
 ///
 /// Both conventions give the same frame: `Rx(alpha) Tx(a) Ry(beta)` (MDH) and
 /// `Tx(a) Rx(alpha) Ry(beta)` (DH) are equal because Rx leaves the x translation unchanged; the
 /// conventions differ in whether it stands before or after the joint rotation.
+/// `(sin alpha, cos alpha, a)` of a link without a tilt, as [`link_constant`]'s matrix holds
+/// them.
+fn link_rx(l: &Link) -> Option<[f64; 3]> {
+    (l.beta == 0.0).then(|| {
+        let c = link_constant(l);
+        let m = c.rotation.matrix();
+        [m[(2, 1)], m[(1, 1)], l.a]
+    })
+}
+
 fn link_constant(l: &Link) -> Frame {
     frame::frame(
         frame::rot_x(l.alpha) * frame::rot_y(l.beta),
