@@ -8,6 +8,7 @@ use anyhow::Context;
 use clap::{Args, ValueEnum};
 use robocal_core::evaluation::{Against, Evaluator, PerPointWriter, Reference};
 use robocal_core::io::joint_limits::OutsideLimits;
+use robocal_core::io::measurements::read_measurements;
 use robocal_core::io::{
     CalibrationResult, Measurement, MeasurementReader, MeasurementSet, Positions,
 };
@@ -49,6 +50,12 @@ pub struct EvaluateArgs {
     /// [default: the calibration's payload].
     #[arg(long, value_name = "KG")]
     payload_kg: Option<f64>,
+    /// The data were measured from another tracker station (the tracker moved after the
+    /// calibration): fit a fresh rigid tracker frame to them under the calibrated model (and one
+    /// under the nominal model for its series) instead of using the calibration's frame.
+    /// Without it, data that clearly come from another station are refused (exit code 3).
+    #[arg(long)]
+    refit_frame: bool,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -83,6 +90,7 @@ struct Settings {
     outputs: io_plan::Outputs,
     json: bool,
     nominal_limits: bool,
+    refit_frame: bool,
 }
 
 impl TryFrom<&EvaluateArgs> for Settings {
@@ -124,6 +132,7 @@ impl TryFrom<&EvaluateArgs> for Settings {
             outputs,
             json: a.json,
             nominal_limits: a.nominal_limits,
+            refit_frame: a.refit_frame,
         })
     }
 }
@@ -140,15 +149,23 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         mut outputs,
         json,
         nominal_limits,
+        refit_frame,
     } = Settings::try_from(&a)?;
     // Row by row: only the error norms are kept (16 bytes per row), so files of any length fit.
     let context = || format!("--data {}", data.display());
     let mut reader = MeasurementReader::open(&data, nominal.joint_space(), Positions::Required)
         .with_context(context)?;
     let header = reader.header();
-    let frame = res.tracker_frame();
-    let ev = Evaluator::new(&nominal, &cal, &frame, &header, against)?
-        .with_nominal_frame(res.nominal_frame());
+    // A station of their own: both frames fitted to the whole file first.
+    let whole = || read_measurements(&data, nominal.joint_space(), Positions::Required);
+    let (nominal_frame, frame) = if refit_frame {
+        let set = whole().with_context(context)?;
+        robocal_core::evaluation::station_frames(&nominal, &cal, &set)?
+    } else {
+        (res.nominal_frame(), res.tracker_frame())
+    };
+    let ev =
+        Evaluator::new(&nominal, &cal, &frame, &header, against)?.with_nominal_frame(nominal_frame);
     let names = ev.series();
     let mut per_point = match &per_point_path {
         Some(p) => Some(PerPointWriter::to_output(
@@ -177,6 +194,13 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     let n_outside = outside.count();
     // Refused before anything is written (the per-point writer is dropped).
     super::common::check_limits(outside, nominal_limits, &mut Vec::new())?;
+    if !refit_frame && ev.reference() == Reference::Model {
+        let mean = norms[1].iter().sum::<f64>() / norms[1].len().max(1) as f64;
+        if mean > robocal_core::identification::pipeline::STATION_MIN_MM {
+            let set = whole().with_context(context)?;
+            robocal_core::evaluation::check_station(&cal, &set, mean)?;
+        }
+    }
     if let Some(w) = per_point {
         w.commit()?;
     }
@@ -205,6 +229,15 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             .into(),
         );
         o.insert("n".into(), n.into());
+        if refit_frame {
+            o.insert(
+                "refit_frame".into(),
+                serde_json::json!({
+                    "calibrated": frame.vector_deg(),
+                    "nominal": nominal_frame.vector_deg(),
+                }),
+            );
+        }
         if nominal_limits {
             o.insert("rows_outside_limits".into(), n_outside.into());
         }
@@ -231,6 +264,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             reference,
             &series,
             &res,
+            refit_frame.then_some(&frame),
         );
     }
     Ok(())
@@ -318,6 +352,7 @@ fn print_table(
     reference: Reference,
     series: &[Series],
     res: &CalibrationResult,
+    refit: Option<&robocal_core::frame::TrackerFrame>,
 ) {
     let what = match reference {
         Reference::Model => "validation: measured points against the models at the measured joints",
@@ -325,12 +360,18 @@ fn print_table(
             "verification: measured commanded poses against their desired positions (Table V)"
         }
     };
-    println!(
-        "{}: {} points; {what}; tracker frame of {}",
-        data.display(),
-        n,
-        params.display()
-    );
+    let frame = match refit {
+        Some(f) => {
+            let v = f.vector_deg();
+            format!(
+                "tracker frame fitted to these data (another station): x={:.3} y={:.3} z={:.3} mm, \
+                 A={:.4} B={:.4} C={:.4} deg",
+                v[0], v[1], v[2], v[3], v[4], v[5]
+            )
+        }
+        None => format!("tracker frame of {}", params.display()),
+    };
+    println!("{}: {} points; {what}; {frame}", data.display(), n);
     match reference {
         Reference::Model => {
             for s in series {

@@ -33,6 +33,11 @@ const FLAGS: &[(&str, &str)] = &[
     ("robust_scale_mm", "--robust-scale"),
     ("weighting.tracker", "--tracker-sigma"),
     ("validation_refit_frame", "--validate-refit-frame"),
+    // evaluate
+    ("refit_frame", "--refit-frame"),
+    // simulate (targets)
+    ("targets", "--all-targets"),
+    ("orientation_sigma_deg", "--orientation-sigma-deg"),
     ("orientation_mm_per_deg", "--orientation-weight"),
     // planning::PlanSettings (`poses` and `noise_mm` as above)
     ("candidates", "--candidates"),

@@ -10,7 +10,7 @@ use robocal_core::io::result::FrameVec;
 use robocal_core::io::write_all_atomic;
 use robocal_core::simulation::{
     check_truth_matches, simulate, simulate_joints, GeometricErrors, GravityModel, OutlierModel,
-    SimulationConfig, TruthFile, TruthSpec, SET_VALIDATION,
+    SimulationConfig, TargetMeasurement, TruthFile, TruthSpec, SET_VALIDATION,
 };
 use robocal_core::Robot;
 use std::path::{Path, PathBuf};
@@ -107,6 +107,14 @@ pub struct SimulateArgs {
     /// Gross outliers: largest displacement, mm [default: 5].
     #[arg(long, allow_hyphen_values = true, requires = "outlier_fraction")]
     outlier_max_mm: Option<f64>,
+    /// Measure every reflector of the robot file's `tools` at each pose: one row per target,
+    /// with a `target` column (1..k). The plane points use target 1.
+    #[arg(long, conflicts_with = "outlier_fraction")]
+    all_targets: bool,
+    /// 6-DoF measurements: write each measured frame's orientation (`a,b,c`, deg, in the tracker
+    /// frame) beside x,y,z, with this 1-sigma noise per axis (deg, e.g. 0.001).
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "outlier_fraction")]
+    orientation_sigma_deg: Option<f64>,
 }
 
 /// A list of numbers: one value for every joint, or one per joint.
@@ -255,6 +263,7 @@ struct Settings {
     out: PathBuf,
     truth_out: PathBuf,
     validation_out: Option<PathBuf>,
+    targets: TargetMeasurement,
 }
 
 impl TryFrom<&SimulateArgs> for Settings {
@@ -301,6 +310,20 @@ impl TryFrom<&SimulateArgs> for Settings {
             TruthSpec::Random(e) => e.validate()?,
             TruthSpec::Robot(t) => check_truth_matches(&nominal, t)?,
         }
+        if let Some(s) = a.orientation_sigma_deg {
+            if !(s >= 0.0 && s <= 10.0) {
+                return Err(exit::usage(format!(
+                    "--orientation-sigma-deg {s}: not an angle noise in [0, 10] deg"
+                )));
+            }
+        }
+        if a.all_targets && nominal.target_count() < 2 {
+            return Err(exit::usage(format!(
+                "--all-targets: {} has one target; give its reflectors' nominal tools in the \
+                 robot file (`tools = [[x, y, z, a, b, c], ...]`)",
+                a.robot
+            )));
+        }
         Ok(Settings {
             nominal,
             truth,
@@ -309,6 +332,10 @@ impl TryFrom<&SimulateArgs> for Settings {
             out: a.out.clone(),
             truth_out,
             validation_out: a.validation_out.clone(),
+            targets: TargetMeasurement {
+                all_targets: a.all_targets,
+                orientation_sigma_deg: a.orientation_sigma_deg,
+            },
         })
     }
 }
@@ -322,6 +349,7 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         out,
         truth_out,
         validation_out,
+        targets,
     } = Settings::try_from(&a)?;
 
     let joints = match &joints {
@@ -341,11 +369,12 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         Some(b) => b,
         None => &(),
     };
-    let sim = match joints {
+    let mut sim = match joints {
         // The joint file is dropped as soon as it is measured (large files: memory).
         Some(j) => simulate_joints(&nominal, &truth, &cfg, &j, observer)?,
         None => simulate(&nominal, &truth, &cfg, observer)?,
     };
+    sim.measure_targets(&targets)?;
     if let Some(b) = &bar {
         b.finish();
     }

@@ -35,6 +35,7 @@ mod cli_robot;
 mod cli_settings;
 mod cli_shell;
 mod cli_simulate;
+mod cli_stations;
 #[cfg(unix)]
 mod cli_trust_files;
 mod cli_trust_gate;

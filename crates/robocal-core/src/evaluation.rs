@@ -276,7 +276,9 @@ pub fn check_result_nominal(
     Ok(())
 }
 
+mod station;
 mod stream;
+pub use station::{check_station, observations_of, station_frames};
 pub use stream::{Evaluator, PerPointWriter};
 
 #[cfg(test)]

@@ -435,21 +435,31 @@ fn leverages(jac: &[f64], k: usize, rows: usize, kept: &[usize]) -> Option<Vec<f
             }
         }
     }
-    let s = DMatrix::from_fn(k, k, |r, c| upper[r.min(c) * k + r.max(c)]);
+    // Parameters that do not move the points (a tool orientation identified from 6-DoF data)
+    // have no leverage on them: their rows and columns are left out of S.
+    let max_diag = (0..k).map(|a| upper[a * k + a]).fold(0.0, f64::max);
+    let cols: Vec<usize> = (0..k)
+        .filter(|&a| upper[a * k + a] > 1e-12 * max_diag)
+        .collect();
+    let m = cols.len();
+    let s = DMatrix::from_fn(m, m, |r, c| {
+        let (a, b) = (cols[r.min(c)], cols[r.max(c)]);
+        upper[a * k + b]
+    });
     let l = s.cholesky()?.unpack();
-    let l: Vec<f64> = (0..k * k).map(|i| l[(i / k, i % k)]).collect();
+    let l: Vec<f64> = (0..m * m).map(|i| l[(i / m, i % m)]).collect();
     let h = map_poses(
         kept.len(),
-        || vec![0.0; k],
+        || vec![0.0; m],
         |y, n| {
             let j = &jac[kept[n] * block..(kept[n] + 1) * block];
             let mut h = 0.0;
             for r in 0..rows {
                 let jr = &j[r * k..(r + 1) * k];
-                for a in 0..k {
-                    let la = &l[a * k..a * k + a];
+                for a in 0..m {
+                    let la = &l[a * m..a * m + a];
                     let dot: f64 = la.iter().zip(&y[..a]).map(|(u, v)| u * v).sum();
-                    y[a] = (jr[a] - dot) / l[a * k + a];
+                    y[a] = (jr[cols[a]] - dot) / l[a * m + a];
                     h += y[a] * y[a];
                 }
             }
@@ -469,7 +479,8 @@ pub fn predict(
     residual_norms: &[f64],
     threshold_mm: Option<f64>,
 ) -> Option<Prediction> {
-    let rows = calibration.kind().rows();
+    // The residual norms are of the points (3 rows), whatever else the kind measures.
+    let rows = 3;
     // The noise is not known yet: a predictor of zero noise gives the Jacobians' model parts.
     let pred = Predictor::new(calibrated, covariance, 0.0)?;
     let k = pred.index.len();

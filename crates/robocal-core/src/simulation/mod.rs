@@ -44,6 +44,7 @@ mod outliers;
 mod plane;
 mod poses;
 mod session;
+mod targets;
 mod tracker;
 mod truth;
 mod truth_file;
@@ -61,6 +62,7 @@ pub use poses::{random_poses, random_poses_within, PoseSampler, TrackerRange};
 pub use session::{
     simulate, simulate_joints, Simulation, SET_CALIBRATION, SET_PLANE, SET_VALIDATION,
 };
+pub use targets::TargetMeasurement;
 pub use tracker::Tracker;
 pub use truth::{check_truth_matches, parameter_differences, GeometricErrors, TruthSpec};
 pub use truth_file::{OutlierRecord, SetInfo, TruthFile};

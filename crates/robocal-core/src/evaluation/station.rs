@@ -1,0 +1,76 @@
+//! Measurements from another tracker station: when the tracker moved between the calibration
+//! and a validation or verification set, the calibration's tracker frame no longer maps the
+//! readings into the base frame, and every error grows by the station's move. A fresh rigid frame
+//! fitted to the set under a model (the calibrated one, or the nominal one for its own series)
+//! takes the move out; without it, a set that clearly comes from another station is an error,
+//! not a 600 mm "inaccuracy".
+
+use crate::error::{Error, Result};
+use crate::frame::TrackerFrame;
+use crate::identification::pipeline::{STATION_FACTOR, STATION_MIN_MM};
+use crate::io::row_extras::ExtrasLayout;
+use crate::io::MeasurementSet;
+use crate::model::Robot;
+use crate::observations::Observations;
+use crate::registration::refit_frame;
+
+/// The measured rows of `set` (those with x,y,z) as observations, with their targets and
+/// orientations.
+pub fn observations_of(set: &MeasurementSet) -> Result<Observations> {
+    let extras = ExtrasLayout::of(set)?;
+    let mut obs = Observations::with_source(set.dof(), &set.path);
+    for r in &set.rows {
+        let Some(m) = r.p else { continue };
+        obs.push_with(&r.q, m, extras.read(set, r)?, r.line)?;
+    }
+    Ok(obs)
+}
+
+/// The frames of a set measured from a station of its own: fitted under `nominal` (for the
+/// nominal series) and under `calibrated`.
+pub fn station_frames(
+    nominal: &Robot,
+    calibrated: &Robot,
+    set: &MeasurementSet,
+) -> Result<(TrackerFrame, TrackerFrame)> {
+    let obs = observations_of(set)?;
+    obs.check_targets(nominal)?;
+    Ok((refit_frame(nominal, &obs)?, refit_frame(calibrated, &obs)?))
+}
+
+/// Fails when `set` was clearly measured from another station than the calibration's: the
+/// calibrated model's mean error in `frame`, `mean_mm`, is above [`STATION_MIN_MM`] and a frame
+/// of the set's own brings it down by [`STATION_FACTOR`] and by more than [`STATION_MIN_MM`].
+/// The message tells the refit setting by its name, `refit_frame`.
+pub fn check_station(calibrated: &Robot, set: &MeasurementSet, mean_mm: f64) -> Result<()> {
+    if mean_mm <= STATION_MIN_MM {
+        return Ok(());
+    }
+    let obs = observations_of(set)?;
+    if obs.len() < 3 {
+        return Ok(());
+    }
+    let Ok(own) = refit_frame(calibrated, &obs) else {
+        return Ok(());
+    };
+    let there = obs
+        .model_positions(calibrated)
+        .iter()
+        .zip(obs.measured())
+        .map(|(p, m)| (own.to_base(m) - p).norm())
+        .sum::<f64>()
+        / obs.len() as f64;
+    if mean_mm > STATION_FACTOR * there && mean_mm - there > STATION_MIN_MM {
+        return Err(Error::invalid(
+            set.path.display().to_string(),
+            format!(
+                "these points look measured from another tracker station: in the calibration's \
+                 tracker frame the calibrated model is off by {mean_mm:.3} mm on average, with a \
+                 frame of their own by {there:.3} mm. If the tracker moved, let the data fit \
+                 their own frame (`refit_frame`); otherwise check that the file belongs to this \
+                 calibration"
+            ),
+        ));
+    }
+    Ok(())
+}
