@@ -311,7 +311,7 @@ impl TryFrom<&SimulateArgs> for Settings {
             TruthSpec::Robot(t) => check_truth_matches(&nominal, t)?,
         }
         if let Some(s) = a.orientation_sigma_deg {
-            if !(s >= 0.0 && s <= 10.0) {
+            if !(0.0..=10.0).contains(&s) {
                 return Err(exit::usage(format!(
                     "--orientation-sigma-deg {s}: not an angle noise in [0, 10] deg"
                 )));
