@@ -422,18 +422,13 @@ fn leverages(jac: &[f64], k: usize, rows: usize, kept: &[usize]) -> Option<Vec<f
     let block = rows * k;
     let mut upper = vec![0.0; k * k];
     for &i in kept {
-        let j = &jac[i * block..(i + 1) * block];
-        for r in 0..rows {
-            let jr = &j[r * k..(r + 1) * k];
-            for a in 0..k {
-                if jr[a] != 0.0 {
-                    let row = &mut upper[a * k..(a + 1) * k];
-                    for b in a..k {
-                        row[b] += jr[a] * jr[b];
-                    }
-                }
-            }
-        }
+        crate::identification::system::add_gram(
+            &mut upper,
+            &jac[i * block..(i + 1) * block],
+            rows,
+            k,
+            1.0,
+        );
     }
     // Parameters that do not move the points (a tool orientation identified from 6-DoF data)
     // have no leverage on them: their rows and columns are left out of S.
@@ -450,17 +445,19 @@ fn leverages(jac: &[f64], k: usize, rows: usize, kept: &[usize]) -> Option<Vec<f
     let l: Vec<f64> = (0..m * m).map(|i| l[(i / m, i % m)]).collect();
     let h = map_poses(
         kept.len(),
-        || vec![0.0; m],
+        || vec![0.0; rows * m],
         |y, n| {
             let j = &jac[kept[n] * block..(kept[n] + 1) * block];
+            // The rows' forward substitutions side by side (independent sums in flight).
             let mut h = 0.0;
-            for r in 0..rows {
-                let jr = &j[r * k..(r + 1) * k];
-                for a in 0..m {
-                    let la = &l[a * m..a * m + a];
-                    let dot: f64 = la.iter().zip(&y[..a]).map(|(u, v)| u * v).sum();
-                    y[a] = (jr[cols[a]] - dot) / l[a * m + a];
-                    h += y[a] * y[a];
+            for a in 0..m {
+                let la = &l[a * m..a * m + a];
+                for r in 0..rows {
+                    let yr = &y[r * m..r * m + a];
+                    let dot: f64 = la.iter().zip(yr).map(|(u, v)| u * v).sum();
+                    let v = (j[r * k + cols[a]] - dot) / l[a * m + a];
+                    y[r * m + a] = v;
+                    h += v * v;
                 }
             }
             h

@@ -15,6 +15,7 @@ use crate::frame::TrackerFrame;
 use crate::identification::kinds::{self, MeasurementKind, ToolState};
 use crate::identification::objective::Loss;
 use crate::identification::Observations;
+use crate::model::family::PoseFrames;
 use crate::model::{Param, Robot, MAX_JOINTS};
 use nalgebra::{DMatrix, DVector, Vector3};
 use rayon::prelude::*;
@@ -132,6 +133,9 @@ struct Acc {
     /// The observation's Jacobian rows, row-major (rows x k).
     jr: Vec<f64>,
     u: Vec<f64>,
+    /// The last observation's forward pass, reused by the next when it is the same pose seen
+    /// through another target.
+    frames: Option<(usize, Box<PoseFrames>)>,
 }
 
 impl Acc {
@@ -153,6 +157,7 @@ impl Acc {
             jw: vec![Vector3::zeros(); if angular { n_params } else { 0 }],
             jr: vec![0.0; rows * k],
             u: vec![0.0; if newton { k } else { 0 }],
+            frames: None,
         }
     }
 
@@ -183,9 +188,10 @@ impl Acc {
         let rows = p.kind.rows();
         let mut e = [0.0; kinds::MAX_ROWS];
         let angular = !self.jw.is_empty();
-        p.observation_rows(
+        p.observation_rows_cached(
             robot,
             i,
+            &mut self.frames,
             &mut self.jp,
             angular.then_some(&mut self.jw[..]),
             &mut e[..rows],
@@ -269,7 +275,7 @@ impl Acc {
 /// row-major. Point rows (3) take a loop over contiguous row slices that the compiler
 /// vectorizes; the sums are those of the general loop, in the same order.
 #[inline(always)]
-fn add_gram(m: &mut [f64], jr: &[f64], rows: usize, k: usize, scale: f64) {
+pub(crate) fn add_gram(m: &mut [f64], jr: &[f64], rows: usize, k: usize, scale: f64) {
     if rows == 3 {
         let (j0, rest) = jr.split_at(k);
         let (j1, j2) = rest.split_at(k);
@@ -347,11 +353,28 @@ impl<'a> Problem<'a> {
     /// `jr` (row-major, `rows x params`), each row weighted as the fit weights it
     /// ([`Observations::weight`], orientation rows also by [`Observations::mm_per_rad`]). `jp`
     /// (and `jw` when the kind sees orientation) are scratch of `robot.param_count()` screws.
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn observation_rows(
         &self,
         robot: &Robot,
         i: usize,
+        jp: &mut [Vector3<f64>],
+        jw: Option<&mut [Vector3<f64>]>,
+        e: &mut [f64],
+        jr: &mut [f64],
+    ) {
+        self.observation_rows_cached(robot, i, &mut None, jp, jw, e, jr)
+    }
+
+    /// [`Problem::observation_rows`] reusing the forward pass in `frames` (observation index
+    /// and pass) when observation `i` is the same pose, and leaving its own there.
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    fn observation_rows_cached(
+        &self,
+        robot: &Robot,
+        i: usize,
+        frames: &mut Option<(usize, Box<PoseFrames>)>,
         jp: &mut [Vector3<f64>],
         mut jw: Option<&mut [Vector3<f64>]>,
         e: &mut [f64],
@@ -359,8 +382,16 @@ impl<'a> Problem<'a> {
     ) {
         let rows = self.kind.rows();
         let t = self.obs.target(i);
-        let (point, flange) =
-            robot.target_screws(self.obs.q(i), t, None, Some(&mut *jp), jw.as_deref_mut());
+        let q = self.obs.q(i);
+        match frames {
+            Some((j, pose)) if self.obs.q(*j) == q => {
+                robot.retarget(pose, t);
+                *j = i;
+            }
+            _ => *frames = Some((i, Box::new(robot.pose_frames_target(q, t)))),
+        }
+        let pose = &frames.as_ref().expect("set above").1;
+        let (point, flange) = robot.screws_at(pose, None, Some(&mut *jp), jw.as_deref_mut());
         let tool = self.tool_state(robot, t, point, &flange);
         let target = self.target(i);
         self.kind.residual(target, &tool, &mut e[..rows]);
@@ -468,12 +499,39 @@ impl<'a> Problem<'a> {
 
     /// Observation i's unweighted residual rows (forward kinematics only), written to `e`.
     fn residual(&self, robot: &Robot, i: usize, e: &mut [f64]) {
+        self.residual_cached(robot, i, &mut None, e)
+    }
+
+    /// [`Problem::residual`] reusing the flange frame in `flange` (observation index and
+    /// frame) when observation `i` is the same pose (another target), and leaving its own there.
+    fn residual_cached(
+        &self,
+        robot: &Robot,
+        i: usize,
+        flange: &mut Option<(usize, crate::frame::Frame)>,
+        e: &mut [f64],
+    ) {
         let t = self.obs.target(i);
+        let q = self.obs.q(i);
+        let f = match flange {
+            Some((j, f)) if self.obs.q(*j) == q => {
+                *j = i;
+                *f
+            }
+            _ => {
+                let f = robot.flange_pose(q);
+                *flange = Some((i, f));
+                f
+            }
+        };
         let (tool, point) = if self.angular {
-            let f = robot.target_pose(self.obs.q(i), t);
+            let f = f * robot.target_tool_frame(t);
             (Some(*f.rotation.matrix()), f.translation.vector)
         } else {
-            (None, robot.target_position(self.obs.q(i), t))
+            (
+                None,
+                f.rotation * robot.target_tool_frame(t).translation.vector + f.translation.vector,
+            )
         };
         let tool = ToolState {
             point,
@@ -483,10 +541,15 @@ impl<'a> Problem<'a> {
     }
 
     /// Observation i's residual norm as the fit sees it (weighted; forward kinematics only).
-    fn fit_norm(&self, robot: &Robot, i: usize) -> f64 {
+    fn fit_norm(
+        &self,
+        robot: &Robot,
+        i: usize,
+        flange: &mut Option<(usize, crate::frame::Frame)>,
+    ) -> f64 {
         let rows = self.kind.rows();
         let mut e = [0.0; kinds::MAX_ROWS];
-        self.residual(robot, i, &mut e[..rows]);
+        self.residual_cached(robot, i, flange, &mut e[..rows]);
         self.weigh(i, &mut e[..rows], &mut []);
         e[..rows].iter().map(|v| v * v).sum::<f64>().sqrt()
     }
@@ -550,17 +613,21 @@ impl<'a> Problem<'a> {
     /// The residual norms the loss sees (weighted, see [`Observations::weight`]; mm of a
     /// typical point), one per observation.
     pub fn fit_norms(&self, robot: &Robot) -> Vec<f64> {
-        (0..self.len()).map(|i| self.fit_norm(robot, i)).collect()
+        let mut flange = None;
+        (0..self.len())
+            .map(|i| self.fit_norm(robot, i, &mut flange))
+            .collect()
     }
 
     /// The objective `sum l(|e_i|)` (forward kinematics only).
     pub fn objective(&self, robot: &Robot, loss: &Loss) -> f64 {
         chunked(
             self.len(),
-            || 0.0,
-            |sum, i| *sum += loss.value(self.fit_norm(robot, i)),
-            |a, b| a + b,
+            || (0.0, None),
+            |(sum, flange), i| *sum += loss.value(self.fit_norm(robot, i, flange)),
+            |a, b| (a.0 + b.0, None),
         )
+        .0
     }
 
     /// One pass over the observations: objective and IRLS normal equations, and what `level`

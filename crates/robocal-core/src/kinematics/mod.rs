@@ -250,10 +250,31 @@ impl Robot {
         t: usize,
         jq: Option<&mut [Vector3<f64>]>,
         jp: Option<&mut [Vector3<f64>]>,
+        jw: Option<&mut [Vector3<f64>]>,
+    ) -> (Vector3<f64>, Frame) {
+        let pose = self.pose_frames_target(q, t);
+        self.screws_at(&pose, jq, jp, jw)
+    }
+
+    /// `pose`'s frames seen through target `t` (0-based): the same forward pass (deflection
+    /// included: it does not depend on the target), the point of target `t`. Several
+    /// reflectors measured at one pose share one pass this way.
+    pub(crate) fn retarget(&self, pose: &mut PoseFrames, t: usize) {
+        let f = &pose.flange;
+        pose.point =
+            f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
+        pose.target = t;
+    }
+
+    /// [`Robot::target_screws`] from a forward pass already made ([`Robot::pose_frames_target`]).
+    pub(crate) fn screws_at(
+        &self,
+        pose: &PoseFrames,
+        jq: Option<&mut [Vector3<f64>]>,
+        jp: Option<&mut [Vector3<f64>]>,
         mut jw: Option<&mut [Vector3<f64>]>,
     ) -> (Vector3<f64>, Frame) {
         let n = self.dof();
-        let pose = self.pose_frames_target(q, t);
         let p = pose.point;
         if let Some(jq) = jq {
             assert_eq!(jq.len(), n, "joint Jacobian length");
@@ -279,7 +300,7 @@ impl Robot {
         for (id, span) in self.family_spans() {
             family::get(*id).columns(
                 self,
-                &pose,
+                pose,
                 &mut jp[span.clone()],
                 jw.as_deref_mut().map(|w| &mut w[span.clone()]),
             );
