@@ -1,0 +1,60 @@
+"""Result: the result JSON in and out, and the calibrated robot it holds."""
+
+import json
+
+import numpy as np
+import pytest
+
+import robocal
+from conftest import example
+
+
+@pytest.fixture(scope="module")
+def fit(ur5, real_data):
+    from conftest import load_csv
+
+    q, xyz, _ = load_csv(real_data / "jacobi_ur5_grid.csv")
+    return robocal.calibrate(ur5, q, xyz)
+
+
+def test_json_round_trip(fit, tmp_path):
+    text = fit.to_json()
+    again = robocal.Result.from_json(text)
+    assert again.to_json() == text
+    p = tmp_path / "r.json"
+    fit.write(p)
+    assert p.read_text() == text
+    assert robocal.Result.read(p).to_json() == text
+    assert fit.tracker_frame.keys() == {"x", "y", "z", "a", "b", "c"}
+
+
+def test_calibrated_robot_is_the_clis(fit, cli, tmp_path):
+    p = tmp_path / "r.json"
+    fit.write(p)
+    cal = fit.calibrated_robot()
+    q = [10.0, -80.0, 90.0, 0.0, 90.0, 0.0]
+    out = json.loads(cli("fk", "--params", str(p), "--joints", ",".join(map(str, q)), "--json"))
+    assert np.array_equal(cal.fk(q), [out["x"], out["y"], out["z"]])
+    for name, e in fit.parameters.items():
+        assert cal.get(name) == e.calibrated
+        assert fit.nominal_robot().get(name) == e.nominal
+
+
+def test_calibrated_robot_checks_the_nominal(fit):
+    kr = robocal.Robot.preset("kuka-kr480-r3330")
+    with pytest.raises(robocal.RobocalError):
+        fit.calibrated_robot(kr)
+
+
+def test_bad_json_is_an_input_error():
+    with pytest.raises(robocal.InputError) as e:
+        robocal.Result.from_json('{"parameters": 3}')
+    assert e.value.exit_code == 3
+    with pytest.raises(robocal.InputError):
+        robocal.Result.from_json("not json")
+
+
+def test_missing_file_is_a_file_error(tmp_path):
+    with pytest.raises(robocal.FileError) as e:
+        robocal.Result.read(tmp_path / "none.json")
+    assert "none.json" in str(e.value) and e.value.exit_code == 4
