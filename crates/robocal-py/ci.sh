@@ -52,7 +52,7 @@ export ROBOCAL_BIN="${ROBOCAL_BIN:-$root/target/release/robocal}"
 export ROBOCAL_ROOT="$root"
 # The tests run against the installed wheel, not the source folder.
 cd "$work" || exit 1
-"$py" -m pytest -q -rs -p no:cacheprovider "$here/tests"
+"$py" -m pytest -q -s -rs -p no:cacheprovider "$here/tests"
 rc=$?
 if [ "$rc" -ne 0 ]; then
   echo "python-ci: FAILED: pytest exited with $rc"

@@ -9,6 +9,7 @@
 mod arrays;
 mod calibrate;
 mod errors;
+mod evaluate;
 mod options;
 mod result;
 mod robot;
@@ -22,6 +23,7 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<robot::PyRobot>()?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate_files, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::evaluate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(result::parse_result, m)?)?;
     m.add_function(wrap_pyfunction!(result::read_result, m)?)?;
     m.add_function(wrap_pyfunction!(result::write_result, m)?)?;

@@ -58,3 +58,22 @@ def test_missing_file_is_a_file_error(tmp_path):
     with pytest.raises(robocal.FileError) as e:
         robocal.Result.read(tmp_path / "none.json")
     assert "none.json" in str(e.value) and e.value.exit_code == 4
+
+
+def test_evaluate_is_the_clis(fit, real_data, cli, tmp_path):
+    from conftest import load_csv
+
+    p = tmp_path / "r.json"
+    fit.write(p)
+    vq, vxyz, _ = load_csv(real_data / "jacobi_ur5_random.csv")
+    ev = fit.evaluate(vq, vxyz)
+    out = json.loads(cli("evaluate", "--params", str(p), "--data", str(real_data / "jacobi_ur5_random.csv"),
+                         "--against", "model", "--json"))
+    for series in ("nominal", "calibrated"):
+        for k, v in ev[series]["stats"].items():
+            assert abs(v - out[series][k]) <= 1e-12 * max(1, abs(v)), (series, k, v, out[series][k])
+        assert ev[series]["errors"].shape == (20, 3)
+        assert np.allclose(np.linalg.norm(ev[series]["errors"], axis=1), ev[series]["norms"], rtol=0, atol=1e-12)
+    assert robocal.evaluate(fit, vq, vxyz)["calibrated"]["stats"] == ev["calibrated"]["stats"]
+    with pytest.raises(robocal.InputError, match="xyz"):
+        fit.evaluate(vq, vxyz[:, :2])

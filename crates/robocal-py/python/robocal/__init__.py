@@ -44,6 +44,7 @@ __all__ = [
     "Parameter",
     "calibrate",
     "calibrate_files",
+    "evaluate",
     "RobocalError",
     "UsageError",
     "InputError",
@@ -155,6 +156,28 @@ class Result:
         """The predicted error at new poses spread like the calibration poses."""
         v = self._data.get("prediction")
         return None if v is None else dict(v)
+
+    def evaluate(
+        self,
+        q: Any,
+        xyz: Any,
+        *,
+        nominal: Optional[Robot] = None,
+        nominal_limits: bool = False,
+    ) -> Dict[str, Dict[str, Any]]:
+        """The errors of measured points under this result's models: ``robocal evaluate
+        --against model`` (validation, the paper's Table IV on new points).
+
+        ``q`` (n, dof) in degrees, ``xyz`` (n, 3) in mm in the tracker frame. Returns
+        ``{"nominal": S, "calibrated": S}`` with ``S = {"errors": (n, 3) measured minus model
+        (mm, base frame), "norms": (n,), "stats": {n, mean_mm, std_mm, max_mm, rms_mm, p95_mm}}``.
+        The measured points are moved into the base frame by the result's tracker frame (the
+        nominal series by the frame fitted to the nominal model, as the CLI does).
+        """
+        out, notes = _robocal.evaluate_arrays(self._text, q, xyz, nominal, nominal_limits)
+        for n in notes:
+            warnings.warn(n, RuntimeWarning, stacklevel=2)
+        return out
 
     def robots(self, nominal: Optional[Robot] = None) -> Tuple[Robot, Robot]:
         """The nominal robot (the one the result embeds, or ``nominal`` checked to agree with it)
@@ -283,3 +306,9 @@ def calibrate_files(
             opts,
         )
     )
+
+
+def evaluate(result: Result, q: ArrayLike, xyz: ArrayLike, **options: Any) -> Dict[str, Dict[str, Any]]:
+    """The CLI's ``robocal evaluate --params RESULT --against model`` on arrays: see
+    :meth:`Result.evaluate`."""
+    return result.evaluate(q, xyz, **options)
