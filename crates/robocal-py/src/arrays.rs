@@ -59,9 +59,11 @@ pub fn matrix(obj: &Bound<'_, PyAny>, name: &str, cols: usize, what: &str) -> Py
             )))
         }
     };
-    let data: Vec<f64> = match arr.as_slice() {
-        Ok(s) => s.to_vec(),
-        Err(_) => arr.as_array().iter().copied().collect(),
+    // ndarray's `as_slice` is C order only (numpy's would take Fortran order too, transposed).
+    let view = arr.as_array();
+    let data: Vec<f64> = match view.as_slice() {
+        Some(s) => s.to_vec(),
+        None => view.iter().copied().collect(),
     };
     if let Some(k) = data.iter().position(|v| !v.is_finite()) {
         let (i, j) = (k / cols, k % cols);

@@ -25,8 +25,9 @@ struct Data {
 }
 
 /// What a calibration returns to Python: the result JSON (as the CLI writes it), its status,
-/// and the warnings the CLI would print.
-type Outcome = (String, String, Vec<String>);
+/// the warnings the CLI would print, and the seconds spent in the library's `calibrate` (the
+/// binding's overhead is the rest).
+type Outcome = (String, String, Vec<String>, f64);
 
 /// Rows outside the joint limits: an error, or with `nominal_limits` a warning recorded in the
 /// result.
@@ -262,6 +263,7 @@ fn run(
 ) -> PyResult<Outcome> {
     let robot = &nominal.inner;
     let settings = &opts.settings;
+    let started = std::time::Instant::now();
     let cal = py
         .detach(|| {
             calibrate(
@@ -276,6 +278,7 @@ fn run(
             )
         })
         .py_err()?;
+    let library_seconds = started.elapsed().as_secs_f64();
     let converged = cal.solver().termination.converged();
     let implausible = cal.plausibility.implausible();
     if let Some(why) = &cal.covariance.unavailable {
@@ -348,5 +351,5 @@ fn run(
     let mut text = serde_json::to_string_pretty(&res)
         .map_err(|e| raise(1, format!("cannot serialize the result: {e}")))?;
     text.push('\n');
-    Ok((text, status, warnings))
+    Ok((text, status, warnings, library_seconds))
 }

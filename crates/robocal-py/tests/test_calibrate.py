@@ -83,9 +83,17 @@ def test_ur5_calibration_is_as_fast_as_the_cli(ur5, real_data, ur5_cli):
     q, xyz, _ = load_csv(real_data / "jacobi_ur5_grid.csv")
     vq, vxyz, _ = load_csv(real_data / "jacobi_ur5_random.csv")
     robocal.calibrate(ur5, q, xyz, validate=(vq, vxyz))
-    py = min(_timed(lambda: robocal.calibrate(ur5, q, xyz, validate=(vq, vxyz))) for _ in range(3))
+    runs = []
+    for _ in range(3):
+        t = time.perf_counter()
+        res = robocal.calibrate(ur5, q, xyz, validate=(vq, vxyz))
+        runs.append((time.perf_counter() - t, res.library_seconds))
+    py, lib = min(runs)
     cli = ur5_cli[1]
-    print(f"\ncalibration of 1000 UR5 poses: Python {py * 1e3:.0f} ms, CLI process {cli * 1e3:.0f} ms")
+    print(f"\ncalibration of 1000 UR5 poses: Python call {py * 1e3:.0f} ms, of which the library "
+          f"{lib * 1e3:.0f} ms; the whole CLI process {cli * 1e3:.0f} ms")
+    # Within 1.5x of the library's own time, and no slower than the CLI.
+    assert py <= 1.5 * lib, (py, lib)
     assert py <= 1.5 * cli, (py, cli)
 
 

@@ -57,6 +57,8 @@ def test_integer_and_list_input(ur5):
     wide = np.zeros((20, 12))
     wide[:, ::2] = q
     assert np.array_equal(ur5.fk(wide[:, ::2]), ur5.fk(q))
+    # Fortran order too.
+    assert np.array_equal(ur5.fk(np.asfortranarray(q)), ur5.fk(q))
 
 
 def test_jacobian_matches_finite_differences(ur5):

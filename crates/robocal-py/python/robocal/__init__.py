@@ -81,12 +81,22 @@ class Result:
     exactly as robocal writes it (:meth:`to_json`); the properties read it.
     """
 
-    __slots__ = ("_text", "_data")
+    __slots__ = ("_text", "_parsed", "library_seconds")
 
-    def __init__(self, text: str) -> None:
+    def __init__(self, text: str, library_seconds: Optional[float] = None) -> None:
         """Wraps result JSON ``text`` already checked by robocal (use :meth:`from_json`)."""
         self._text = text
-        self._data: Dict[str, Any] = json.loads(text)
+        self._parsed: Optional[Dict[str, Any]] = None
+        #: Seconds the calibration spent in the library (robocal-core's ``calibrate``, the
+        #: function the CLI calls); None for a result read from JSON.
+        self.library_seconds = library_seconds
+
+    @property
+    def _data(self) -> Dict[str, Any]:
+        # Parsed on first use: a calibration in a loop need not pay for it.
+        if self._parsed is None:
+            self._parsed = json.loads(self._text)
+        return self._parsed
 
     @classmethod
     def from_json(cls, text: str) -> "Result":
@@ -204,11 +214,11 @@ def _options(**kw: Any) -> Dict[str, Any]:
     return {k: v for k, v in kw.items() if v is not None}
 
 
-def _finish(outcome: Tuple[str, str, Sequence[str]]) -> Result:
-    text, _status, notes = outcome
+def _finish(outcome: Tuple[str, str, Sequence[str], float]) -> Result:
+    text, _status, notes, seconds = outcome
     for n in notes:
         warnings.warn(n, RuntimeWarning, stacklevel=3)
-    return Result(text)
+    return Result(text, seconds)
 
 
 ArrayLike = Any

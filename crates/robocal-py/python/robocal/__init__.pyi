@@ -100,7 +100,8 @@ class Parameter(NamedTuple):
 class Result:
     """A calibration result: the CLI's result JSON."""
 
-    def __init__(self, text: str) -> None: ...
+    library_seconds: Optional[float]
+    def __init__(self, text: str, library_seconds: Optional[float] = None) -> None: ...
     @classmethod
     def from_json(cls, text: str) -> Result: ...
     @classmethod
