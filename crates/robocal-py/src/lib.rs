@@ -8,6 +8,7 @@
 
 mod arrays;
 mod calibrate;
+mod compensate;
 mod errors;
 mod evaluate;
 mod options;
@@ -24,6 +25,7 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate::calibrate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate_files, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(compensate::compensate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(result::parse_result, m)?)?;
     m.add_function(wrap_pyfunction!(result::read_result, m)?)?;
     m.add_function(wrap_pyfunction!(result::write_result, m)?)?;

@@ -77,3 +77,31 @@ def test_evaluate_is_the_clis(fit, real_data, cli, tmp_path):
     assert robocal.evaluate(fit, vq, vxyz)["calibrated"]["stats"] == ev["calibrated"]["stats"]
     with pytest.raises(robocal.InputError, match="xyz"):
         fit.evaluate(vq, vxyz[:, :2])
+
+
+def test_compensate_is_the_clis(fit, real_data, cli, tmp_path):
+    from conftest import load_csv
+
+    p = tmp_path / "r.json"
+    fit.write(p)
+    data = real_data / "jacobi_ur5_random.csv"
+    vq, _, _ = load_csv(data)
+    c = fit.compensate(vq)
+    assert c["commanded"].shape == (20, 6) and len(c["status"]) == 20
+    out = tmp_path / "commanded.csv"
+    cli("compensate", "--params", str(p), "--joints", str(data), "--out", str(out))
+    import numpy as np_
+
+    a = np_.genfromtxt(out, delimiter=",", names=True, dtype=None, encoding="utf-8")
+    cq = np_.column_stack([a[f"q{i}"].astype(float) for i in range(1, 7)])
+    # The CLI writes its joints rounded for the file; the same solve otherwise.
+    assert np.allclose(c["commanded"], cq, rtol=0, atol=1e-8), np.abs(c["commanded"] - cq).max()
+    assert all(s == "converged" for s in c["status"])
+    # The calibrated model at the commanded joints reaches the nominal model's point.
+    cal = fit.calibrated_robot()
+    assert np.allclose(cal.fk(c["commanded"]), fit.nominal_robot().fk(vq), atol=1e-5)
+    assert np.array_equal(c["desired_position"], fit.nominal_robot().fk(vq))
+    one = robocal.compensate(fit, vq[0])
+    assert one["commanded"].shape == (6,)
+    with pytest.raises(robocal.UsageError, match="max_iterations"):
+        fit.compensate(vq, max_iterations=0)

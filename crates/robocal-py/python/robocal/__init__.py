@@ -45,6 +45,7 @@ __all__ = [
     "calibrate",
     "calibrate_files",
     "evaluate",
+    "compensate",
     "RobocalError",
     "UsageError",
     "InputError",
@@ -189,6 +190,35 @@ class Result:
             warnings.warn(n, RuntimeWarning, stacklevel=2)
         return out
 
+    def compensate(
+        self,
+        q: Any,
+        *,
+        nominal: Optional[Robot] = None,
+        tolerance_mm: float = 1e-6,
+        max_iterations: int = 500,
+        payload_kg: Optional[float] = None,
+        accept_implausible: bool = False,
+    ) -> Dict[str, Any]:
+        """Compensated joint commands for desired poses (paper, eq. 12-14): ``robocal compensate
+        --joints``.
+
+        ``q`` (n, dof): the desired joint values in degrees (the poses the nominal model would
+        reach). Returns ``commanded`` (n, dof; degrees: the calibrated model puts the tool where
+        the nominal one puts it at ``q``), ``desired_position`` (n, 3; mm, base frame),
+        ``status`` (list: "converged", "joint_limit", "unreachable", "not_converged"),
+        ``residual_mm`` (n,) and ``iterations`` (n,). A partial result raises
+        :class:`InputError`; an implausible one :class:`ImplausibleError` unless
+        ``accept_implausible``. ``payload_kg``: the payload now carried, for a result whose
+        compliances are physical.
+        """
+        out, notes = _robocal.compensate_arrays(
+            self._text, q, nominal, tolerance_mm, max_iterations, payload_kg, accept_implausible
+        )
+        for n in notes:
+            warnings.warn(n, RuntimeWarning, stacklevel=2)
+        return out
+
     def robots(self, nominal: Optional[Robot] = None) -> Tuple[Robot, Robot]:
         """The nominal robot (the one the result embeds, or ``nominal`` checked to agree with it)
         and the calibrated one."""
@@ -322,3 +352,9 @@ def evaluate(result: Result, q: ArrayLike, xyz: ArrayLike, **options: Any) -> Di
     """The CLI's ``robocal evaluate --params RESULT --against model`` on arrays: see
     :meth:`Result.evaluate`."""
     return result.evaluate(q, xyz, **options)
+
+
+def compensate(result: Result, q: ArrayLike, **options: Any) -> Dict[str, Any]:
+    """The CLI's ``robocal compensate --params RESULT --joints`` on arrays: see
+    :meth:`Result.compensate`."""
+    return result.compensate(q, **options)

@@ -128,6 +128,17 @@ class Result:
         self, q: ArrayLike, xyz: ArrayLike, *, nominal: Optional[Robot] = None, nominal_limits: bool = False
     ) -> Dict[str, Dict[str, Any]]:
         """Errors under the nominal and calibrated models: {"nominal": S, "calibrated": S}."""
+    def compensate(
+        self,
+        q: ArrayLike,
+        *,
+        nominal: Optional[Robot] = None,
+        tolerance_mm: float = 1e-6,
+        max_iterations: int = 500,
+        payload_kg: Optional[float] = None,
+        accept_implausible: bool = False,
+    ) -> Dict[str, Any]:
+        """Compensated joints (eq. 12-14): commanded, desired_position, status, residual_mm, iterations."""
     def robots(self, nominal: Optional[Robot] = None) -> Tuple[Robot, Robot]: ...
     def calibrated_robot(self, nominal: Optional[Robot] = None) -> Robot: ...
     def nominal_robot(self) -> Robot: ...
@@ -170,3 +181,6 @@ def calibrate_files(
 
 def evaluate(result: Result, q: ArrayLike, xyz: ArrayLike, **options: Any) -> Dict[str, Dict[str, Any]]:
     """The CLI's ``robocal evaluate --against model`` on arrays."""
+
+def compensate(result: Result, q: ArrayLike, **options: Any) -> Dict[str, Any]:
+    """The CLI's ``robocal compensate --joints`` on arrays."""
