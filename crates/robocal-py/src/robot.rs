@@ -37,8 +37,18 @@ impl PyRobot {
         let dof = self.inner.dof();
         let mut m = matrix(q, name, dof, &self.joint_words())?;
         let js = self.inner.joint_space();
-        for row in m.data.chunks_mut(dof) {
+        // The plausible range of a joint value, as the CLI's `--joints` and files check it.
+        let ranges: Vec<&robocal_core::ranges::Range> = (0..dof)
+            .map(|j| match js.joint_type(j) {
+                robocal_core::JointType::Prismatic => &robocal_core::ranges::LENGTH,
+                _ => &robocal_core::ranges::JOINT,
+            })
+            .collect();
+        for (i, row) in m.data.chunks_mut(dof).enumerate() {
             for (j, v) in row.iter_mut().enumerate() {
+                if let Err(msg) = ranges[j].check(*v) {
+                    return Err(input(format!("{name}: row {i}, column {j}: {msg}")));
+                }
                 *v = js.to_internal(j, *v);
             }
         }

@@ -48,6 +48,16 @@ def test_non_finite_values_name_row_and_column(bad):
         robocal.calibrate(ur5, q, xyz)
 
 
+def test_implausible_joint_values_are_refused():
+    ur5, q, _ = good()
+    q[2, 4] = 1e300
+    with pytest.raises(robocal.InputError, match=r"q: row 2, column 4: .*out of range"):
+        ur5.fk(q)
+    assert ur5.fk(np.zeros((0, 6))).shape == (0, 3)
+    with pytest.raises(robocal.InputError, match="no calibration points"):
+        robocal.calibrate(ur5, np.zeros((0, 6)), np.zeros((0, 3)))
+
+
 def test_calibrate_shapes():
     ur5, q, xyz = good()
     with pytest.raises(robocal.InputError, match="40 row.*39"):
