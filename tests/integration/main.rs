@@ -40,5 +40,6 @@ mod cli_stations;
 mod cli_trust_files;
 mod cli_trust_gate;
 mod cli_trust_readers;
+mod python_bindings;
 mod readme_commands;
 mod report_browser;

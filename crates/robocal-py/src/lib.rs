@@ -1,0 +1,35 @@
+//! robocal's Python face: the `robocal._robocal` extension module behind the `robocal` Python
+//! package (`python/robocal`), built by maturin (`pyproject.toml`).
+//!
+//! numpy arrays in and out; the work is robocal-core's own functions, called as the CLI calls
+//! them, so Python and the CLI give the same numbers. Library errors become Python exceptions
+//! (`errors`) with the library's messages, the settings named as this module's keyword
+//! arguments.
+
+mod arrays;
+mod calibrate;
+mod compensate;
+mod errors;
+mod evaluate;
+mod options;
+mod result;
+mod robot;
+
+use pyo3::prelude::*;
+
+/// The extension module.
+#[pymodule]
+fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    errors::register(m)?;
+    m.add_class::<robot::PyRobot>()?;
+    m.add_function(wrap_pyfunction!(calibrate::calibrate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(calibrate::calibrate_files, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::evaluate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(compensate::compensate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(result::parse_result, m)?)?;
+    m.add_function(wrap_pyfunction!(result::read_result, m)?)?;
+    m.add_function(wrap_pyfunction!(result::write_result, m)?)?;
+    m.add_function(wrap_pyfunction!(result::result_robots, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

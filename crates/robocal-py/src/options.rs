@@ -1,0 +1,365 @@
+//! The options of `robocal.calibrate`, checked as the CLI checks its flags (`src/cmd/calibrate.rs`)
+//! before any work, and turned into the library's `CalibrationSettings` and model families.
+
+use crate::errors::{input, usage, IntoPy};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use robocal_core::identification::{
+    CalibrationSettings, IdentifiabilityOptions, Objective, RobustLoss, SolverOptions,
+    DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
+};
+use robocal_core::model::family::{compliance, transmission};
+use robocal_core::observations::{TrackerSigma, Weighting};
+use robocal_core::{Param, Robot};
+
+/// The iteration limit's range (the CLI's `--max-iterations`).
+const MAX_ITERATIONS: usize = 1_000_000;
+/// The largest length accepted for a scale (mm): 1 km, as the CLI.
+const MAX_LENGTH_MM: f64 = 1e6;
+
+/// Everything `calibrate` takes beside the data.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// The library's settings.
+    pub settings: CalibrationSettings,
+    /// Use rows outside the joint limits (with a warning).
+    pub nominal_limits: bool,
+    /// Return a result of a solver that did not converge, marked partial.
+    pub keep_partial: bool,
+    /// Return a converged fit that failed the plausibility gate, marked implausible.
+    pub accept_implausible: bool,
+    /// Notes for the caller (shown as Python warnings).
+    pub notes: Vec<String>,
+}
+
+/// The known option names (the keyword arguments of `robocal.calibrate`).
+const KNOWN: &[&str] = &[
+    "objective",
+    "robust_loss",
+    "robust_scale",
+    "fix",
+    "free",
+    "beta",
+    "compliance",
+    "payload_kg",
+    "harmonics",
+    "affine",
+    "rank_tol",
+    "max_iterations",
+    "keep_partial",
+    "accept_implausible",
+    "tracker_sigma",
+    "orientation_weight",
+    "validate_refit_frame",
+    "nominal_limits",
+];
+
+/// Reads option `key` of `d`, `None` when absent or None.
+fn opt<'py, T: FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    key: &str,
+    what: &str,
+) -> PyResult<Option<T>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(v) if v.is_none() => Ok(None),
+        Some(v) => v
+            .extract::<T>()
+            .map(Some)
+            .map_err(|_| usage(format!("{key}: expected {what}, got {}", describe(&v)))),
+    }
+}
+
+/// A value as Python shows it, shortened.
+fn describe(v: &Bound<'_, PyAny>) -> String {
+    let r = v.repr().map(|s| s.to_string()).unwrap_or_default();
+    let t = v
+        .get_type()
+        .name()
+        .map(|s| s.to_string())
+        .unwrap_or_default();
+    let r: String = r.chars().take(60).collect();
+    format!("{r} ({t})")
+}
+
+/// A list option: a comma-separated string or a sequence of strings.
+fn names(d: &Bound<'_, PyDict>, key: &str) -> PyResult<Vec<String>> {
+    let Some(v) = d.get_item(key)? else {
+        return Ok(Vec::new());
+    };
+    if v.is_none() {
+        return Ok(Vec::new());
+    }
+    if let Ok(s) = v.extract::<String>() {
+        return Ok(s.split(',').map(|p| p.trim().to_owned()).collect());
+    }
+    v.extract::<Vec<String>>().map_err(|_| {
+        usage(format!(
+            "{key}: expected parameter names (a list of str, or one comma-separated str), got {}",
+            describe(&v)
+        ))
+    })
+}
+
+/// A joint selection: a keyword (`none`, `parallel`/`auto`), a comma-separated string or a
+/// sequence of 1-based joint numbers; returned as text the CLI's parser reads.
+fn joint_selection(d: &Bound<'_, PyDict>, key: &str) -> PyResult<String> {
+    let Some(v) = d.get_item(key)? else {
+        return Ok("none".into());
+    };
+    if v.is_none() {
+        return Ok("none".into());
+    }
+    if let Ok(s) = v.extract::<String>() {
+        return Ok(s);
+    }
+    if let Ok(js) = v.extract::<Vec<i64>>() {
+        if js.is_empty() {
+            return Ok("none".into());
+        }
+        return Ok(js
+            .iter()
+            .map(|j| j.to_string())
+            .collect::<Vec<_>>()
+            .join(","));
+    }
+    Err(usage(format!(
+        "{key}: expected a keyword or a list of joint numbers (from 1), got {}",
+        describe(&v)
+    )))
+}
+
+/// 1-based joint numbers of a list, checked against the robot.
+fn joint_numbers(robot: &Robot, list: &str, key: &str, keywords: &str) -> PyResult<Vec<usize>> {
+    let mut out = Vec::new();
+    for part in list.split(',') {
+        let j: usize = part.trim().parse().map_err(|_| {
+            usage(format!(
+                "{key}: `{part}` is not {keywords} or a joint number"
+            ))
+        })?;
+        if j == 0 || j > robot.dof() {
+            return Err(usage(format!(
+                "{key}: joint {j} does not exist (robot `{}` has joints 1..{})",
+                robot.name(),
+                robot.dof()
+            )));
+        }
+        if !out.contains(&(j - 1)) {
+            out.push(j - 1);
+        }
+    }
+    Ok(out)
+}
+
+/// Parses a list of parameter names, naming every unknown one at once.
+fn param_list(robot: &Robot, names: &[String], key: &str) -> PyResult<Vec<Param>> {
+    let mut out = Vec::new();
+    let mut unknown = Vec::new();
+    for n in names.iter().map(|n| n.trim()).filter(|n| !n.is_empty()) {
+        match robot.param_by_name(n) {
+            Ok(p) if !out.contains(&p) => out.push(p),
+            Ok(_) => {}
+            Err(_) => unknown.push(format!("`{n}`")),
+        }
+    }
+    if !unknown.is_empty() {
+        let known: Vec<String> = robot.params().iter().map(|p| p.name()).collect();
+        return Err(usage(format!(
+            "{key}: unknown parameter{} {} (robot `{}` has: {})",
+            if unknown.len() > 1 { "s" } else { "" },
+            unknown.join(", "),
+            robot.name(),
+            known.join(", ")
+        )));
+    }
+    Ok(out)
+}
+
+/// Checks the options of `d` and applies the model families they enable (`beta`,
+/// `compliance`, `payload_kg`, `harmonics`) to `robot`.
+pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
+    for k in d.keys() {
+        let k: String = k.extract()?;
+        if !KNOWN.contains(&k.as_str()) {
+            return Err(usage(format!(
+                "unknown option `{k}` (known: {})",
+                KNOWN.join(", ")
+            )));
+        }
+    }
+    let mut notes = Vec::new();
+    let objective: String = opt(d, "objective", "a str")?.unwrap_or_else(|| "adaptive".into());
+    let robust_loss: String = opt(d, "robust_loss", "a str")?.unwrap_or_else(|| "cauchy".into());
+    let robust = match robust_loss.replace('_', "-").as_str() {
+        "cauchy" => RobustLoss::Cauchy,
+        "huber" => RobustLoss::Huber,
+        other => {
+            return Err(usage(format!(
+                "robust_loss: `{other}` is not `cauchy` or `huber`"
+            )))
+        }
+    };
+    let objective = match objective.replace('_', "-").as_str() {
+        "adaptive" => Objective::Adaptive,
+        "sum-of-norms" => Objective::SumOfNorms,
+        "least-squares" => Objective::LeastSquares,
+        "robust" => Objective::Robust(robust),
+        other => {
+            return Err(usage(format!(
+                "objective: `{other}` is not `adaptive`, `sum-of-norms`, `least-squares` or \
+                 `robust`"
+            )))
+        }
+    };
+    let robust_scale: Option<f64> = opt(d, "robust_scale", "a number (mm)")?;
+    if let Some(s) = robust_scale {
+        if !(s > 0.0 && s.is_finite() && s <= MAX_LENGTH_MM) {
+            return Err(usage(format!(
+                "robust_scale: {s} is not a positive length of at most {MAX_LENGTH_MM} mm"
+            )));
+        }
+    }
+    let max_iterations: i64 = opt(d, "max_iterations", "an int")?.unwrap_or(1000);
+    if !(1..=MAX_ITERATIONS as i64).contains(&max_iterations) {
+        return Err(usage(format!(
+            "max_iterations: {max_iterations} is not in 1..{MAX_ITERATIONS} (a solver that has \
+             not converged by then will not)"
+        )));
+    }
+
+    // Model families, in the CLI's order: tilts, compliance, harmonics.
+    let beta = joint_selection(d, "beta")?;
+    match beta.trim() {
+        "none" | "" => {}
+        "parallel" => {
+            if robot.enable_beta_for_parallel_axes().is_empty() {
+                notes.push(format!(
+                    "beta=\"parallel\": robot `{}` has no pair of consecutive parallel axes; no \
+                     tilt parameter added",
+                    robot.name()
+                ));
+            }
+        }
+        list => {
+            let js = joint_numbers(robot, list, "beta", "`parallel`, `none`")?;
+            for &j in &js {
+                robot.enable_beta(j).py_err()?;
+            }
+        }
+    }
+    let comp = joint_selection(d, "compliance")?;
+    let mut joints = match comp.trim() {
+        "none" | "" => Vec::new(),
+        "auto" => {
+            let j = compliance::auto_joints(robot);
+            if j.is_empty() {
+                notes.push(format!(
+                    "compliance=\"auto\": no joint of robot `{}` turns under gravity (every axis \
+                     is parallel to its `gravity`); no compliance added",
+                    robot.name()
+                ));
+            }
+            j
+        }
+        list => joint_numbers(robot, list, "compliance", "`auto`, `none`")?,
+    };
+    joints.sort_unstable();
+    let payload_kg: Option<f64> = opt(d, "payload_kg", "a number (kg)")?;
+    if payload_kg.is_some() && joints.is_empty() {
+        return Err(usage(
+            "payload_kg: the payload makes the joint compliances physical; give compliance=\"auto\" \
+             or a list of joints too",
+        ));
+    }
+    if !joints.is_empty() {
+        compliance::enable(robot, &joints, payload_kg)
+            .map_err(|e| usage(crate::errors::message(&e)))?;
+    }
+    let harmonics: i64 = opt(d, "harmonics", "an int")?.unwrap_or(0);
+    if !(0..=transmission::MAX_HARMONICS as i64).contains(&harmonics) {
+        return Err(usage(format!(
+            "harmonics: {harmonics}: from 0 to {} harmonics per joint",
+            transmission::MAX_HARMONICS
+        )));
+    }
+    let all: Vec<usize> = (0..robot.dof()).collect();
+    transmission::enable(robot, &all, harmonics as usize)
+        .map_err(|e| usage(crate::errors::message(&e)))?;
+
+    let fix = param_list(robot, &names(d, "fix")?, "fix")?;
+    let free = param_list(robot, &names(d, "free")?, "free")?;
+    if fix.len() == robot.param_count() {
+        return Err(usage(format!(
+            "fix names every parameter of robot `{}` ({}): nothing is left to identify",
+            robot.name(),
+            robot.param_count()
+        )));
+    }
+    if let Some(p) = fix.iter().find(|p| free.contains(p)) {
+        return Err(input(format!(
+            "fix: `{}` is given both to `fix` and to `free`",
+            p.name()
+        )));
+    }
+    let rank_tol: Option<f64> = opt(d, "rank_tol", "a number")?;
+    let rank_tolerance = rank_tol.unwrap_or(DEFAULT_RANK_TOLERANCE);
+    if !(MIN_RANK_TOLERANCE..1.0).contains(&rank_tolerance) {
+        return Err(usage(format!(
+            "rank_tol: {rank_tolerance:?} is not in [{MIN_RANK_TOLERANCE:e}, 1); it is the \
+             smallest independence (sine of the angle between a parameter's effect and the \
+             others') accepted, and below {MIN_RANK_TOLERANCE:e} double precision cannot tell a \
+             parameter from an exact duplicate"
+        )));
+    }
+
+    let mut weighting = Weighting::default();
+    let tracker_sigma: Option<Vec<f64>> = opt(d, "tracker_sigma", "(fixed_mm, per_m_mm)")?;
+    if let Some(ts) = tracker_sigma {
+        let [fixed, per_m] = ts[..] else {
+            return Err(usage(format!(
+                "tracker_sigma: expected two numbers (fixed_mm, per_m_mm), got {}",
+                ts.len()
+            )));
+        };
+        weighting.tracker = Some(TrackerSigma::new(fixed, per_m).map_err(|_| {
+            usage(format!(
+                "tracker_sigma: ({fixed}, {per_m}): expected (fixed_mm, per_m_mm), both \
+                 non-negative and at most 1000, not both zero (e.g. (0.0075, 0.003))"
+            ))
+        })?);
+    }
+    if let Some(m) = opt::<f64>(d, "orientation_weight", "a number (mm per degree)")? {
+        if !(m > 0.0 && m.is_finite() && m <= 1e6) {
+            return Err(usage(format!(
+                "orientation_weight: {m}: expected a positive number of mm per degree"
+            )));
+        }
+        weighting.mm_per_deg = m;
+    }
+    let flag = |k: &str| -> PyResult<bool> { Ok(opt::<bool>(d, k, "a bool")?.unwrap_or(false)) };
+    let settings = CalibrationSettings {
+        objective,
+        robust_scale_mm: robust_scale,
+        affine_registration: flag("affine")?,
+        identifiability: IdentifiabilityOptions {
+            rank_tolerance,
+            fix,
+            free,
+            allow_ill_conditioned: rank_tol.is_some(),
+        },
+        solver: SolverOptions {
+            max_iterations: max_iterations as usize,
+            ..Default::default()
+        },
+        weighting,
+        validation_refit_frame: flag("validate_refit_frame")?,
+    };
+    Ok(Options {
+        settings,
+        nominal_limits: flag("nominal_limits")?,
+        keep_partial: flag("keep_partial")?,
+        accept_implausible: flag("accept_implausible")?,
+        notes,
+    })
+}
