@@ -39,5 +39,6 @@ mod cli_simulate;
 mod cli_trust_files;
 mod cli_trust_gate;
 mod cli_trust_readers;
+mod cli_urdf;
 mod readme_commands;
 mod report_browser;
