@@ -77,7 +77,7 @@ pub fn chain_robot(chain: &UrdfChain, path: &Path) -> Result<Robot> {
     let robot = mdh::to_robot(chain, err)?;
     let tol = 1e-9 * robot.reach_mm().max(1000.0);
     let worst = worst_fk_difference(chain, &robot, 64);
-    if !(worst <= tol) {
+    if worst.is_nan() || worst > tol {
         return Err(err(format!(
             "the chain from `{}` to `{}` could not be written as a modified DH table: its \
              kinematics differ from the URDF's by {worst:.3e} mm",
