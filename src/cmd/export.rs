@@ -113,8 +113,8 @@ impl TryFrom<&ExportArgs> for Settings {
         if format == ExportFormat::Urdf {
             notes.push(
                 "Joint values are robocal's model joint values (rad; m for a prismatic joint). \
-                 Links: base_link, frame0, link_1..link_n, flange, tcp (the tool point). Import \
-                 it again with: robocal ... --robot FILE.urdf --tip-link tcp"
+                 Links: base_link, frame0, link_1..link_n, flange, tcp (the tool point): read \
+                 it again with tcp as the tip link."
                     .into(),
             );
             if calibrated.controller().is_some() {
