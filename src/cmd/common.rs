@@ -3,12 +3,49 @@
 use anyhow::Context;
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::CalibrationResult;
-use robocal_core::{load_robot, Robot};
+use robocal_core::{load_robot_with, ChainSelection, Robot};
 use std::path::Path;
 
-/// The robot of `--robot NAME|FILE`.
+/// `--base-link` and `--tip-link`: which chain of a URDF robot file to use. Global flags: they
+/// apply to the `--robot` argument of whichever command is given.
+#[derive(clap::Args, Debug, Clone, Default)]
+pub struct ChainArgs {
+    /// URDF robots: the link the robot starts at (its frame is the base frame) [default: the
+    /// file's root link].
+    #[arg(long, global = true, value_name = "LINK")]
+    pub base_link: Option<String>,
+    /// URDF robots: the link the robot ends at (its frame is the tool frame) [default: the only
+    /// end of a chain with movable joints; required when the file holds several].
+    #[arg(long, global = true, value_name = "LINK")]
+    pub tip_link: Option<String>,
+}
+
+static CHAIN: std::sync::OnceLock<ChainSelection> = std::sync::OnceLock::new();
+
+/// Records the command line's `--base-link`/`--tip-link` for [`robot`] (once, before any work).
+pub fn set_chain(a: &ChainArgs) {
+    let _ = CHAIN.set(ChainSelection {
+        base_link: a.base_link.clone(),
+        tip_link: a.tip_link.clone(),
+    });
+}
+
+/// The robot of `--robot NAME|FILE` (for a URDF file, the chain of `--base-link`/`--tip-link`).
 pub fn robot(arg: &str) -> anyhow::Result<Robot> {
-    load_robot(arg).with_context(|| format!("--robot {arg}"))
+    let chain = CHAIN.get().cloned().unwrap_or_default();
+    if chain.is_given() && !robocal_core::io::robot::is_urdf_arg(arg) {
+        let path = Path::new(arg);
+        let urdf = path.is_file()
+            && std::fs::read_to_string(path)
+                .is_ok_and(|t| robocal_core::model::urdf::looks_like_urdf(&t));
+        if !urdf {
+            return Err(crate::exit::usage(format!(
+                "--base-link and --tip-link choose the chain of a URDF robot; --robot {arg} is \
+                 not a URDF file"
+            )));
+        }
+    }
+    load_robot_with(arg, &chain).with_context(|| format!("--robot {arg}"))
 }
 
 /// A nominal robot and, with `--params RESULT.json`, the calibrated one and its result.

@@ -61,6 +61,9 @@ pub fn flag_for(setting: &str) -> Option<&'static str> {
 const PHRASES: &[(&str, &str)] = &[
     ("wrong nominal robot", "wrong --robot"),
     ("rank tolerance", "rank tolerance (--rank-tol)"),
+    ("the `base_link` setting", "--base-link"),
+    ("the `tip_link` setting", "--tip-link"),
+    ("`base_link` and `tip_link`", "--base-link and --tip-link"),
 ];
 
 /// `text` with every setting named in backticks (`` `noise_mm` ``) replaced by its flag.

@@ -5,6 +5,7 @@ mod common;
 mod compensate;
 mod demo;
 mod evaluate;
+mod export;
 mod fk;
 pub(crate) mod flags;
 mod io_plan;
@@ -28,6 +29,9 @@ use clap::{Parser, Subcommand};
 pub struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Which chain of a URDF robot (`--base-link`, `--tip-link`), for every robot argument.
+    #[command(flatten)]
+    chain: common::ChainArgs,
 }
 
 #[derive(Subcommand, Debug)]
@@ -54,6 +58,9 @@ enum Command {
     Plan(plan::PlanArgs),
     /// The HTML report of a calibration result (tables, histogram, per-point errors, parameters).
     Report(report::ReportArgs),
+    /// The calibrated robot of a result as a file for other tools: a URDF (ROS, MoveIt) or a
+    /// robocal robot file.
+    Export(export::ExportArgs),
     /// Shell completions (bash, zsh, fish, elvish, powershell) on standard output.
     Completions(shell::CompletionsArgs),
     /// The manual page (roff) of robocal or one of its commands on standard output.
@@ -62,6 +69,7 @@ enum Command {
 
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    common::set_chain(&cli.chain);
     match cli.command {
         Command::Robot(c) => robot::run(c),
         Command::Fk(a) => fk::run(a),
@@ -72,6 +80,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Demo(a) => demo::run(a),
         Command::Plan(a) => plan::run(a),
         Command::Report(a) => report::run(a),
+        Command::Export(a) => export::run(a),
         Command::Completions(a) => shell::completions(a),
         Command::Man(a) => shell::man(a),
     }

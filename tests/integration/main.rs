@@ -40,6 +40,7 @@ mod cli_stations;
 mod cli_trust_files;
 mod cli_trust_gate;
 mod cli_trust_readers;
+mod cli_urdf;
 mod python_bindings;
 mod readme_commands;
 mod report_browser;

@@ -153,6 +153,7 @@ fn every_command_and_flag_is_documented() {
         &["compensate"],
         &["plan"],
         &["report"],
+        &["export"],
         &["demo"],
         &["completions"],
         &["man"],

@@ -56,7 +56,8 @@ pub fn frame_vector(f: &Frame) -> [f64; 6] {
     let (a, c) = if cb > 1e-12 {
         (r[(1, 0)].atan2(r[(0, 0)]), r[(2, 1)].atan2(r[(2, 2)]))
     } else {
-        (0.0, (-r[(1, 2)]).atan2(r[(1, 1)]) * b.signum())
+        // With A = 0, Ry(±90°) Rx(C) has r11 = cos C and r12 = -sin C at either sign of B.
+        (0.0, (-r[(1, 2)]).atan2(r[(1, 1)]))
     };
     [p.x, p.y, p.z, a, b, c]
 }
@@ -167,6 +168,28 @@ mod tests {
         let w = frame_vector(&pose(&v));
         for k in 0..6 {
             assert!((v[k] - w[k]).abs() < 1e-12, "{k}: {} vs {}", v[k], w[k]);
+        }
+    }
+
+    /// At the singularity B = ±90° the vector's A is 0 and its C takes the whole turn: the frame
+    /// it gives back is the same (B = -90° used to come back with C of the wrong sign).
+    #[test]
+    fn frame_vector_roundtrip_at_the_singularity() {
+        for b in [-90f64, 90.0] {
+            for (a, c) in [(0.0f64, 90.0f64), (30.0, -20.0), (-120.0, 45.0)] {
+                let v = [
+                    1.0,
+                    2.0,
+                    3.0,
+                    a.to_radians(),
+                    b.to_radians(),
+                    c.to_radians(),
+                ];
+                let f = pose(&v);
+                let g = pose(&frame_vector(&f));
+                let gap = (f.rotation.matrix() - g.rotation.matrix()).norm();
+                assert!(gap < 1e-12, "B = {b}, A = {a}, C = {c}: {gap}");
+            }
         }
     }
 

@@ -58,10 +58,11 @@ pub use compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
 pub use error::{Error, Result};
 pub use frame::{frame_vector, pose, Frame, TrackerFrame};
 pub use identification::{ParamEntry, ParamVector};
-pub use io::robot::{load_robot, load_robot_file};
+pub use io::robot::{load_robot, load_robot_file, load_robot_with};
 pub use kinematics::poe::{Poe, Twist};
 pub use model::presets::{preset, PRESETS};
 pub use model::robot_file::parse_robot_toml;
+pub use model::urdf::ChainSelection;
 pub use model::{
     Controller, Convention, FamilyId, JointLimit, JointSpace, JointType, Link, Param,
     ParameterFamily, PoseFrames, Robot, Unit, MAX_JOINTS,

@@ -2,6 +2,7 @@
 
 pub mod atomic;
 pub(crate) mod columns;
+pub mod export;
 pub mod input;
 pub mod joint_limits;
 pub mod json_keys;

@@ -17,6 +17,7 @@ mod params;
 pub mod presets;
 pub mod robot_file;
 mod targets;
+pub mod urdf;
 
 pub use controller::{Controller, Coupling};
 pub use family::{FamilyId, ParameterFamily, PoseFrames, RigidPose};
