@@ -108,7 +108,7 @@ pub struct CalibrateArgs {
         long,
         value_name = "FIXED_MM,PER_M_MM",
         value_delimiter = ',',
-        num_args = 2
+        allow_hyphen_values = true
     )]
     tracker_sigma: Vec<f64>,
     /// 6-DoF data (a,b,c columns): how many mm of position error one degree of orientation
@@ -151,6 +151,12 @@ pub(crate) fn weighting(
     orientation_weight: Option<f64>,
 ) -> anyhow::Result<Weighting> {
     let mut w = Weighting::default();
+    if !tracker_sigma.is_empty() && tracker_sigma.len() != 2 {
+        return Err(exit::usage(format!(
+            "--tracker-sigma: expected two numbers FIXED_MM,PER_M_MM (e.g. 0.0075,0.003), got {}",
+            tracker_sigma.len()
+        )));
+    }
     if let [fixed, per_m] = tracker_sigma {
         w.tracker = Some(TrackerSigma::new(*fixed, *per_m).map_err(|_| {
             exit::usage(format!(

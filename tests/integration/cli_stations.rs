@@ -280,3 +280,77 @@ fn another_station_is_refused_or_fitted_with_refit_frame() {
     // The calibration's own station still evaluates without a refit.
     ok(&["evaluate", "--params", p(&result), "--data", p(&data)]);
 }
+
+/// `--tracker-sigma F,P` as the README writes it: weighted fitting whose standard deviations are
+/// in physical units; a malformed value is a usage error.
+#[test]
+fn tracker_sigma_weights_the_fit() {
+    let dir = Dir::new();
+    let d = dir.path();
+    let data = d.join("cell.csv");
+    ok(&[
+        "simulate",
+        "--robot",
+        "kuka-kr480-r3330",
+        "--truth",
+        "random",
+        "--poses",
+        "75",
+        "--seed",
+        "8",
+        "--out",
+        p(&data),
+    ]);
+    let plain = d.join("plain.json");
+    let weighted = d.join("weighted.json");
+    ok(&[
+        "calibrate",
+        "--robot",
+        "kuka-kr480-r3330",
+        "--data",
+        p(&data),
+        "--out",
+        p(&plain),
+    ]);
+    ok(&[
+        "calibrate",
+        "--robot",
+        "kuka-kr480-r3330",
+        "--data",
+        p(&data),
+        "--out",
+        p(&weighted),
+        "--tracker-sigma",
+        "0.01,0.005",
+    ]);
+    let read = |f: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(f).unwrap()).unwrap()
+    };
+    let (a, b) = (read(&plain), read(&weighted));
+    let (xa, xb) = (
+        a["parameters"]["a2"]["calibrated"].as_f64().unwrap(),
+        b["parameters"]["a2"]["calibrated"].as_f64().unwrap(),
+    );
+    assert!(xa != xb, "the weights change the estimate");
+    assert!((xa - xb).abs() < 0.05, "{xa} vs {xb}");
+    for bad in ["1", "0.01,0.005,1", "-1,0", "x,1"] {
+        let o = robocal(&[
+            "calibrate",
+            "--robot",
+            "kuka-kr480-r3330",
+            "--data",
+            p(&data),
+            "--out",
+            p(&d.join("bad.json")),
+            "--tracker-sigma",
+            bad,
+        ]);
+        assert_eq!(o.code(), Some(2), "{bad}: {}", o.text());
+        assert!(
+            o.stderr().contains("--tracker-sigma"),
+            "{bad}: {}",
+            o.stderr()
+        );
+    }
+    assert!(!d.join("bad.json").exists());
+}
