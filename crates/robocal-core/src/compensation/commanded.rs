@@ -133,7 +133,8 @@ pub fn write_commanded(
 
 /// Whether rows are full-pose compensations (the first has a desired orientation).
 fn is_full_pose(rows: &[Compensation]) -> bool {
-    rows.first().is_some_and(|c| c.desired_orientation.is_some())
+    rows.first()
+        .is_some_and(|c| c.desired_orientation.is_some())
 }
 
 /// The text [`write_commanded`] writes, for callers that write several files together

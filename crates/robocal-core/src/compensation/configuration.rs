@@ -49,7 +49,9 @@ impl Configuration {
     /// The distance to the nearest branch boundary: the smallest normalized factor's magnitude
     /// (0 at a singularity, about 1 far from all).
     pub fn margin(&self) -> f64 {
-        self.factors.iter().fold(f64::INFINITY, |m, f| m.min(f.abs()))
+        self.factors
+            .iter()
+            .fold(f64::INFINITY, |m, f| m.min(f.abs()))
     }
 
     /// The names of the flags that differ between `self` and `other` (`shoulder`, `elbow`,
@@ -119,7 +121,12 @@ pub fn configuration(robot: &Robot, q: &[f64]) -> Option<Configuration> {
 
 /// The point of the line `(p, u)` closest to the line `(r, v)` (unit directions); `p` when the
 /// lines are parallel.
-fn closest_point_on(p: Vector3<f64>, u: Vector3<f64>, r: Vector3<f64>, v: Vector3<f64>) -> Vector3<f64> {
+fn closest_point_on(
+    p: Vector3<f64>,
+    u: Vector3<f64>,
+    r: Vector3<f64>,
+    v: Vector3<f64>,
+) -> Vector3<f64> {
     let w0 = p - r;
     let b = u.dot(&v);
     let den = 1.0 - b * b;
@@ -153,7 +160,10 @@ mod tests {
         // axis 1; the shoulder flag changes.
         let front = configuration(&r, &[0.0, -0.5, 0.5, 0.0, 0.5, 0.0]).unwrap();
         let back = configuration(&r, &[0.0, -2.8, 0.3, 0.0, 0.5, 0.0]).unwrap();
-        assert!(front.changes(&back).contains(&"shoulder"), "{front:?} {back:?}");
+        assert!(
+            front.changes(&back).contains(&"shoulder"),
+            "{front:?} {back:?}"
+        );
         // Elbow: the two elbow solutions of the same wrist point differ in the elbow flag.
         let up = configuration(&r, &[0.0, -1.0, 1.0, 0.0, 0.5, 0.0]).unwrap();
         let down = configuration(&r, &[0.0, -1.0, -2.5, 0.0, 0.5, 0.0]).unwrap();
@@ -169,7 +179,9 @@ mod tests {
             "/../../examples/wam.toml"
         ))
         .unwrap();
-        let wam = crate::model::robot_file::parse_robot_toml(&toml, std::path::Path::new("wam.toml")).unwrap();
+        let wam =
+            crate::model::robot_file::parse_robot_toml(&toml, std::path::Path::new("wam.toml"))
+                .unwrap();
         assert_eq!(wam.dof(), 7);
         assert!(!has_configuration(&wam));
         assert!(configuration(&wam, &[0.0; 7]).is_none());

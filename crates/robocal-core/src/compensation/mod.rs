@@ -486,6 +486,6 @@ fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
 }
 
 #[cfg(test)]
-mod tests;
-#[cfg(test)]
 mod pose_tests;
+#[cfg(test)]
+mod tests;

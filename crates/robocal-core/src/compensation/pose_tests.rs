@@ -133,7 +133,10 @@ fn a_branch_change_and_a_singular_neighbourhood_get_their_statuses() {
     assert_eq!(rep.status, IkStatus::ConfigurationChange, "{rep:?} {q:?}");
     assert!(rep.residual_mm <= 1e-6 && rep.residual_deg <= 1e-6);
     assert!(!rep.status.is_converged() && rep.status.reaches_target());
-    let (a, b) = (configuration(&cal, &seed).unwrap(), configuration(&cal, &q).unwrap());
+    let (a, b) = (
+        configuration(&cal, &seed).unwrap(),
+        configuration(&cal, &q).unwrap(),
+    );
     assert_eq!(a.changes(&b), vec!["wrist"]);
     // Half a degree from the wrist singularity.
     let d = [0.3, -1.2, 1.3, 0.4, 0.5f64.to_radians(), 0.2];
@@ -187,5 +190,9 @@ fn statuses_read_back_and_settings_are_checked() {
         tolerance_deg: 0.0,
         ..PoseNewton::default()
     };
-    assert!(bad.validate().unwrap_err().to_string().contains("tolerance_deg"));
+    assert!(bad
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("tolerance_deg"));
 }
