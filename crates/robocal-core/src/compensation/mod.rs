@@ -27,6 +27,12 @@ mod targets;
 
 pub use dls::DampedLeastSquares;
 pub use pose::PoseNewton;
+
+/// The angle (rad) of a rotation matrix, accurate to rounding near the identity (the norm of its
+/// rotation vector; `acos` of the trace loses half the digits there).
+pub fn rotation_angle(r: &nalgebra::Matrix3<f64>) -> f64 {
+    pose::rotation_vector(r).norm()
+}
 pub use targets::{parse_targets, read_targets, Target, TargetSet};
 
 use crate::error::{Error, Result};
@@ -458,7 +464,7 @@ fn halton(mut k: usize, base: usize) -> f64 {
 /// Turns the first revolute joint of `q` (joint 1, or the first after prismatic ones such as a
 /// linear track) so that the tool point's azimuth about its axis matches the target's (when the
 /// result stays within the joint's limits, trying a full turn either way).
-fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
+pub(crate) fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
     let Some(k) = robot
         .joint_types()
         .iter()
