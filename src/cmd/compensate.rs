@@ -1,5 +1,7 @@
 //! `robocal compensate`: commanded joint values from the calibrated model (paper, section V.A,
-//! eq. 12-14), for desired joint vectors or for Cartesian targets.
+//! eq. 12-14), for desired joint vectors or for Cartesian targets: the whole tool pose by default
+//! (position and orientation, on the desired configuration), the tool position with
+//! `--position-only`.
 
 use super::evaluate::calibrated_model;
 use super::io_plan::IoPlan;
@@ -8,6 +10,7 @@ use crate::exit;
 use anyhow::Context;
 use clap::Args;
 use robocal_core::compensation::commanded::{check_extra_columns, CommandedWriter};
+use robocal_core::compensation::PoseNewton;
 use robocal_core::compensation::{read_targets, Compensation, IkStatus};
 use robocal_core::io::{MeasurementReader, Positions};
 use robocal_core::{Compensator, DampedLeastSquares, Robot, Unit};
@@ -34,8 +37,10 @@ pub struct CompensateArgs {
     /// Other columns are carried; x,y,z (old measurements), if present, are not.
     #[arg(long, value_name = "DESIRED.csv", required_unless_present = "targets")]
     joints: Option<PathBuf>,
-    /// Cartesian targets instead: CSV with x,y,z (mm, robot base frame) and optionally q1..qn
-    /// (or axis1..axisN) to start from; without them, several start configurations are tried.
+    /// Cartesian targets instead: CSV with x,y,z (mm, robot base frame), optionally a,b,c (deg,
+    /// the tool orientation as A, B, C; without them the targets are position-only) and
+    /// optionally q1..qn (or axis1..axisN) to start from; without them, several start
+    /// configurations are tried.
     #[arg(long, value_name = "XYZ.csv", conflicts_with = "joints")]
     targets: Option<PathBuf>,
     /// Output: commanded joints q1..qn (degrees, mm for a prismatic joint) and, when the robot
@@ -47,6 +52,14 @@ pub struct CompensateArgs {
     /// A solve has converged when the tool is this close to its target (mm).
     #[arg(long, default_value_t = 1e-6)]
     tolerance_mm: f64,
+    /// Full pose: a solve has converged when the tool's orientation is this close to the target
+    /// orientation (deg, the angle of the rotation between them).
+    #[arg(long, default_value_t = 1e-6)]
+    tolerance_deg: f64,
+    /// Compensate the tool position only (the paper's eq. 13-14 as written): the orientation is
+    /// free, and the configuration is not checked. Default: the whole pose.
+    #[arg(long)]
+    position_only: bool,
     /// Most iterations (Jacobian evaluations) per solve (1 to 100000).
     #[arg(long, default_value_t = 500)]
     max_iterations: usize,
@@ -69,6 +82,8 @@ struct Settings {
     nominal: Robot,
     calibrated: Robot,
     solver: DampedLeastSquares,
+    pose_solver: PoseNewton,
+    position_only: bool,
     joints: Option<PathBuf>,
     targets: Option<PathBuf>,
     out: PathBuf,
@@ -89,6 +104,16 @@ impl TryFrom<&CompensateArgs> for Settings {
         solver
             .validate()
             .map_err(|e| exit::usage(super::flags::cli_text(&e)))?;
+        let pose_solver = PoseNewton {
+            tolerance_mm: a.tolerance_mm,
+            tolerance_deg: a.tolerance_deg,
+            max_iterations: a.max_iterations,
+            ..PoseNewton::default()
+        };
+        pose_solver
+            .validate()
+            .map_err(|e| exit::usage(super::flags::cli_text(&e)))?;
+        limits::magnitude("--tolerance-deg", a.tolerance_deg, 3600.0, "deg")?;
         limits::count(
             "--max-iterations",
             a.max_iterations,
@@ -140,6 +165,8 @@ impl TryFrom<&CompensateArgs> for Settings {
             nominal,
             calibrated,
             solver,
+            pose_solver,
+            position_only: a.position_only,
             joints: a.joints.clone(),
             targets: a.targets.clone(),
             out: a.out.clone(),
@@ -155,6 +182,8 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         nominal,
         calibrated: cal,
         solver,
+        pose_solver,
+        position_only,
         joints: joints_path,
         targets,
         out,
@@ -165,7 +194,10 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
     let dof = nominal.dof();
     let joints = nominal.joint_space();
     let tolerance_mm = solver.tolerance_mm;
-    let comp = Compensator::new(&nominal, &cal, solver)?;
+    let tolerance_deg = pose_solver.tolerance_deg;
+    let mut comp = Compensator::new(&nominal, &cal, solver)?;
+    comp.pose_solver = pose_solver;
+    let mut full_pose = !position_only;
     let pb = crate::progress::spinner("compensating");
     let mut tally = Tally::default();
     let mut q = vec![0.0; dof];
@@ -182,8 +214,13 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 path.display()
             );
         }
-        let mut w =
-            CommandedWriter::to_output(outputs.open(&out)?, joints, true, reader.extra_columns())?;
+        let mut w = CommandedWriter::to_output(
+            outputs.open(&out)?,
+            joints,
+            true,
+            full_pose,
+            reader.extra_columns(),
+        )?;
         let mut outside = Listing::default();
         while let Some(r) = reader.next_row().with_context(context)? {
             nominal.check_joints(&r.q, &format!("{}:{}", path.display(), r.line))?;
@@ -192,11 +229,22 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 let js: Vec<String> = o.iter().map(|i| format!("q{}", i + 1)).collect();
                 outside.push(format!("line {} ({})", r.line, js.join(" ")));
             }
-            let (p, report) = comp.compensate(&r.q, &mut q);
-            let c = Compensation {
-                desired_position: p,
-                commanded: q.clone(),
-                report,
+            let c = if full_pose {
+                let (f, report) = comp.compensate_pose(&r.q, &mut q);
+                Compensation {
+                    desired_position: f.translation.vector,
+                    desired_orientation: Some(f.rotation),
+                    commanded: q.clone(),
+                    report,
+                }
+            } else {
+                let (p, report) = comp.compensate(&r.q, &mut q);
+                Compensation {
+                    desired_position: p,
+                    desired_orientation: None,
+                    commanded: q.clone(),
+                    report,
+                }
             };
             tally.add(&nominal, r.line, &c, Some(&r.q));
             w.write(&c, Some(&r.q), &r.extra)?;
@@ -222,17 +270,43 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         let set =
             read_targets(path, joints).with_context(|| format!("--targets {}", path.display()))?;
         check_extra_columns(path, joints, &set.extra_columns)?;
-        let mut w =
-            CommandedWriter::to_output(outputs.open(&out)?, joints, false, &set.extra_columns)?;
+        if full_pose && !set.has_orientation {
+            eprintln!(
+                "note: {}: no a,b,c columns: the targets are positions, compensated position-only \
+                 (orientation free, configuration not checked)",
+                path.display()
+            );
+            full_pose = false;
+        } else if position_only && set.has_orientation {
+            eprintln!(
+                "note: {}: --position-only: the a,b,c columns (orientations) are not used",
+                path.display()
+            );
+        }
+        let mut w = CommandedWriter::to_output(
+            outputs.open(&out)?,
+            joints,
+            false,
+            full_pose,
+            &set.extra_columns,
+        )?;
         for t in &set.rows {
             if let Some(s) = &t.seed {
                 cal.check_joints(s, &format!("{}:{}", path.display(), t.line))?;
             }
-            let report = comp.reach(&t.p, t.seed.as_deref(), &mut q);
-            let c = Compensation {
-                desired_position: t.p,
-                commanded: q.clone(),
-                report,
+            let c = match t.frame().filter(|_| full_pose) {
+                Some(f) => Compensation {
+                    desired_position: t.p,
+                    desired_orientation: Some(f.rotation),
+                    report: comp.reach_pose(&f, t.seed.as_deref(), &mut q),
+                    commanded: q.clone(),
+                },
+                None => Compensation {
+                    desired_position: t.p,
+                    desired_orientation: None,
+                    report: comp.reach(&t.p, t.seed.as_deref(), &mut q),
+                    commanded: q.clone(),
+                },
             };
             tally.add(&nominal, t.line, &c, None);
             w.write(&c, None, &t.extra)?;
@@ -267,8 +341,9 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
     writer.commit()?;
     print_summary(
         joints_path.is_some(),
+        full_pose,
         &params,
-        tolerance_mm,
+        (tolerance_mm, tolerance_deg),
         &out,
         input,
         &tally,
@@ -313,10 +388,12 @@ impl Listing {
 #[derive(Default)]
 struct Tally {
     rows: usize,
-    counts: [usize; 4],
+    counts: [usize; IkStatus::ALL.len()],
     failed: Listing,
     max_residual_converged: f64,
     max_residual: f64,
+    max_residual_deg_converged: f64,
+    max_residual_deg: f64,
     iterations: usize,
     max_iterations: usize,
     /// The largest joint change among converged rows, of revolute joints (degrees) and of
@@ -332,6 +409,7 @@ impl Tally {
             self.counts[k] += 1;
         }
         self.max_residual = self.max_residual.max(r.residual_mm);
+        self.max_residual_deg = self.max_residual_deg.max(r.residual_deg);
         self.iterations += r.iterations;
         self.max_iterations = self.max_iterations.max(r.iterations);
         if !r.status.is_converged() {
@@ -339,6 +417,7 @@ impl Tally {
             return;
         }
         self.max_residual_converged = self.max_residual_converged.max(r.residual_mm);
+        self.max_residual_deg_converged = self.max_residual_deg_converged.max(r.residual_deg);
         if let Some(d) = desired {
             for (i, (qc, qd)) in c.commanded.iter().zip(d).enumerate() {
                 let unit = robot.joint_unit(i);
@@ -370,28 +449,45 @@ fn describe_failure(line: usize, c: &Compensation) -> String {
         }
         IkStatus::Unreachable => "outside the workspace of the calibrated model".to_owned(),
         IkStatus::NotConverged => format!("no convergence in {} iterations", r.iterations),
+        IkStatus::ConfigurationChange => {
+            "the pose is reached only on another configuration (shoulder, elbow or wrist) than \
+             the desired one"
+                .to_owned()
+        }
+        IkStatus::Singular => {
+            "near a singularity (configuration undecided, large joint motions)".to_owned()
+        }
         IkStatus::Converged => "converged".to_owned(),
     };
-    format!(
-        "line {line}: {}: {why}; closest {:.4} mm from the target",
-        r.status, r.residual_mm
-    )
+    if c.desired_orientation.is_some() {
+        format!(
+            "line {line}: {}: {why}; {:.4} mm and {:.4} deg from the target pose",
+            r.status, r.residual_mm, r.residual_deg
+        )
+    } else {
+        format!(
+            "line {line}: {}: {why}; closest {:.4} mm from the target",
+            r.status, r.residual_mm
+        )
+    }
 }
 
 /// Prints the summary of a run on `input` (desired joints if `joints`, else targets), solved on
 /// the calibrated model of `params`, written to `out`.
 fn print_summary(
     joints: bool,
+    full_pose: bool,
     params: &std::path::Path,
-    tolerance_mm: f64,
+    (tolerance_mm, tolerance_deg): (f64, f64),
     out: &std::path::Path,
     input: &std::path::Path,
     t: &Tally,
 ) {
-    let mode = if joints {
-        "desired poses; target = nominal tool position (eq. 13)"
-    } else {
-        "Cartesian targets (base frame)"
+    let mode = match (joints, full_pose) {
+        (true, true) => "desired poses; target = nominal tool pose (eq. 13, full pose)",
+        (true, false) => "desired poses; target = nominal tool position (eq. 13, position only)",
+        (false, true) => "Cartesian targets (base frame, full pose)",
+        (false, false) => "Cartesian targets (base frame, position only)",
     };
     println!(
         "{}: {} {mode}; solved on the calibrated model of {}",
@@ -406,6 +502,13 @@ fn print_summary(
         "  residual       max {:.3e} mm over converged rows, {:.3e} mm over all (tolerance {:e} mm)",
         t.max_residual_converged, t.max_residual, tolerance_mm
     );
+    if full_pose {
+        println!(
+            "  orientation    max {:.3e} deg over converged rows, {:.3e} deg over all \
+             (tolerance {:e} deg)",
+            t.max_residual_deg_converged, t.max_residual_deg, tolerance_deg
+        );
+    }
     let it_mean = t.iterations as f64 / t.rows.max(1) as f64;
     println!(
         "  iterations     mean {it_mean:.1}, max {}",

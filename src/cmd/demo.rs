@@ -478,6 +478,7 @@ fn print_files(exp: &Experiment, dir: &Path) {
         format!("--params {}", p(files::RESULT)),
         format!("--joints {}", p(files::DESIRED)),
         format!("--out {}", p(files::COMMANDED)),
+        "--position-only".to_owned(),
     ]);
     let mut verify = vec![
         "robocal simulate".to_owned(),

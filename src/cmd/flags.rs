@@ -49,6 +49,8 @@ const FLAGS: &[(&str, &str)] = &[
     // compensation::DampedLeastSquares
     ("tolerance_mm", "--tolerance-mm"),
     ("max_iterations", "--max-iterations"),
+    // compensation::PoseNewton
+    ("tolerance_deg", "--tolerance-deg"),
 ];
 
 /// The flag that sets a library setting, if there is one.

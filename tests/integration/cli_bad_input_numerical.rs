@@ -33,6 +33,7 @@ fn singular_and_unreachable_poses_are_reported_per_row_never_dropped() {
         p(&fx.result),
         "--joints",
         p(&joints),
+        "--position-only",
         "--out",
         p(&out),
     ]);

@@ -30,6 +30,7 @@ fn joints_mode_writes_converged_commanded_joints() {
         p(&input),
         "--out",
         p(&out),
+        "--position-only",
     ]);
     o.assert_ok();
     let text = o.stdout();

@@ -63,6 +63,7 @@ fn simulate_calibrate_compensate_verify_on_the_tracked_robot() {
         p(&d("res.json")),
         "--joints",
         p(&d("cell.csv")),
+        "--position-only",
         "--out",
         p(&d("cmd.csv")),
     ])

@@ -24,6 +24,7 @@ mod cli_bad_input_numerical;
 mod cli_bad_input_paths;
 mod cli_calibrate;
 mod cli_compensate;
+mod cli_compensate_pose;
 mod cli_compliance;
 mod cli_demo;
 mod cli_evaluate;

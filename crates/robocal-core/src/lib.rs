@@ -42,6 +42,7 @@ pub mod kinematics;
 pub mod model;
 pub mod observations;
 pub mod planning;
+pub mod programs;
 pub mod progress;
 pub mod ranges;
 pub mod registration;

@@ -6,10 +6,12 @@
 //! - `axis1..axisN`, when the robot has a controller map (`[controller]`; the KUKA presets have
 //!   one): the same commanded joints as the controller's axis values, what to send to the
 //!   controller. Without a map axis values are the joint values, and the columns are left out;
-//! - `status` ([`IkStatus::as_str`]), `residual_mm`, `iterations`, `at_limit` (joints that end at a
-//!   limit, e.g. `q2 q5`, empty when none);
+//! - `status` ([`IkStatus::as_str`]), `residual_mm`, `residual_deg` (full pose only: the angle of
+//!   the orientation error), `iterations`, `at_limit` (joints that end at a limit, e.g. `q2 q5`,
+//!   empty when none);
 //! - `x_desired,y_desired,z_desired`: the desired tool position P_des (mm, base frame; eq. 13, or
-//!   the given target);
+//!   the given target), and for a full-pose compensation `a_desired,b_desired,c_desired`, its
+//!   orientation as A, B, C (deg, frame vector convention);
 //! - `q1_desired..qn_desired`: the desired joint values theta_des (degrees or mm; eq. 12), when the
 //!   input was a joint file;
 //! - the input's other columns, unchanged.
@@ -31,12 +33,16 @@ use std::path::Path;
 pub const STATUS_COLUMN: &str = "status";
 /// Column with the solve's residual (mm).
 pub const RESIDUAL_COLUMN: &str = "residual_mm";
+/// Column with the solve's orientation residual (deg; full pose only).
+pub const RESIDUAL_DEG_COLUMN: &str = "residual_deg";
 /// Column with the solve's iteration count.
 pub const ITERATIONS_COLUMN: &str = "iterations";
 /// Column listing the joints that end at a limit.
 pub const AT_LIMIT_COLUMN: &str = "at_limit";
 /// Columns of the desired tool position P_des (mm, base frame).
 pub const DESIRED_POSITION_COLUMNS: [&str; 3] = ["x_desired", "y_desired", "z_desired"];
+/// Columns of the desired tool orientation (A, B, C in deg, base frame; full pose only).
+pub const DESIRED_ORIENTATION_COLUMNS: [&str; 3] = ["a_desired", "b_desired", "c_desired"];
 
 /// The column of desired joint `i` (0-based): `q{i+1}_desired`.
 pub fn desired_joint_column(i: usize) -> String {
@@ -44,23 +50,28 @@ pub fn desired_joint_column(i: usize) -> String {
 }
 
 /// The header of a commanded file for a robot with the joints `joints`, with or without desired
-/// joints, before the input's extra columns.
-pub fn commanded_header(joints: &JointSpace, with_desired_joints: bool) -> Vec<String> {
+/// joints, position-only or full pose, before the input's extra columns.
+pub fn commanded_header(
+    joints: &JointSpace,
+    with_desired_joints: bool,
+    full_pose: bool,
+) -> Vec<String> {
     let dof = joints.dof();
     let mut h: Vec<String> = (0..dof).map(joint_column).collect();
     if joints.controller().is_some() {
         h.extend((0..dof).map(axis_column));
     }
-    h.extend(
-        [
-            STATUS_COLUMN,
-            RESIDUAL_COLUMN,
-            ITERATIONS_COLUMN,
-            AT_LIMIT_COLUMN,
-        ]
-        .map(String::from),
-    );
+    h.push(STATUS_COLUMN.into());
+    h.push(RESIDUAL_COLUMN.into());
+    if full_pose {
+        h.push(RESIDUAL_DEG_COLUMN.into());
+    }
+    h.push(ITERATIONS_COLUMN.into());
+    h.push(AT_LIMIT_COLUMN.into());
     h.extend(DESIRED_POSITION_COLUMNS.map(String::from));
+    if full_pose {
+        h.extend(DESIRED_ORIENTATION_COLUMNS.map(String::from));
+    }
     if with_desired_joints {
         h.extend((0..dof).map(desired_joint_column));
     }
@@ -68,13 +79,14 @@ pub fn commanded_header(joints: &JointSpace, with_desired_joints: bool) -> Vec<S
 }
 
 /// Checks that no extra column of the input (`input` names the file in the message) has the name
-/// of a column the commanded file adds (desired joints included, whichever the mode).
+/// of a column the commanded file adds (desired joints and orientation included, whichever the
+/// mode).
 pub fn check_extra_columns(
     input: &Path,
     joints: &JointSpace,
     extra_columns: &[String],
 ) -> Result<()> {
-    let own = commanded_header(joints, true);
+    let own = commanded_header(joints, true, true);
     for c in extra_columns {
         if own.contains(c) {
             return Err(Error::parse(
@@ -106,11 +118,23 @@ pub fn write_commanded(
             "row counts of results, desired joints and extra columns differ",
         ));
     }
-    let mut w = CommandedWriter::create(path, joints, desired_joints.is_some(), extra_columns)?;
+    let mut w = CommandedWriter::create(
+        path,
+        joints,
+        desired_joints.is_some(),
+        is_full_pose(rows),
+        extra_columns,
+    )?;
     for (k, c) in rows.iter().enumerate() {
         w.write(c, desired_joints.map(|d| d[k].as_slice()), extra_rows[k])?;
     }
     w.commit()
+}
+
+/// Whether rows are full-pose compensations (the first has a desired orientation).
+fn is_full_pose(rows: &[Compensation]) -> bool {
+    rows.first()
+        .is_some_and(|c| c.desired_orientation.is_some())
 }
 
 /// The text [`write_commanded`] writes, for callers that write several files together
@@ -133,6 +157,7 @@ pub fn commanded_csv(
         Path::new("commanded file"),
         joints,
         desired_joints.is_some(),
+        is_full_pose(rows),
         extra_columns,
     )?;
     for (k, c) in rows.iter().enumerate() {
@@ -150,23 +175,26 @@ pub struct CommandedWriter<W: Write = AtomicFile> {
     w: csv::Writer<W>,
     joints: JointSpace,
     with_desired_joints: bool,
+    full_pose: bool,
     extra: usize,
     fields: Vec<String>,
 }
 
 impl CommandedWriter<AtomicFile> {
     /// Starts the file: the header for a robot with the joints `joints`, with or without the
-    /// desired joints, and the input's `extra_columns`.
+    /// desired joints, position-only or `full_pose`, and the input's `extra_columns`.
     pub fn create(
         path: &Path,
         joints: &JointSpace,
         with_desired_joints: bool,
+        full_pose: bool,
         extra_columns: &[String],
     ) -> Result<Self> {
         Self::to_output(
             AtomicFile::create(path)?,
             joints,
             with_desired_joints,
+            full_pose,
             extra_columns,
         )
     }
@@ -177,10 +205,18 @@ impl CommandedWriter<AtomicFile> {
         out: AtomicFile,
         joints: &JointSpace,
         with_desired_joints: bool,
+        full_pose: bool,
         extra_columns: &[String],
     ) -> Result<Self> {
         let path = out.target().to_owned();
-        Self::start(out, &path, joints, with_desired_joints, extra_columns)
+        Self::start(
+            out,
+            &path,
+            joints,
+            with_desired_joints,
+            full_pose,
+            extra_columns,
+        )
     }
 
     /// Completes the file: renames it into place.
@@ -205,9 +241,17 @@ impl CommandedWriter<Vec<u8>> {
         path: &Path,
         joints: &JointSpace,
         with_desired_joints: bool,
+        full_pose: bool,
         extra_columns: &[String],
     ) -> Result<Self> {
-        Self::start(Vec::new(), path, joints, with_desired_joints, extra_columns)
+        Self::start(
+            Vec::new(),
+            path,
+            joints,
+            with_desired_joints,
+            full_pose,
+            extra_columns,
+        )
     }
 
     /// The complete text.
@@ -226,9 +270,10 @@ impl<W: Write> CommandedWriter<W> {
         path: &Path,
         joints: &JointSpace,
         with_desired_joints: bool,
+        full_pose: bool,
         extra_columns: &[String],
     ) -> Result<Self> {
-        let mut header = commanded_header(joints, with_desired_joints);
+        let mut header = commanded_header(joints, with_desired_joints, full_pose);
         header.extend(extra_columns.iter().cloned());
         let mut w = csv::Writer::from_writer(sink);
         w.write_record(&header).map_err(|e| csv_io(path, e))?;
@@ -237,6 +282,7 @@ impl<W: Write> CommandedWriter<W> {
             w,
             joints: joints.clone(),
             with_desired_joints,
+            full_pose,
             extra: extra_columns.len(),
             fields: Vec::with_capacity(header.len()),
         })
@@ -252,6 +298,7 @@ impl<W: Write> CommandedWriter<W> {
     ) -> Result<()> {
         let dof = self.joints.dof();
         let lengths_ok = c.commanded.len() == dof
+            && c.desired_orientation.is_some() == self.full_pose
             && extra.len() == self.extra
             && match desired_joints {
                 Some(d) => self.with_desired_joints && d.len() == dof,
@@ -260,7 +307,8 @@ impl<W: Write> CommandedWriter<W> {
         if !lengths_ok {
             return Err(Error::invalid(
                 "commanded file",
-                "a row does not match the header (joints, desired joints or extra columns)",
+                "a row does not match the header (joints, desired joints, desired orientation or \
+                 extra columns)",
             ));
         }
         let f = &mut self.fields;
@@ -283,6 +331,9 @@ impl<W: Write> CommandedWriter<W> {
         }
         f.push(c.report.status.as_str().to_owned());
         f.push(format!("{:.3e}", c.report.residual_mm));
+        if self.full_pose {
+            f.push(format!("{:.3e}", c.report.residual_deg));
+        }
         f.push(c.report.iterations.to_string());
         f.push(
             c.report
@@ -292,6 +343,13 @@ impl<W: Write> CommandedWriter<W> {
                 .join(" "),
         );
         f.extend(c.desired_position.iter().map(|v| format!("{v:.9}")));
+        if let Some(r) = &c.desired_orientation {
+            let v = crate::frame::frame_vector(&crate::frame::Frame::from_parts(
+                nalgebra::Translation3::identity(),
+                *r,
+            ));
+            f.extend(v[3..].iter().map(|a| format!("{:.9}", a.to_degrees())));
+        }
         if let Some(d) = desired_joints {
             f.extend(display(d));
         }
@@ -308,6 +366,6 @@ fn csv_io(path: &Path, e: csv::Error) -> Error {
 }
 
 /// Counts of each status in `rows`, in [`IkStatus::ALL`] order.
-pub fn status_counts(rows: &[Compensation]) -> [(IkStatus, usize); 4] {
+pub fn status_counts(rows: &[Compensation]) -> [(IkStatus, usize); IkStatus::ALL.len()] {
     IkStatus::ALL.map(|s| (s, rows.iter().filter(|c| c.report.status == s).count()))
 }

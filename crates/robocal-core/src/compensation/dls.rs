@@ -285,6 +285,7 @@ impl IkSolver for DampedLeastSquares {
         let report = |status| IkReport {
             status,
             residual_mm: run.residual,
+            residual_deg: 0.0,
             iterations: run.iterations,
             joints_at_limit: run.at_limit,
         };

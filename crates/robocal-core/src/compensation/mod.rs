@@ -1,5 +1,12 @@
 //! Compensation (paper, section V.A, eq. 12-14): commanded joint values that put the *calibrated*
-//! model's tool point where the controller's *nominal* model believes it to be.
+//! model's tool where the controller's *nominal* model believes it to be.
+//!
+//! Two kinds of target: the tool **pose** (position and orientation; [`Compensator::compensate_pose`],
+//! [`Compensator::reach_pose`], solved by [`PoseNewton`]), the default of `robocal compensate`,
+//! and the tool **position** only (the paper's eq. 13-14 as written; [`Compensator::compensate`],
+//! [`Compensator::reach`], solved by [`DampedLeastSquares`]). A full-pose compensation also keeps
+//! the desired configuration (branch, see [`configuration`]) and says when it cannot
+//! ([`IkStatus::ConfigurationChange`], [`IkStatus::Singular`]).
 //!
 //! For a desired joint vector `theta_des` (eq. 12) the target is its nominal tool position
 //! `P_des = FK_nominal(theta_des)` (eq. 13); numerical inverse kinematics on the calibrated model,
@@ -13,16 +20,26 @@
 //! hidden, a caller decides what to do with rows that did not converge.
 
 pub mod commanded;
+pub mod configuration;
 mod dls;
+mod pose;
 mod targets;
 
 pub use dls::DampedLeastSquares;
+pub use pose::PoseNewton;
+
+/// The angle (rad) of a rotation matrix, accurate to rounding near the identity (the norm of its
+/// rotation vector; `acos` of the trace loses half the digits there).
+pub fn rotation_angle(r: &nalgebra::Matrix3<f64>) -> f64 {
+    pose::rotation_vector(r).norm()
+}
 pub use targets::{parse_targets, read_targets, Target, TargetSet};
 
 use crate::error::{Error, Result};
+use crate::frame::Frame;
 use crate::model::{JointType, Robot, MAX_JOINTS};
 use crate::progress::{Observer, Stage};
-use nalgebra::Vector3;
+use nalgebra::{Rotation3, Vector3};
 
 /// How an inverse-kinematics solve ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -39,24 +56,38 @@ pub enum IkStatus {
     /// Neither of the above: the iteration limit was reached while the error was still
     /// decreasing.
     NotConverged,
+    /// Full pose only: the pose is reached within the tolerances, but on another configuration
+    /// (branch: shoulder, elbow or wrist, see [`configuration`]) than the desired joints'. The
+    /// nearest solution lies on another branch; the robot would flip to get there.
+    ConfigurationChange,
+    /// Full pose only: the pose is reached within the tolerances, but the desired or the
+    /// commanded joints lie in the neighbourhood of a singularity
+    /// ([`PoseNewton::singular_margin`]), where the configuration is undecided and small pose
+    /// changes need large joint motions.
+    Singular,
 }
 
 impl IkStatus {
     /// Every status, in the order used for summaries.
-    pub const ALL: [IkStatus; 4] = [
+    pub const ALL: [IkStatus; 6] = [
         IkStatus::Converged,
         IkStatus::JointLimit,
         IkStatus::Unreachable,
         IkStatus::NotConverged,
+        IkStatus::ConfigurationChange,
+        IkStatus::Singular,
     ];
 
-    /// The word written to files: `converged`, `joint_limit`, `unreachable`, `not_converged`.
+    /// The word written to files: `converged`, `joint_limit`, `unreachable`, `not_converged`,
+    /// `configuration_change`, `singular`.
     pub fn as_str(self) -> &'static str {
         match self {
             IkStatus::Converged => "converged",
             IkStatus::JointLimit => "joint_limit",
             IkStatus::Unreachable => "unreachable",
             IkStatus::NotConverged => "not_converged",
+            IkStatus::ConfigurationChange => "configuration_change",
+            IkStatus::Singular => "singular",
         }
     }
 
@@ -65,9 +96,19 @@ impl IkStatus {
         IkStatus::ALL.into_iter().find(|x| x.as_str() == s.trim())
     }
 
-    /// Whether the solve succeeded.
+    /// Whether the solve succeeded: [`IkStatus::Converged`] only (a configuration change or a
+    /// singular neighbourhood reaches the pose but is not a compensation to send unchecked).
     pub fn is_converged(self) -> bool {
         self == IkStatus::Converged
+    }
+
+    /// Whether the returned joints reach the target within the tolerances (converged, or on
+    /// another configuration, or near a singularity).
+    pub fn reaches_target(self) -> bool {
+        matches!(
+            self,
+            IkStatus::Converged | IkStatus::ConfigurationChange | IkStatus::Singular
+        )
     }
 }
 
@@ -84,6 +125,9 @@ pub struct IkReport {
     pub status: IkStatus,
     /// Distance (mm) between the tool point at the returned joints and the target.
     pub residual_mm: f64,
+    /// Angle (deg) of the orientation error `R_target R^T` at the returned joints (full pose;
+    /// 0 for a position-only solve).
+    pub residual_deg: f64,
     /// Iterations used (Jacobian evaluations of the solve within the limits).
     pub iterations: usize,
     /// Bit `i` set: joint `i` (0-based) ends at one of its limits.
@@ -118,6 +162,9 @@ pub trait IkSolver {
 pub struct Compensation {
     /// The desired tool position `P_des` (mm, base frame): eq. 13, or the given target.
     pub desired_position: Vector3<f64>,
+    /// The desired tool orientation (base frame) of a full-pose compensation; `None` for a
+    /// position-only one.
+    pub desired_orientation: Option<Rotation3<f64>>,
     /// The commanded joint values `theta_com` (rad, model joint values), eq. 14. For a row that
     /// did not converge: the closest configuration found, within the limits.
     pub commanded: Vec<f64>,
@@ -130,8 +177,10 @@ pub struct Compensation {
 pub struct Compensator<'a, S: IkSolver = DampedLeastSquares> {
     nominal: &'a Robot,
     calibrated: &'a Robot,
-    /// The inverse-kinematics method and its tolerances.
+    /// The inverse-kinematics method for positions and its tolerances.
     pub solver: S,
+    /// The inverse-kinematics method for full poses and its tolerances.
+    pub pose_solver: PoseNewton,
     /// How many start configurations [`Compensator::reach`] tries for a target without a seed
     /// (see [`default_seeds`]).
     pub seeds: usize,
@@ -158,6 +207,7 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
             nominal,
             calibrated,
             solver,
+            pose_solver: PoseNewton::default(),
             seeds: 8,
         })
     }
@@ -217,6 +267,94 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
         best.expect("at least one seed")
     }
 
+    /// Full-pose compensation of one desired joint vector (rad): the target is the nominal tool
+    /// frame `FK_nominal(desired)` (eq. 13 with the orientation), solved on the calibrated model
+    /// from `desired` ([`PoseNewton`]); writes `theta_com` to `commanded`. The status says when
+    /// the solution lies on another configuration than `desired` or near a singularity (see
+    /// [`Compensator::check_configuration`]). Returns the target frame and the report.
+    /// Allocation-free.
+    pub fn compensate_pose(&self, desired: &[f64], commanded: &mut [f64]) -> (Frame, IkReport) {
+        let target = self.nominal.tool_pose(desired);
+        let rep = self
+            .pose_solver
+            .solve(self.calibrated, &target, 0, desired, commanded);
+        let rep = self.check_configuration(self.nominal, desired, commanded, rep);
+        (target, rep)
+    }
+
+    /// Turns a report that reached its target into [`IkStatus::Singular`] when the reference
+    /// joints `reference` (rad, of `reference_model`: the desired joints on the nominal model,
+    /// or a seed on the calibrated one) or the solution `q` (on the calibrated model) lie within
+    /// [`PoseNewton::singular_margin`] of a singularity, else into
+    /// [`IkStatus::ConfigurationChange`] when their configurations differ
+    /// ([`configuration::configuration`]). Robots without a configuration are not checked.
+    pub fn check_configuration(
+        &self,
+        reference_model: &Robot,
+        reference: &[f64],
+        q: &[f64],
+        mut rep: IkReport,
+    ) -> IkReport {
+        if rep.status != IkStatus::Converged {
+            return rep;
+        }
+        let (Some(a), Some(b)) = (
+            configuration::configuration(reference_model, reference),
+            configuration::configuration(self.calibrated, q),
+        ) else {
+            return rep;
+        };
+        if a.margin().min(b.margin()) < self.pose_solver.singular_margin {
+            rep.status = IkStatus::Singular;
+        } else if a.flags != b.flags {
+            rep.status = IkStatus::ConfigurationChange;
+        }
+        rep
+    }
+
+    /// Joint values (rad) that put the calibrated model's tool frame at `target` (base frame),
+    /// position and orientation. With a `seed` the solve starts there and keeps its configuration
+    /// (or says it could not); without, it tries up to [`Compensator::seeds`] start
+    /// configurations as [`Compensator::reach`] does and keeps the first that reaches the pose
+    /// (whatever its configuration; [`IkStatus::Singular`] near a singularity), else the one that
+    /// ends closest (position error plus [`PoseNewton::length_scale_mm`] times the angle).
+    pub fn reach_pose(&self, target: &Frame, seed: Option<&[f64]>, q: &mut [f64]) -> IkReport {
+        let cal = self.calibrated;
+        if let Some(s) = seed {
+            let rep = self.pose_solver.solve(cal, target, 0, s, q);
+            return self.check_configuration(cal, s, q, rep);
+        }
+        let n = cal.dof();
+        let mut start = [0.0; MAX_JOINTS];
+        let mut trial = [0.0; MAX_JOINTS];
+        let mut best: Option<IkReport> = None;
+        let cost = |r: &IkReport| {
+            r.residual_mm + self.pose_solver.length_scale_mm * r.residual_deg.to_radians()
+        };
+        let p = target.translation.vector;
+        for k in 0..self.seeds.max(1) {
+            seed_configuration(cal, k, &mut start[..n]);
+            turn_towards(cal, &p, &mut start[..n]);
+            let rep = self
+                .pose_solver
+                .solve(cal, target, 0, &start[..n], &mut trial[..n]);
+            let better = match &best {
+                None => true,
+                Some(b) => rep.status.is_converged() || cost(&rep) < cost(b),
+            };
+            if better {
+                q.copy_from_slice(&trial[..n]);
+                best = Some(rep);
+            }
+            if rep.status.is_converged() {
+                break;
+            }
+        }
+        let rep = best.expect("at least one seed");
+        // Without a desired branch only the singular neighbourhood is checked.
+        self.check_configuration(cal, q, q, rep)
+    }
+
     /// Compensates every desired joint vector (rad), in order (eq. 12-14). `observer` hears
     /// [`Stage::Compensation`] as rows complete.
     pub fn compensate_all(
@@ -233,6 +371,7 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
             let (p, report) = self.compensate(d, &mut q);
             out.push(Compensation {
                 desired_position: p,
+                desired_orientation: None,
                 commanded: q,
                 report,
             });
@@ -268,6 +407,7 @@ impl<'a, S: IkSolver> Compensator<'a, S> {
             let report = self.reach(&t.p, t.seed.as_deref(), &mut q);
             out.push(Compensation {
                 desired_position: t.p,
+                desired_orientation: None,
                 commanded: q,
                 report,
             });
@@ -324,7 +464,7 @@ fn halton(mut k: usize, base: usize) -> f64 {
 /// Turns the first revolute joint of `q` (joint 1, or the first after prismatic ones such as a
 /// linear track) so that the tool point's azimuth about its axis matches the target's (when the
 /// result stays within the joint's limits, trying a full turn either way).
-fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
+pub(crate) fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
     let Some(k) = robot
         .joint_types()
         .iter()
@@ -351,5 +491,7 @@ fn turn_towards(robot: &Robot, target: &Vector3<f64>, q: &mut [f64]) {
     }
 }
 
+#[cfg(test)]
+mod pose_tests;
 #[cfg(test)]
 mod tests;

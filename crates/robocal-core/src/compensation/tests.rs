@@ -201,12 +201,14 @@ fn targets_outside_the_workspace_are_reported() {
         Target {
             line: 2,
             p: Vector3::new(8_000.0, 0.0, 1_000.0),
+            abc: None,
             seed: Some(vec![0.0; 6]),
             extra: vec![],
         },
         Target {
             line: 3,
             p: cal.tool_position(&[0.1, -0.5, 0.4, 0.2, 0.3, 0.0]),
+            abc: None,
             seed: None,
             extra: vec![],
         },

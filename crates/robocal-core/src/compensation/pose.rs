@@ -1,0 +1,412 @@
+//! Full-pose inverse kinematics: joint values that put a tool frame at a target frame, position
+//! *and* orientation (the paper's eq. 14 with the whole pose as the target).
+//!
+//! The residual of a pose is six numbers: the position error `e_p = p_target - p` (mm, base
+//! frame) and the orientation error as a rotation vector `e_w = log(R_target R^T)` (rad, base
+//! frame): never differences of A, B, C angles, which are unstable near B = ±90 degrees
+//! (DESIGN.md). The Jacobian is the 6 x n spatial Jacobian at the tool point: column `i` is
+//! `[z_i x (p - o_i); z_i]` for a revolute joint (`z_i` the axis, `o_i` a point on it) and
+//! `[z_i; 0]` for a prismatic one. Position rows are divided by
+//! [`PoseNewton::length_scale_mm`] so that a millimetre and a milliradian weigh comparably.
+//!
+//! Each step is the damped minimum-norm step `dq = J^T (J J^T + lambda I)^-1 e` (Levenberg–
+//! Marquardt, the damping adapted by the gain ratio and driven to 1e-14 of the mean eigenvalue
+//! after good steps):
+//! - **6 joints**: the system is square and the step tends to the Newton step `J^-1 e`, which
+//!   converges quadratically from the desired joints (a compensation moves the joints by
+//!   milliradians): 2 to 4 iterations;
+//! - **more than 6 joints** (a 6R arm on a track, a 7-joint arm): the minimum-norm step keeps the
+//!   joints as close to the start as the pose allows (the redundancy is spent on staying near
+//!   the desired joints), and still converges quadratically away from singularities;
+//! - **fewer than 6 joints**: a general pose is out of reach (6 equations, fewer unknowns); the
+//!   iteration ends at the least-squares pose of the weighted residual and reports
+//!   [`IkStatus::Unreachable`] unless the pose happens to be reachable. Use position-only
+//!   compensation ([`super::DampedLeastSquares`]) for such robots.
+//!
+//! Joint limits, the trust region and the classification of a stop ([`IkStatus::JointLimit`],
+//! [`IkStatus::Unreachable`], [`IkStatus::NotConverged`]) work as in the position solver; the
+//! configuration statuses are added by the caller, which knows the desired branch
+//! (see [`super::configuration`]).
+//!
+//! Allocation-free: everything lives on the stack (`Matrix6`, `Vector6`, arrays of
+//! [`MAX_JOINTS`]).
+
+use super::{IkReport, IkStatus};
+use crate::error::{Error, Result};
+use crate::frame::Frame;
+use crate::model::{JointType, Robot, MAX_JOINTS};
+use nalgebra::{Matrix6, Vector3, Vector6};
+
+/// Damped Newton inverse kinematics for the whole tool pose (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PoseNewton {
+    /// Position tolerance (mm). Default 1e-6.
+    pub tolerance_mm: f64,
+    /// Orientation tolerance (deg): the angle of `R_target R^T`. Default 1e-6.
+    pub tolerance_deg: f64,
+    /// Most Jacobian evaluations per solve. Default 200.
+    pub max_iterations: usize,
+    /// Largest change of any joint in one step (rad; times
+    /// [`PoseNewton::prismatic_scale_mm`] for a prismatic joint). Default 0.25.
+    pub max_step_rad: f64,
+    /// How many mm of a prismatic joint weigh as much as one radian of a revolute joint in the
+    /// step norm. Default 1000.
+    pub prismatic_scale_mm: f64,
+    /// How many mm of position error weigh as much as one radian of orientation error. Default
+    /// 1000 (a metre-sized arm: a milliradian turns the tool point by about a millimetre).
+    pub length_scale_mm: f64,
+    /// Initial damping, relative to the mean eigenvalue of `J J^T`. Default 1e-9.
+    pub initial_damping: f64,
+    /// A stop counts as a stationary point of the residual when no free joint's motion has a
+    /// direction cosine with the (scaled) residual larger than this. Default 1e-3.
+    pub stationary_cosine: f64,
+    /// The neighbourhood of a singularity: a configuration margin
+    /// ([`super::configuration::Configuration::margin`]) below this gives
+    /// [`IkStatus::Singular`]. Default 0.01 (about 0.6 degrees from a wrist or elbow
+    /// singularity, 1% of the reach from the shoulder singularity).
+    pub singular_margin: f64,
+}
+
+impl Default for PoseNewton {
+    fn default() -> Self {
+        PoseNewton {
+            tolerance_mm: 1e-6,
+            tolerance_deg: 1e-6,
+            max_iterations: 200,
+            max_step_rad: 0.25,
+            prismatic_scale_mm: 1000.0,
+            length_scale_mm: 1000.0,
+            initial_damping: 1e-9,
+            stationary_cosine: 1e-3,
+            singular_margin: 0.01,
+        }
+    }
+}
+
+const MAX_DAMPING: f64 = 1e8;
+const MIN_DAMPING: f64 = 1e-14;
+/// Relative decrease of the residual over the second half of the budget below which a run that
+/// used it up counts as stopped on a plateau.
+const PLATEAU: f64 = 1e-3;
+
+/// Where one run stopped.
+#[derive(Clone, Copy)]
+struct Run {
+    residual_mm: f64,
+    residual_rad: f64,
+    iterations: usize,
+    blocking: u32,
+    at_limit: u32,
+    stationary: bool,
+}
+
+/// The residual of a pose and the scaled Jacobian columns at it.
+struct Eval {
+    e: Vector6<f64>,
+    ep: f64,
+    ew: f64,
+}
+
+impl PoseNewton {
+    /// The defaults.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Checks the settings: positive finite tolerances, step, scales and damping, at least one
+    /// iteration, a stationary cosine in (0, 1), a non-negative singular margin.
+    pub fn validate(&self) -> Result<()> {
+        let pos = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(Error::invalid(
+                    name,
+                    format!("{v} must be a positive number"),
+                ))
+            }
+        };
+        pos("tolerance_mm", self.tolerance_mm)?;
+        pos("tolerance_deg", self.tolerance_deg)?;
+        pos("max_step_rad", self.max_step_rad)?;
+        pos("prismatic_scale_mm", self.prismatic_scale_mm)?;
+        pos("length_scale_mm", self.length_scale_mm)?;
+        pos("initial_damping", self.initial_damping)?;
+        if self.max_iterations == 0 {
+            return Err(Error::invalid("max_iterations", "must be at least 1"));
+        }
+        if !(self.stationary_cosine > 0.0 && self.stationary_cosine < 1.0) {
+            return Err(Error::invalid(
+                "stationary_cosine",
+                format!("{} must lie in (0, 1)", self.stationary_cosine),
+            ));
+        }
+        if !(self.singular_margin.is_finite() && self.singular_margin >= 0.0) {
+            return Err(Error::invalid(
+                "singular_margin",
+                format!("{} must be a non-negative number", self.singular_margin),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Joint values (rad, mm for a prismatic joint) that put `robot`'s target `t` frame (0-based;
+    /// 0 is the tool, [`Robot::target_pose`]) at `target` (base frame), starting from `start`
+    /// (moved into the limits first). Writes them to `q` and reports how the solve ended with
+    /// one of [`IkStatus::Converged`], [`IkStatus::JointLimit`], [`IkStatus::Unreachable`],
+    /// [`IkStatus::NotConverged`]; the residuals are the position error (mm) and the angle of the
+    /// orientation error (deg).
+    ///
+    /// Panics if `start` or `q` do not have `robot.dof()` entries or `t` is not a target of the
+    /// robot (programming errors).
+    pub fn solve(
+        &self,
+        robot: &Robot,
+        target: &Frame,
+        t: usize,
+        start: &[f64],
+        q: &mut [f64],
+    ) -> IkReport {
+        let n = robot.dof();
+        assert_eq!(start.len(), n, "start joint vector length");
+        assert_eq!(q.len(), n, "output joint vector length");
+        assert!(t < robot.target_count(), "target index");
+        for (i, l) in robot.limits().iter().enumerate() {
+            q[i] = start[i].clamp(l.min, l.max);
+        }
+        let run = self.run(robot, target, t, q, true);
+        let report = |status| IkReport {
+            status,
+            residual_mm: run.residual_mm,
+            residual_deg: run.residual_rad.to_degrees(),
+            iterations: run.iterations,
+            joints_at_limit: run.at_limit,
+        };
+        if self.within_tolerance(run.residual_mm, run.residual_rad) {
+            return report(IkStatus::Converged);
+        }
+        let unc = if run.blocking != 0 {
+            let mut free = [0.0; MAX_JOINTS];
+            free[..n].copy_from_slice(q);
+            self.run(robot, target, t, &mut free[..n], false)
+        } else {
+            run
+        };
+        if self.within_tolerance(unc.residual_mm, unc.residual_rad) {
+            report(IkStatus::JointLimit)
+        } else if unc.stationary {
+            report(IkStatus::Unreachable)
+        } else {
+            report(IkStatus::NotConverged)
+        }
+    }
+
+    fn within_tolerance(&self, mm: f64, rad: f64) -> bool {
+        mm <= self.tolerance_mm && rad.to_degrees() <= self.tolerance_deg
+    }
+
+    /// The residual at `q` and the scaled Jacobian columns (one per joint, per scaled joint
+    /// unit) into `cols`.
+    fn eval(
+        &self,
+        robot: &Robot,
+        target: &Frame,
+        t: usize,
+        q: &[f64],
+        sc: &[f64; MAX_JOINTS],
+        cols: &mut [Vector6<f64>; MAX_JOINTS],
+    ) -> Eval {
+        let n = robot.dof();
+        let frames = robot.pose_frames_target(q, t);
+        let tool = frames.flange * robot.target_tool_frame(t);
+        let p = tool.translation.vector;
+        let ep = target.translation.vector - p;
+        let ew = rotation_vector(&(target.rotation.matrix() * tool.rotation.matrix().transpose()));
+        let l = self.length_scale_mm;
+        let types = robot.joint_types();
+        for i in 0..n {
+            let f = &frames.axis[i];
+            let z: Vector3<f64> = f.rotation.matrix().column(2).into();
+            let (v, w) = if types[i] == JointType::Prismatic {
+                (z, Vector3::zeros())
+            } else {
+                (z.cross(&(p - f.translation.vector)), z)
+            };
+            let s = sc[i];
+            cols[i] = Vector6::new(
+                v.x * s / l,
+                v.y * s / l,
+                v.z * s / l,
+                w.x * s,
+                w.y * s,
+                w.z * s,
+            );
+        }
+        let e = Vector6::new(ep.x / l, ep.y / l, ep.z / l, ew.x, ew.y, ew.z);
+        Eval {
+            e,
+            ep: ep.norm(),
+            ew: ew.norm(),
+        }
+    }
+
+    /// The iteration on `q` (in place); with `limits`, joints stay within the robot's limits.
+    fn run(&self, robot: &Robot, target: &Frame, t: usize, q: &mut [f64], limits: bool) -> Run {
+        let n = robot.dof();
+        let lim = robot.limits();
+        let mut sc = [1.0; MAX_JOINTS];
+        for (s, ty) in sc.iter_mut().zip(robot.joint_types()) {
+            if *ty == JointType::Prismatic {
+                *s = self.prismatic_scale_mm;
+            }
+        }
+        let mut cols = [Vector6::zeros(); MAX_JOINTS];
+        let mut cols_t = [Vector6::zeros(); MAX_JOINTS];
+        let mut qt = [0.0; MAX_JOINTS];
+        let mut ev = self.eval(robot, target, t, q, &sc, &mut cols);
+        let mut r = ev.e.norm();
+        let mut mu = self.initial_damping;
+        let mut iterations = 1;
+        let mut stalled = false;
+        let mut r_half = f64::INFINITY;
+        loop {
+            if r_half.is_infinite() && 2 * iterations >= self.max_iterations {
+                r_half = r;
+            }
+            let mut free = 0u32;
+            for i in 0..n {
+                let g = cols[i].dot(&ev.e);
+                let blocked =
+                    limits && ((q[i] <= lim[i].min && g < 0.0) || (q[i] >= lim[i].max && g > 0.0));
+                if !blocked {
+                    free |= 1 << i;
+                }
+            }
+            if self.within_tolerance(ev.ep, ev.ew) || iterations >= self.max_iterations {
+                break;
+            }
+            let mut a = Matrix6::zeros();
+            for i in (0..n).filter(|i| free & (1 << i) != 0) {
+                a += cols[i] * cols[i].transpose();
+            }
+            let scale = a.trace() / 6.0;
+            if scale <= 0.0 || !scale.is_finite() {
+                stalled = true;
+                break;
+            }
+            let mut accepted = false;
+            let mut nu = 2.0;
+            while mu <= MAX_DAMPING {
+                let m = a + Matrix6::identity() * (mu * scale);
+                let Some(ch) = m.cholesky() else {
+                    mu *= nu;
+                    nu *= 2.0;
+                    continue;
+                };
+                let y = ch.solve(&ev.e);
+                let mut largest = 0.0f64;
+                for i in 0..n {
+                    qt[i] = if free & (1 << i) != 0 {
+                        cols[i].dot(&y)
+                    } else {
+                        0.0
+                    };
+                    largest = largest.max(qt[i].abs());
+                }
+                let shrink = if largest > self.max_step_rad {
+                    self.max_step_rad / largest
+                } else {
+                    1.0
+                };
+                let mut predicted = ev.e;
+                for i in 0..n {
+                    let mut v = q[i] + sc[i] * qt[i] * shrink;
+                    if limits {
+                        v = v.clamp(lim[i].min, lim[i].max);
+                    }
+                    predicted -= cols[i] * ((v - q[i]) / sc[i]);
+                    qt[i] = v;
+                }
+                let et = self.eval(robot, target, t, &qt[..n], &sc, &mut cols_t);
+                iterations += 1;
+                let rt = et.e.norm();
+                if rt < r {
+                    let gain = (r * r - rt * rt) / (r * r - predicted.norm_squared()).max(1e-300);
+                    q.copy_from_slice(&qt[..n]);
+                    std::mem::swap(&mut cols, &mut cols_t);
+                    ev = et;
+                    r = rt;
+                    mu = (mu * (1.0 / 3.0f64).max(1.0 - (2.0 * gain - 1.0).powi(3)))
+                        .max(MIN_DAMPING);
+                    accepted = true;
+                    break;
+                }
+                mu *= nu;
+                nu *= 2.0;
+                if iterations >= self.max_iterations {
+                    break;
+                }
+            }
+            if !accepted {
+                stalled = mu > MAX_DAMPING;
+                break;
+            }
+        }
+        let mut blocking = 0u32;
+        let mut at_limit = 0u32;
+        let mut max_cosine = 0.0f64;
+        for i in 0..n {
+            let cn = cols[i].norm();
+            let cos = if cn > 0.0 && r > 0.0 {
+                cols[i].dot(&ev.e) / (cn * r)
+            } else {
+                0.0
+            };
+            let low = limits && q[i] <= lim[i].min;
+            let high = limits && q[i] >= lim[i].max;
+            if low || high {
+                at_limit |= 1 << i;
+            }
+            if (low && cos < -self.stationary_cosine) || (high && cos > self.stationary_cosine) {
+                blocking |= 1 << i;
+            } else if !((low && cos < 0.0) || (high && cos > 0.0)) {
+                max_cosine = max_cosine.max(cos.abs());
+            }
+        }
+        let plateau = iterations >= self.max_iterations && r_half - r < PLATEAU * r_half;
+        // With fewer joints than equations, every column orthogonal to the residual is the
+        // least-squares optimum: stationary too.
+        Run {
+            residual_mm: ev.ep,
+            residual_rad: ev.ew,
+            iterations,
+            blocking,
+            at_limit,
+            stationary: stalled || plateau || max_cosine < self.stationary_cosine,
+        }
+    }
+}
+
+/// The rotation vector `log(R)` (rad) of a rotation matrix, accurate to rounding at small angles
+/// (nalgebra's `scaled_axis` goes through `acos` of the trace, whose error near the identity is
+/// about 1e-8 rad, above a 1e-6 degree tolerance's reach): the angle from `atan2` of the skew
+/// and symmetric parts.
+pub(crate) fn rotation_vector(r: &nalgebra::Matrix3<f64>) -> Vector3<f64> {
+    let v = 0.5
+        * Vector3::new(
+            r[(2, 1)] - r[(1, 2)],
+            r[(0, 2)] - r[(2, 0)],
+            r[(1, 0)] - r[(0, 1)],
+        );
+    let s = v.norm();
+    let c = 0.5 * (r.trace() - 1.0);
+    if s < 1e-3 && c > 0.0 {
+        // theta / sin(theta) by its series: accurate where the ratio is about 1.
+        return v * (1.0 + s * s / 6.0 + 3.0 * s.powi(4) / 40.0);
+    }
+    if c > -0.99 {
+        return v * (s.atan2(c) / s);
+    }
+    // Near a half turn the skew part vanishes: the axis from the symmetric part.
+    nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis()
+}
