@@ -8,6 +8,7 @@ use crate::robot::{per_pose, PyRobot};
 use numpy::PyArray1;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use robocal_core::compensation::PoseNewton;
 use robocal_core::io::CalibrationResult;
 use robocal_core::{Compensator, DampedLeastSquares};
 use std::path::Path;
@@ -20,7 +21,7 @@ const MAX_IK_ITERATIONS: usize = 100_000;
 /// tool at `q`, eq. 13), `status` (list of "converged", "joint_limit", "unreachable",
 /// "not_converged"), `residual_mm` (n,) and `iterations` (n,); and the warnings.
 #[pyfunction]
-#[pyo3(signature = (text, q, nominal = None, tolerance_mm = 1e-6, max_iterations = 500, payload_kg = None, accept_implausible = false))]
+#[pyo3(signature = (text, q, nominal = None, tolerance_mm = 1e-6, max_iterations = 500, payload_kg = None, accept_implausible = false, position_only = false, tolerance_deg = 1e-6))]
 #[allow(clippy::too_many_arguments)]
 pub fn compensate_arrays<'py>(
     py: Python<'py>,
@@ -31,6 +32,8 @@ pub fn compensate_arrays<'py>(
     max_iterations: usize,
     payload_kg: Option<f64>,
     accept_implausible: bool,
+    position_only: bool,
+    tolerance_deg: f64,
 ) -> PyResult<(Bound<'py, PyDict>, Vec<String>)> {
     if !(1..=MAX_IK_ITERATIONS).contains(&max_iterations) {
         return Err(usage(format!(
@@ -44,6 +47,15 @@ pub fn compensate_arrays<'py>(
         ..DampedLeastSquares::default()
     };
     solver
+        .validate()
+        .map_err(|e| usage(crate::errors::message(&e)))?;
+    let pose_solver = PoseNewton {
+        tolerance_mm,
+        tolerance_deg,
+        max_iterations,
+        ..PoseNewton::default()
+    };
+    pose_solver
         .validate()
         .map_err(|e| usage(crate::errors::message(&e)))?;
     let res = CalibrationResult::parse(text, Path::new("<result json>")).py_err()?;
@@ -95,14 +107,21 @@ pub fn compensate_arrays<'py>(
             if outside.len() > 10 { ", ..." } else { "" }
         ));
     }
-    let comp = Compensator::new(&nom.inner, &cal.inner, solver).py_err()?;
+    let mut comp = Compensator::new(&nom.inner, &cal.inner, solver).py_err()?;
+    comp.pose_solver = pose_solver;
     let dof = nom.inner.dof();
-    // Per pose: commanded joints, desired position, status, residual, iterations.
-    let width = dof + 3 + 3;
+    // Per pose: commanded joints, desired position, status, residual (mm), iterations,
+    // residual (deg).
+    let width = dof + 3 + 4;
     let js = nom.inner.joint_space();
     let out = py.detach(|| {
         per_pose(&m, width, |q, o| {
-            let (p, rep) = comp.compensate(q, &mut o[..dof]);
+            let (p, rep) = if position_only {
+                comp.compensate(q, &mut o[..dof])
+            } else {
+                let (f, rep) = comp.compensate_pose(q, &mut o[..dof]);
+                (f.translation.vector, rep)
+            };
             for j in 0..dof {
                 o[j] = js.to_display(j, o[j]);
             }
@@ -114,6 +133,7 @@ pub fn compensate_arrays<'py>(
             o[dof + 3] = status as f64;
             o[dof + 4] = rep.residual_mm;
             o[dof + 5] = rep.iterations as f64;
+            o[dof + 6] = rep.residual_deg;
         })
     });
     let col = |k: usize| -> Vec<f64> { out.chunks(width).map(|o| o[k]).collect() };
@@ -133,5 +153,6 @@ pub fn compensate_arrays<'py>(
     d.set_item("residual_mm", PyArray1::from_vec(py, col(dof + 4)))?;
     let iterations: Vec<i64> = col(dof + 5).iter().map(|v| *v as i64).collect();
     d.set_item("iterations", PyArray1::from_vec(py, iterations))?;
+    d.set_item("residual_deg", PyArray1::from_vec(py, col(dof + 6)))?;
     Ok((d, warnings))
 }

@@ -106,3 +106,12 @@ def test_compensate_is_the_clis(fit, real_data, cli, tmp_path):
     assert one["commanded"].shape == (6,)
     with pytest.raises(robocal.UsageError, match="max_iterations"):
         fit.compensate(vq, max_iterations=0)
+    # Position only, as `--position-only`: the same point, other joints than the full pose.
+    pc = fit.compensate(vq, position_only=True)
+    out2 = tmp_path / "commanded-position.csv"
+    cli("compensate", "--params", str(p), "--joints", str(data), "--out", str(out2), "--position-only")
+    b = np_.genfromtxt(out2, delimiter=",", names=True, dtype=None, encoding="utf-8")
+    bq = np_.column_stack([b[f"q{i}"].astype(float) for i in range(1, 7)])
+    assert np.allclose(pc["commanded"], bq, rtol=0, atol=1e-8)
+    assert np.allclose(cal.fk(pc["commanded"]), fit.nominal_robot().fk(vq), atol=1e-5)
+    assert np.all(c["residual_deg"] <= 1e-6)

@@ -199,21 +199,34 @@ class Result:
         max_iterations: int = 500,
         payload_kg: Optional[float] = None,
         accept_implausible: bool = False,
+        position_only: bool = False,
+        tolerance_deg: float = 1e-6,
     ) -> Dict[str, Any]:
         """Compensated joint commands for desired poses (paper, eq. 12-14): ``robocal compensate
-        --joints``.
+        --joints``. By default the full pose (position and orientation of the tool, on the
+        desired configuration); ``position_only=True`` compensates the tool point only (the
+        paper's eq. 14, ``--position-only``).
 
         ``q`` (n, dof): the desired joint values in degrees (the poses the nominal model would
         reach). Returns ``commanded`` (n, dof; degrees: the calibrated model puts the tool where
         the nominal one puts it at ``q``), ``desired_position`` (n, 3; mm, base frame),
-        ``status`` (list: "converged", "joint_limit", "unreachable", "not_converged"),
-        ``residual_mm`` (n,) and ``iterations`` (n,). A partial result raises
+        ``status`` (list: "converged", "joint_limit", "unreachable", "not_converged",
+        "configuration_change", "singular"), ``residual_mm`` (n,), ``residual_deg`` (n,) and
+        ``iterations`` (n,). A partial result raises
         :class:`InputError`; an implausible one :class:`ImplausibleError` unless
         ``accept_implausible``. ``payload_kg``: the payload now carried, for a result whose
         compliances are physical.
         """
         out, notes = _robocal.compensate_arrays(
-            self._text, q, nominal, tolerance_mm, max_iterations, payload_kg, accept_implausible
+            self._text,
+            q,
+            nominal,
+            tolerance_mm,
+            max_iterations,
+            payload_kg,
+            accept_implausible,
+            position_only,
+            tolerance_deg,
         )
         for n in notes:
             warnings.warn(n, RuntimeWarning, stacklevel=2)

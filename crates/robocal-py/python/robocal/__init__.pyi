@@ -137,8 +137,11 @@ class Result:
         max_iterations: int = 500,
         payload_kg: Optional[float] = None,
         accept_implausible: bool = False,
+        position_only: bool = False,
+        tolerance_deg: float = 1e-6,
     ) -> Dict[str, Any]:
-        """Compensated joints (eq. 12-14): commanded, desired_position, status, residual_mm, iterations."""
+        """Compensated joints (eq. 12-14), full pose unless position_only: commanded,
+        desired_position, status, residual_mm, residual_deg, iterations."""
     def robots(self, nominal: Optional[Robot] = None) -> Tuple[Robot, Robot]: ...
     def calibrated_robot(self, nominal: Optional[Robot] = None) -> Robot: ...
     def nominal_robot(self) -> Robot: ...
