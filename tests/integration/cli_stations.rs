@@ -166,6 +166,14 @@ fn several_reflectors_and_six_dof_rows_simulate_and_calibrate() {
         "{}",
         res6["prediction"]
     );
+    // The report shows the orientation errors of 6-DoF data, and no such panel for points.
+    ok(&["report", p(&result6), "--out", p(&d.join("six-report"))]);
+    let html = std::fs::read_to_string(d.join("six-report/report.html")).unwrap();
+    assert!(html.contains("<h2>Orientation errors</h2>"));
+    assert!(html.contains("<td>Validation, calibrated model</td><td class=\"num\">20</td>"));
+    ok(&["report", p(&result), "--out", p(&d.join("points-report"))]);
+    let html = std::fs::read_to_string(d.join("points-report/report.html")).unwrap();
+    assert!(!html.contains("Orientation errors"));
 
     // Misuse is a usage error naming the flag.
     let one = robocal(&[

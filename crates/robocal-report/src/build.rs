@@ -235,9 +235,34 @@ impl ReportData {
             identifiability: crate::result_details::identifiability(result),
             solver: crate::result_details::solver(result),
             notes,
+            orientation: orientation_rows(result),
             ..ReportData::default()
         }
     }
+}
+
+/// The orientation-error rows of a 6-DoF result (none for point data).
+fn orientation_rows(result: &CalibrationResult) -> Vec<crate::data::AngleRow> {
+    let Some(o) = &result.orientation_errors else {
+        return Vec::new();
+    };
+    let row = |label: &str, s: &robocal_core::io::result_cell::AngleStats| crate::data::AngleRow {
+        label: label.to_string(),
+        n: s.n,
+        mean_deg: s.mean_deg,
+        std_deg: s.std_deg,
+        max_deg: s.max_deg,
+        rms_deg: s.rms_deg,
+    };
+    let mut rows = vec![
+        row("Calibration, nominal model", &o.calibration.before),
+        row("Calibration, calibrated model", &o.calibration.after),
+    ];
+    if let Some(v) = &o.validation {
+        rows.push(row("Validation, nominal model", &v.before));
+        rows.push(row("Validation, calibrated model", &v.after));
+    }
+    rows
 }
 
 #[cfg(test)]

@@ -45,6 +45,26 @@ pub struct ReportData {
     pub solver: Option<SolverSummary>,
     /// Warnings and notes, shown near the top.
     pub notes: Vec<Note>,
+    /// Orientation errors of 6-DoF measurements (the angle of `R_measured R_model^T`, deg): one
+    /// row per point set and model; empty for point data.
+    pub orientation: Vec<AngleRow>,
+}
+
+/// One row of the orientation-error table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AngleRow {
+    /// Which points and which model, e.g. "Calibration, nominal model".
+    pub label: String,
+    /// Number of points.
+    pub n: usize,
+    /// Mean, sample standard deviation, maximum and RMS of the angles (deg).
+    pub mean_deg: f64,
+    /// See [`AngleRow::mean_deg`].
+    pub std_deg: f64,
+    /// See [`AngleRow::mean_deg`].
+    pub max_deg: f64,
+    /// See [`AngleRow::mean_deg`].
+    pub rms_deg: f64,
 }
 
 /// A key/value line of the run's settings.

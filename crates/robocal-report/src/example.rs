@@ -186,6 +186,7 @@ impl ReportData {
             point_sets,
             reach: ReachKind::Radial,
             parameters,
+            orientation: Vec::new(),
             identifiability: Some(Identifiability {
                 condition_number: Some(412.7),
                 identified: Some(26),

@@ -46,6 +46,7 @@ mod joints;
 mod map;
 mod markup;
 mod numfmt;
+mod orientation;
 mod page;
 mod plot;
 mod points_table;

@@ -32,6 +32,11 @@ pub const SECTIONS: &[Section] = &[
         render: crate::tables::errors_section,
     },
     Section {
+        id: "orientation",
+        nav: "Orientation",
+        render: crate::orientation::section,
+    },
+    Section {
         id: "histogram",
         nav: "Histogram",
         render: crate::histogram_section::section,
