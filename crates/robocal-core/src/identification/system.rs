@@ -383,15 +383,24 @@ impl<'a> Problem<'a> {
         let rows = self.kind.rows();
         let t = self.obs.target(i);
         let q = self.obs.q(i);
-        match frames {
-            Some((j, pose)) if self.obs.q(*j) == q => {
-                robot.retarget(pose, t);
-                *j = i;
+        let (point, flange) = if robot.target_count() == 1 {
+            // One target: nothing to share (and the pass is not worth copying).
+            robot.target_screws(q, t, None, Some(&mut *jp), jw.as_deref_mut())
+        } else {
+            match frames {
+                Some((j, pose)) if self.obs.q(*j) == q => {
+                    robot.retarget(pose, t);
+                    *j = i;
+                }
+                Some((j, pose)) => {
+                    **pose = robot.pose_frames_target(q, t);
+                    *j = i;
+                }
+                None => *frames = Some((i, Box::new(robot.pose_frames_target(q, t)))),
             }
-            _ => *frames = Some((i, Box::new(robot.pose_frames_target(q, t)))),
-        }
-        let pose = &frames.as_ref().expect("set above").1;
-        let (point, flange) = robot.screws_at(pose, None, Some(&mut *jp), jw.as_deref_mut());
+            let pose = &frames.as_ref().expect("set above").1;
+            robot.screws_at(pose, None, Some(&mut *jp), jw.as_deref_mut())
+        };
         let tool = self.tool_state(robot, t, point, &flange);
         let target = self.target(i);
         self.kind.residual(target, &tool, &mut e[..rows]);
