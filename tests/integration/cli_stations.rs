@@ -37,6 +37,26 @@ fn three_reflectors(dir: &Path) -> std::path::PathBuf {
     path
 }
 
+/// 75 poses of a random KR 480 truth (seed `seed`), written to `cell.csv` in `dir` with its
+/// truth file.
+fn kr480_cell(dir: &Path, seed: &str) -> std::path::PathBuf {
+    let data = dir.join("cell.csv");
+    ok(&[
+        "simulate",
+        "--robot",
+        "kuka-kr480-r3330",
+        "--truth",
+        "random",
+        "--poses",
+        "75",
+        "--seed",
+        seed,
+        "--out",
+        p(&data),
+    ]);
+    data
+}
+
 fn stats(result: &Path, set: &str) -> serde_json::Value {
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(result).unwrap()).unwrap();
@@ -199,20 +219,7 @@ fn several_reflectors_and_six_dof_rows_simulate_and_calibrate() {
 fn another_station_is_refused_or_fitted_with_refit_frame() {
     let dir = Dir::new();
     let d = dir.path();
-    let data = d.join("cell.csv");
-    ok(&[
-        "simulate",
-        "--robot",
-        "kuka-kr480-r3330",
-        "--truth",
-        "random",
-        "--poses",
-        "75",
-        "--seed",
-        "5",
-        "--out",
-        p(&data),
-    ]);
+    let data = kr480_cell(d, "5");
     let result = d.join("cell.json");
     ok(&[
         "calibrate",
@@ -295,20 +302,7 @@ fn another_station_is_refused_or_fitted_with_refit_frame() {
 fn tracker_sigma_weights_the_fit() {
     let dir = Dir::new();
     let d = dir.path();
-    let data = d.join("cell.csv");
-    ok(&[
-        "simulate",
-        "--robot",
-        "kuka-kr480-r3330",
-        "--truth",
-        "random",
-        "--poses",
-        "75",
-        "--seed",
-        "8",
-        "--out",
-        p(&data),
-    ]);
+    let data = kr480_cell(d, "8");
     let plain = d.join("plain.json");
     let weighted = d.join("weighted.json");
     ok(&[

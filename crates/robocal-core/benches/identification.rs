@@ -36,6 +36,32 @@ fn data(truth: &Robot, n: usize, seed: u64) -> Observations {
     obs
 }
 
+/// Times the whole calibration of `obs` with `model` (default settings) as benchmark `name`.
+fn bench_calibrate(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    model: &Robot,
+    obs: &Observations,
+) {
+    let settings = CalibrationSettings::default();
+    g.bench_function(name, |b| {
+        b.iter(|| {
+            let cal = calibrate(
+                model,
+                CalibrationData {
+                    calibration: black_box(obs),
+                    plane: None,
+                    validation: None,
+                },
+                &settings,
+                &(),
+            )
+            .unwrap();
+            black_box(cal.calibration.after_stats())
+        })
+    });
+}
+
 /// 1000 poses of the UR5 example sagging under gravity (about the UR5's masses, harmonic-drive
 /// compliances), and the nominal model with compliance on its `auto` joints at the 2 kg payload.
 fn ur5_elasto(c: &mut Criterion) {
@@ -64,26 +90,10 @@ fn ur5_elasto(c: &mut Criterion) {
     let mut model = nominal.clone();
     let joints = compliance::auto_joints(&model);
     compliance::enable(&mut model, &joints, Some(2.0)).unwrap();
-    let settings = CalibrationSettings::default();
     let mut grp = c.benchmark_group("identification");
     grp.sample_size(20);
     for (name, model) in [("elasto-geometric", &model), ("geometric", &nominal)] {
-        grp.bench_function(format!("ur5 {name} 1000 poses"), |b| {
-            b.iter(|| {
-                let cal = calibrate(
-                    model,
-                    CalibrationData {
-                        calibration: black_box(&obs),
-                        plane: None,
-                        validation: None,
-                    },
-                    &settings,
-                    &(),
-                )
-                .unwrap();
-                black_box(cal.calibration.after_stats())
-            })
-        });
+        bench_calibrate(&mut grp, &format!("ur5 {name} 1000 poses"), model, &obs);
     }
     grp.finish();
 }
@@ -91,27 +101,16 @@ fn ur5_elasto(c: &mut Criterion) {
 fn bench(c: &mut Criterion) {
     let truth = preset("kuka-kr480-r3330-table3").unwrap();
     let nominal = preset("kuka-kr480-r3330").unwrap();
-    let settings = CalibrationSettings::default();
     for (n, samples) in [(75usize, 100usize), (20_000, 10)] {
         let obs = data(&truth, n, 7);
         let mut g = c.benchmark_group("identification");
         g.sample_size(samples);
-        g.bench_function(format!("kr480 sum-of-norms {n} poses"), |b| {
-            b.iter(|| {
-                let cal = calibrate(
-                    &nominal,
-                    CalibrationData {
-                        calibration: black_box(&obs),
-                        plane: None,
-                        validation: None,
-                    },
-                    &settings,
-                    &(),
-                )
-                .unwrap();
-                black_box(cal.calibration.after_stats())
-            })
-        });
+        bench_calibrate(
+            &mut g,
+            &format!("kr480 sum-of-norms {n} poses"),
+            &nominal,
+            &obs,
+        );
         g.finish();
     }
 }
@@ -152,25 +151,9 @@ fn reflectors(c: &mut Criterion) {
             obs.push_with(q, m, extras, 3 * i + t + 2).unwrap();
         }
     }
-    let settings = CalibrationSettings::default();
     let mut g = c.benchmark_group("identification");
     g.sample_size(20);
-    g.bench_function("kr480 1000 poses x 3 reflectors", |b| {
-        b.iter(|| {
-            let cal = calibrate(
-                &nominal,
-                CalibrationData {
-                    calibration: black_box(&obs),
-                    plane: None,
-                    validation: None,
-                },
-                &settings,
-                &(),
-            )
-            .unwrap();
-            black_box(cal.calibration.after_stats())
-        })
-    });
+    bench_calibrate(&mut g, "kr480 1000 poses x 3 reflectors", &nominal, &obs);
     g.finish();
 }
 

@@ -26,7 +26,7 @@
 //! [`IkStatus::NotConverged`].
 
 use super::{IkReport, IkSolver, IkStatus};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::model::{JointType, Robot, MAX_JOINTS};
 use nalgebra::{Matrix3, Vector3};
 
@@ -99,29 +99,11 @@ impl DampedLeastSquares {
     /// Checks the settings: positive finite tolerance, step and damping, at least one iteration,
     /// a stationary cosine in (0, 1).
     pub fn validate(&self) -> Result<()> {
-        let pos = |name: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(Error::invalid(
-                    name,
-                    format!("{v} must be a positive number"),
-                ))
-            }
-        };
-        pos("tolerance_mm", self.tolerance_mm)?;
-        pos("max_step_rad", self.max_step_rad)?;
-        pos("prismatic_scale_mm", self.prismatic_scale_mm)?;
-        pos("initial_damping", self.initial_damping)?;
-        if self.max_iterations == 0 {
-            return Err(Error::invalid("max_iterations", "must be at least 1"));
-        }
-        if !(self.stationary_cosine > 0.0 && self.stationary_cosine < 1.0) {
-            return Err(Error::invalid(
-                "stationary_cosine",
-                format!("{} must lie in (0, 1)", self.stationary_cosine),
-            ));
-        }
+        super::checks::positive("tolerance_mm", self.tolerance_mm)?;
+        super::checks::positive("max_step_rad", self.max_step_rad)?;
+        super::checks::positive("prismatic_scale_mm", self.prismatic_scale_mm)?;
+        super::checks::positive("initial_damping", self.initial_damping)?;
+        super::checks::iterations_and_stationary(self.max_iterations, self.stationary_cosine)?;
         Ok(())
     }
 

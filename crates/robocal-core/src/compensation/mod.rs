@@ -19,6 +19,7 @@
 //! method provided. Every solve ends with an [`IkStatus`] and its residual: nothing is dropped or
 //! hidden, a caller decides what to do with rows that did not converge.
 
+mod checks;
 pub mod commanded;
 pub mod configuration;
 mod dls;

@@ -116,31 +116,13 @@ impl PoseNewton {
     /// Checks the settings: positive finite tolerances, step, scales and damping, at least one
     /// iteration, a stationary cosine in (0, 1), a non-negative singular margin.
     pub fn validate(&self) -> Result<()> {
-        let pos = |name: &str, v: f64| {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(Error::invalid(
-                    name,
-                    format!("{v} must be a positive number"),
-                ))
-            }
-        };
-        pos("tolerance_mm", self.tolerance_mm)?;
-        pos("tolerance_deg", self.tolerance_deg)?;
-        pos("max_step_rad", self.max_step_rad)?;
-        pos("prismatic_scale_mm", self.prismatic_scale_mm)?;
-        pos("length_scale_mm", self.length_scale_mm)?;
-        pos("initial_damping", self.initial_damping)?;
-        if self.max_iterations == 0 {
-            return Err(Error::invalid("max_iterations", "must be at least 1"));
-        }
-        if !(self.stationary_cosine > 0.0 && self.stationary_cosine < 1.0) {
-            return Err(Error::invalid(
-                "stationary_cosine",
-                format!("{} must lie in (0, 1)", self.stationary_cosine),
-            ));
-        }
+        super::checks::positive("tolerance_mm", self.tolerance_mm)?;
+        super::checks::positive("tolerance_deg", self.tolerance_deg)?;
+        super::checks::positive("max_step_rad", self.max_step_rad)?;
+        super::checks::positive("prismatic_scale_mm", self.prismatic_scale_mm)?;
+        super::checks::positive("length_scale_mm", self.length_scale_mm)?;
+        super::checks::positive("initial_damping", self.initial_damping)?;
+        super::checks::iterations_and_stationary(self.max_iterations, self.stationary_cosine)?;
         if !(self.singular_margin.is_finite() && self.singular_margin >= 0.0) {
             return Err(Error::invalid(
                 "singular_margin",
