@@ -196,7 +196,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     super::common::check_limits(outside, nominal_limits, &mut Vec::new())?;
     if !refit_frame && ev.reference() == Reference::Model {
         let mean = norms[1].iter().sum::<f64>() / norms[1].len().max(1) as f64;
-        if mean > robocal_core::identification::pipeline::STATION_MIN_MM {
+        if mean > robocal_core::registration::STATION_MIN_MM {
             let set = whole().with_context(context)?;
             robocal_core::evaluation::check_station(&cal, &set, mean)?;
         }

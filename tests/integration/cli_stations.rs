@@ -294,6 +294,43 @@ fn another_station_is_refused_or_fitted_with_refit_frame() {
 
     // The calibration's own station still evaluates without a refit.
     ok(&["evaluate", "--params", p(&result), "--data", p(&data)]);
+
+    // The same set as calibrate's validation: refused, or fitted with --validate-refit-frame.
+    let again = d.join("again.json");
+    let calibrate = |extra: &[&str]| {
+        let mut args = vec![
+            "calibrate",
+            "--robot",
+            "kuka-kr480-r3330",
+            "--data",
+            p(&data),
+            "--validate",
+            p(&moved),
+            "--out",
+            p(&again),
+        ];
+        args.extend_from_slice(extra);
+        robocal(&args)
+    };
+    let refused = calibrate(&[]);
+    assert_eq!(refused.code(), Some(3), "{}", refused.text());
+    assert!(
+        refused.stderr().contains("another tracker station"),
+        "{}",
+        refused.stderr()
+    );
+    assert!(
+        refused.stderr().contains("--validate-refit-frame"),
+        "{}",
+        refused.stderr()
+    );
+    assert!(!again.exists(), "nothing written on refusal");
+    calibrate(&["--validate-refit-frame"]).assert_ok();
+    let validation = stats(&again, "validation")["mean_mm"].as_f64().unwrap();
+    assert!(
+        validation < 2.0 * calibration + 0.02,
+        "{validation} vs {calibration}"
+    );
 }
 
 /// `--tracker-sigma F,P` as the README writes it: weighted fitting whose standard deviations are

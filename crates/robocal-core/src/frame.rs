@@ -62,6 +62,31 @@ pub fn frame_vector(f: &Frame) -> [f64; 6] {
     [p.x, p.y, p.z, a, b, c]
 }
 
+/// The rotation vector `log(R)` (axis times angle, rad) of a rotation matrix, accurate to
+/// rounding at small angles: the angle from `atan2` of the skew and symmetric parts (nalgebra's
+/// `scaled_axis` goes through `acos` of the trace, whose error near the identity is about 1e-8
+/// rad, above a 1e-6 degree tolerance's reach). Orientation errors of 6-DoF fits and of full-pose
+/// compensation both use it.
+pub fn rotation_vector(r: &Matrix3<f64>) -> Vector3<f64> {
+    let v = 0.5
+        * Vector3::new(
+            r[(2, 1)] - r[(1, 2)],
+            r[(0, 2)] - r[(2, 0)],
+            r[(1, 0)] - r[(0, 1)],
+        );
+    let s = v.norm();
+    let c = 0.5 * (r.trace() - 1.0);
+    if s < 1e-3 && c > 0.0 {
+        // theta / sin(theta) by its series: accurate where the ratio is about 1.
+        return v * (1.0 + s * s / 6.0 + 3.0 * s.powi(4) / 40.0);
+    }
+    if c > -0.99 {
+        return v * (s.atan2(c) / s);
+    }
+    // Near a half turn the skew part vanishes: the axis from the symmetric part.
+    nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis()
+}
+
 /// Converts a frame vector from mm/degrees to mm/radians.
 pub(crate) fn vec_deg_to_rad(v: &[f64; 6]) -> [f64; 6] {
     [

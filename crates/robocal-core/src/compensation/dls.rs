@@ -25,6 +25,7 @@
 //! [`IkStatus::Unreachable`]; a run still making progress when the budget ran out gives
 //! [`IkStatus::NotConverged`].
 
+use super::stop::{stop_point, StopPoint};
 use super::{IkReport, IkSolver, IkStatus};
 use crate::error::Result;
 use crate::model::{JointType, Robot, MAX_JOINTS};
@@ -217,27 +218,19 @@ impl DampedLeastSquares {
             }
         }
         // Classify the stopping point.
-        let mut blocking = 0u32;
-        let mut at_limit = 0u32;
-        let mut max_cosine = 0.0f64;
-        for i in 0..n {
-            let jn = jq[i].norm();
-            let cos = if jn > 0.0 && r > 0.0 {
-                jq[i].dot(&e) / (jn * r)
-            } else {
-                0.0
-            };
-            let low = limits && q[i] <= lim[i].min;
-            let high = limits && q[i] >= lim[i].max;
-            if low || high {
-                at_limit |= 1 << i;
-            }
-            if (low && cos < -self.stationary_cosine) || (high && cos > self.stationary_cosine) {
-                blocking |= 1 << i;
-            } else if !((low && cos < 0.0) || (high && cos > 0.0)) {
-                max_cosine = max_cosine.max(cos.abs());
-            }
-        }
+        let StopPoint {
+            blocking,
+            at_limit,
+            max_cosine,
+        } = stop_point(
+            &jq[..n],
+            &e,
+            r,
+            &q[..n],
+            lim,
+            limits,
+            self.stationary_cosine,
+        );
         let plateau = iterations >= self.max_iterations && r_half - r < PLATEAU * r_half;
         Run {
             residual: r,

@@ -24,6 +24,7 @@ pub mod commanded;
 pub mod configuration;
 mod dls;
 mod pose;
+mod stop;
 mod targets;
 
 pub use dls::DampedLeastSquares;
@@ -32,7 +33,7 @@ pub use pose::PoseNewton;
 /// The angle (rad) of a rotation matrix, accurate to rounding near the identity (the norm of its
 /// rotation vector; `acos` of the trace loses half the digits there).
 pub fn rotation_angle(r: &nalgebra::Matrix3<f64>) -> f64 {
-    pose::rotation_vector(r).norm()
+    crate::frame::rotation_vector(r).norm()
 }
 pub use targets::{parse_targets, read_targets, Target, TargetSet};
 

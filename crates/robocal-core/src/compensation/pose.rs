@@ -31,6 +31,7 @@
 //! Allocation-free: everything lives on the stack (`Matrix6`, `Vector6`, arrays of
 //! [`MAX_JOINTS`]).
 
+use super::stop::{stop_point, StopPoint};
 use super::{IkReport, IkStatus};
 use crate::error::{Error, Result};
 use crate::frame::Frame;
@@ -203,7 +204,9 @@ impl PoseNewton {
         let tool = frames.flange * robot.target_tool_frame(t);
         let p = tool.translation.vector;
         let ep = target.translation.vector - p;
-        let ew = rotation_vector(&(target.rotation.matrix() * tool.rotation.matrix().transpose()));
+        let ew = crate::frame::rotation_vector(
+            &(target.rotation.matrix() * tool.rotation.matrix().transpose()),
+        );
         let l = self.length_scale_mm;
         let types = robot.joint_types();
         for i in 0..n {
@@ -334,27 +337,20 @@ impl PoseNewton {
                 break;
             }
         }
-        let mut blocking = 0u32;
-        let mut at_limit = 0u32;
-        let mut max_cosine = 0.0f64;
-        for i in 0..n {
-            let cn = cols[i].norm();
-            let cos = if cn > 0.0 && r > 0.0 {
-                cols[i].dot(&ev.e) / (cn * r)
-            } else {
-                0.0
-            };
-            let low = limits && q[i] <= lim[i].min;
-            let high = limits && q[i] >= lim[i].max;
-            if low || high {
-                at_limit |= 1 << i;
-            }
-            if (low && cos < -self.stationary_cosine) || (high && cos > self.stationary_cosine) {
-                blocking |= 1 << i;
-            } else if !((low && cos < 0.0) || (high && cos > 0.0)) {
-                max_cosine = max_cosine.max(cos.abs());
-            }
-        }
+        // Classify the stopping point.
+        let StopPoint {
+            blocking,
+            at_limit,
+            max_cosine,
+        } = stop_point(
+            &cols[..n],
+            &ev.e,
+            r,
+            &q[..n],
+            lim,
+            limits,
+            self.stationary_cosine,
+        );
         let plateau = iterations >= self.max_iterations && r_half - r < PLATEAU * r_half;
         // With fewer joints than equations, every column orthogonal to the residual is the
         // least-squares optimum: stationary too.
@@ -367,28 +363,4 @@ impl PoseNewton {
             stationary: stalled || plateau || max_cosine < self.stationary_cosine,
         }
     }
-}
-
-/// The rotation vector `log(R)` (rad) of a rotation matrix, accurate to rounding at small angles
-/// (nalgebra's `scaled_axis` goes through `acos` of the trace, whose error near the identity is
-/// about 1e-8 rad, above a 1e-6 degree tolerance's reach): the angle from `atan2` of the skew
-/// and symmetric parts.
-pub(crate) fn rotation_vector(r: &nalgebra::Matrix3<f64>) -> Vector3<f64> {
-    let v = 0.5
-        * Vector3::new(
-            r[(2, 1)] - r[(1, 2)],
-            r[(0, 2)] - r[(2, 0)],
-            r[(1, 0)] - r[(0, 1)],
-        );
-    let s = v.norm();
-    let c = 0.5 * (r.trace() - 1.0);
-    if s < 1e-3 && c > 0.0 {
-        // theta / sin(theta) by its series: accurate where the ratio is about 1.
-        return v * (1.0 + s * s / 6.0 + 3.0 * s.powi(4) / 40.0);
-    }
-    if c > -0.99 {
-        return v * (s.atan2(c) / s);
-    }
-    // Near a half turn the skew part vanishes: the axis from the symmetric part.
-    nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis()
 }

@@ -7,12 +7,11 @@
 
 use crate::error::{Error, Result};
 use crate::frame::TrackerFrame;
-use crate::identification::pipeline::{STATION_FACTOR, STATION_MIN_MM};
 use crate::io::row_extras::ExtrasLayout;
 use crate::io::MeasurementSet;
 use crate::model::Robot;
 use crate::observations::Observations;
-use crate::registration::refit_frame;
+use crate::registration::{another_station, refit_frame, STATION_MIN_MM};
 
 /// The measured rows of `set` (those with x,y,z) as observations, with their targets and
 /// orientations.
@@ -38,29 +37,16 @@ pub fn station_frames(
     Ok((refit_frame(nominal, &obs)?, refit_frame(calibrated, &obs)?))
 }
 
-/// Fails when `set` was clearly measured from another station than the calibration's: the
-/// calibrated model's mean error in `frame`, `mean_mm`, is above [`STATION_MIN_MM`] and a frame
-/// of the set's own brings it down by [`STATION_FACTOR`] and by more than [`STATION_MIN_MM`].
-/// The message tells the refit setting by its name, `refit_frame`.
+/// Fails when `set` was clearly measured from another station than the calibration's
+/// ([`crate::registration::another_station`]): the calibrated model is off by `mean_mm` on
+/// average in the calibration's frame. The message tells the refit setting by its name,
+/// `refit_frame`.
 pub fn check_station(calibrated: &Robot, set: &MeasurementSet, mean_mm: f64) -> Result<()> {
     if mean_mm <= STATION_MIN_MM {
         return Ok(());
     }
     let obs = observations_of(set)?;
-    if obs.len() < 3 {
-        return Ok(());
-    }
-    let Ok(own) = refit_frame(calibrated, &obs) else {
-        return Ok(());
-    };
-    let there = obs
-        .model_positions(calibrated)
-        .iter()
-        .zip(obs.measured())
-        .map(|(p, m)| (own.to_base(m) - p).norm())
-        .sum::<f64>()
-        / obs.len() as f64;
-    if mean_mm > STATION_FACTOR * there && mean_mm - there > STATION_MIN_MM {
+    if let Some(there) = another_station(calibrated, &obs, mean_mm) {
         return Err(Error::invalid(
             set.path.display().to_string(),
             format!(

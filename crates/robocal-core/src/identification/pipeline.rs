@@ -494,7 +494,7 @@ pub fn calibrate(
         }
         Some(v) => {
             let e = SetErrors::new(v, &registration, nominal, frame, &robot);
-            check_same_station(v, &e, nominal, &robot)?;
+            check_same_station(v, &e, &robot)?;
             Some(e)
         }
     };
@@ -544,26 +544,15 @@ pub fn calibrate(
     })
 }
 
-/// How much better a frame of their own must explain validation points, and by how much (mm),
-/// before they are taken for data from another tracker station.
-pub const STATION_FACTOR: f64 = 10.0;
-/// See [`STATION_FACTOR`].
-pub const STATION_MIN_MM: f64 = 1.0;
+pub use crate::registration::{STATION_FACTOR, STATION_MIN_MM};
 
 /// Fails when the validation points `v` were clearly measured from another tracker station: a
 /// rigid frame of their own brings the calibrated model's mean error down by [`STATION_FACTOR`]
 /// and by more than [`STATION_MIN_MM`]. Their errors in the calibration's frame would then be the
 /// tracker's move, not the robot's accuracy.
-fn check_same_station(v: &Observations, e: &SetErrors, nominal: &Robot, cal: &Robot) -> Result<()> {
+fn check_same_station(v: &Observations, e: &SetErrors, cal: &Robot) -> Result<()> {
     let here = e.after_stats().mean_mm;
-    if here <= STATION_MIN_MM || v.len() < 3 {
-        return Ok(());
-    }
-    let Ok((own, _)) = SetErrors::refit(v, nominal, cal) else {
-        return Ok(());
-    };
-    let there = own.after_stats().mean_mm;
-    if here > STATION_FACTOR * there && here - there > STATION_MIN_MM {
+    if let Some(there) = crate::registration::another_station(cal, v, here) {
         return Err(Error::invalid(
             v.source()
                 .map_or("validation data".into(), |p| p.display().to_string()),

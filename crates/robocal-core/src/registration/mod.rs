@@ -223,3 +223,29 @@ pub fn refit_frame(robot: &Robot, obs: &Observations) -> Result<TrackerFrame> {
     }
     fit_rigid(obs.measured(), &obs.model_positions(robot), None)
 }
+
+/// How much better a frame of their own must explain a set of points, and by how much (mm),
+/// before they are taken for data from another tracker station.
+pub const STATION_FACTOR: f64 = 10.0;
+/// See [`STATION_FACTOR`].
+pub const STATION_MIN_MM: f64 = 1.0;
+
+/// Whether the points of `obs`, on which `robot` is off by `here_mm` on average in the frame
+/// they were mapped with, look measured from another tracker station: a rigid frame of their own
+/// ([`refit_frame`]) brings the mean down by [`STATION_FACTOR`] and by more than
+/// [`STATION_MIN_MM`]. Returns that frame's mean error (mm) when they do; `None` when they do not
+/// or cannot tell (fewer than 3 points, a frame that cannot be fitted).
+pub fn another_station(robot: &Robot, obs: &Observations, here_mm: f64) -> Option<f64> {
+    if here_mm <= STATION_MIN_MM || obs.len() < 3 {
+        return None;
+    }
+    let own = refit_frame(robot, obs).ok()?;
+    let there = obs
+        .model_positions(robot)
+        .iter()
+        .zip(obs.measured())
+        .map(|(p, m)| (own.to_base(m) - p).norm())
+        .sum::<f64>()
+        / obs.len() as f64;
+    (here_mm > STATION_FACTOR * there && here_mm - there > STATION_MIN_MM).then_some(there)
+}

@@ -15,7 +15,7 @@ mod point;
 mod pose6;
 
 pub use point::Point;
-pub use pose6::{rotation_log, Pose6};
+pub use pose6::Pose6;
 
 use crate::frame::TrackerFrame;
 use crate::observations::Observations;

@@ -5,34 +5,13 @@
 //! the orientation rows by the observations' mm per radian.
 
 use super::{Measurability, MeasurementKind, ToolState};
+use crate::frame::rotation_vector;
 use crate::frame::TrackerFrame;
 use crate::observations::Observations;
-use nalgebra::{Matrix3, Rotation3, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 /// A measured tool frame.
 pub struct Pose6;
-
-/// The rotation vector of `r` (axis times angle, rad): accurate for small angles (no `acos`
-/// near 1), valid up to a half turn.
-pub fn rotation_log(r: &Matrix3<f64>) -> Vector3<f64> {
-    let v = 0.5
-        * Vector3::new(
-            r[(2, 1)] - r[(1, 2)],
-            r[(0, 2)] - r[(2, 0)],
-            r[(1, 0)] - r[(0, 1)],
-        );
-    let s = v.norm();
-    let c = 0.5 * (r.trace() - 1.0);
-    if c > 0.0 || s > 1e-3 && c > -0.99 {
-        let theta = s.atan2(c);
-        if s < 1e-300 {
-            return Vector3::zeros();
-        }
-        v * (theta / s)
-    } else {
-        Rotation3::from_matrix_unchecked(*r).scaled_axis()
-    }
-}
 
 /// The inverse right Jacobian of SO(3) at rotation vector `e`: how `log(exp(e) exp(-d))`
 /// changes with a small `d` (`-J_r^{-1}(e) d`).
@@ -91,7 +70,7 @@ impl MeasurementKind for Pose6 {
         }
         let rt = Matrix3::from_column_slice(&target[3..12]);
         let rm = tool.rotation.unwrap_or_else(Matrix3::identity);
-        let w = rotation_log(&(rt * rm.transpose()));
+        let w = rotation_vector(&(rt * rm.transpose()));
         e[3..6].copy_from_slice(w.as_slice());
     }
 
@@ -123,9 +102,10 @@ impl MeasurementKind for Pose6 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::Rotation3;
 
     #[test]
-    fn rotation_log_inverts_exp_small_and_large() {
+    fn rotation_vector_inverts_exp_small_and_large() {
         for v in [
             Vector3::new(1e-9, -2e-9, 3e-10),
             Vector3::new(0.01, 0.2, -0.3),
@@ -133,7 +113,7 @@ mod tests {
             Vector3::new(0.0, 3.0, 0.0),
         ] {
             let r = Rotation3::new(v).into_inner();
-            let back = rotation_log(&r);
+            let back = rotation_vector(&r);
             assert!(
                 (back - v).norm() <= 1e-12 * (1.0 + v.norm()),
                 "{v} -> {back}"
@@ -150,8 +130,8 @@ mod tests {
         for c in 0..3 {
             let mut d = Vector3::zeros();
             d[c] = h;
-            let p = rotation_log(&(re * Rotation3::new(-d).into_inner()));
-            let m = rotation_log(&(re * Rotation3::new(d).into_inner()));
+            let p = rotation_vector(&(re * Rotation3::new(-d).into_inner()));
+            let m = rotation_vector(&(re * Rotation3::new(d).into_inner()));
             let fd = (p - m) / (2.0 * h);
             let an = -(j.column(c));
             assert!((fd - an).norm() < 1e-7, "column {c}: {fd} vs {an}");
