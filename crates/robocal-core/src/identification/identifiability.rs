@@ -46,8 +46,10 @@ pub const MAX_CONDITION_NUMBER: f64 = 1e7;
 
 /// Points per QR block.
 const BLOCK_POINTS: usize = 128;
-/// Points per parallel task.
-const TASK_POINTS: usize = 4096;
+/// Points per parallel task, about: the points are split into `ceil(n / TASK_POINTS)` tasks of
+/// equal size (an even split keeps both cores of a small machine busy to the end). The split
+/// depends on the number of points only, so the factor is the same on any number of threads.
+const TASK_POINTS: usize = 512;
 
 /// Settings of the identifiability analysis.
 #[derive(Debug, Clone, PartialEq)]
@@ -247,8 +249,11 @@ pub fn jacobian_r(robot: &Robot, obs: &Observations) -> Reduced {
         }
         (r, ang)
     };
-    let parts: Vec<(DMatrix<f64>, Vec<f64>)> = if obs.len() > TASK_POINTS {
-        idx.par_chunks(TASK_POINTS).map(r_of).collect()
+    let tasks = obs.len().div_ceil(TASK_POINTS).max(1);
+    let parts: Vec<(DMatrix<f64>, Vec<f64>)> = if tasks > 1 {
+        idx.par_chunks(obs.len().div_ceil(tasks))
+            .map(r_of)
+            .collect()
     } else {
         vec![r_of(&idx)]
     };
@@ -397,7 +402,10 @@ pub fn analyze_reduced(
             .filter(|(_, v)| v.abs() >= 0.1 * cmax && v.abs() > 1e-9)
             .map(|(b, v)| (b, *v))
             .collect();
-        terms.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
+        // Largest coefficient first; equal ones (to 1e-9 of the largest, as rounding leaves
+        // them) in parameter order, so the order does not depend on the last bits.
+        let rank = |v: f64| -((v.abs() / cmax * 1e9).round() as i64);
+        terms.sort_by_key(|&(b, v)| (rank(v), b));
         terms.truncate(4);
         let of = terms
             .into_iter()

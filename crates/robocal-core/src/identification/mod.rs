@@ -26,6 +26,7 @@ pub mod plausibility;
 pub mod precision;
 pub mod prediction;
 pub mod report;
+pub(crate) mod simd;
 pub mod solver;
 pub mod split;
 pub mod system;

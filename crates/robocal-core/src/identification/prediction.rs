@@ -11,6 +11,7 @@
 //! them ([`Prediction::mean_mm`]), the figure a validation set measures.
 
 use crate::identification::covariance::Covariance;
+use crate::identification::system::add_gram;
 use crate::model::{Param, Robot};
 use crate::observations::Observations;
 use crate::simulation::{random_poses, PoseSampler};
@@ -208,6 +209,9 @@ pub struct Predictor<'a> {
     index: Vec<usize>,
     /// The covariance, row-major (k x k).
     cov: Vec<f64>,
+    /// Its Cholesky factor `L` (`C = L L^T`, lower, row-major), when `C` is positive definite:
+    /// then `J C J^T = (J L)(J L)^T` at half the cost.
+    factor: Option<Vec<f64>>,
     sigma: f64,
     norms: NormExpectation,
 }
@@ -231,11 +235,18 @@ impl<'a> Predictor<'a> {
             .map(|p: &Param| robot.param_position(*p))
             .collect::<Option<Vec<_>>>()?;
         let k = index.len();
+        let factor = cov
+            .matrix
+            .clone()
+            .cholesky()
+            .map(|c| c.unpack())
+            .map(|l| (0..k * k).map(|i| l[(i / k, i % k)]).collect());
         let cov = (0..k * k).map(|i| cov.matrix[(i / k, i % k)]).collect();
         Some(Predictor {
             robot,
             index,
             cov,
+            factor,
             sigma: noise_sigma_mm,
             norms: NormExpectation::new(),
         })
@@ -253,6 +264,34 @@ impl<'a> Predictor<'a> {
     /// `J C J^T` for the 3 x k rows `j` (row-major); `x` is scratch of 3 k.
     fn model_covariance(&self, j: &[f64], x: &mut [f64]) -> Matrix3<f64> {
         let k = self.index.len();
+        if let Some(l) = &self.factor {
+            // x = J L (L lower: row a reaches columns 0..=a).
+            for r in 0..3 {
+                let jr = &j[r * k..(r + 1) * k];
+                let xr = &mut x[r * k..(r + 1) * k];
+                xr.fill(0.0);
+                for (a, &ja) in jr.iter().enumerate() {
+                    if ja != 0.0 {
+                        for (xv, lv) in xr[..=a].iter_mut().zip(&l[a * k..a * k + a + 1]) {
+                            *xv += ja * lv;
+                        }
+                    }
+                }
+            }
+            let mut m = Matrix3::zeros();
+            for r in 0..3 {
+                for c in r..3 {
+                    let v: f64 = x[r * k..(r + 1) * k]
+                        .iter()
+                        .zip(&x[c * k..(c + 1) * k])
+                        .map(|(a, b)| a * b)
+                        .sum();
+                    m[(r, c)] = v;
+                    m[(c, r)] = v;
+                }
+            }
+            return m;
+        }
         // x = J C (C symmetric, read by rows).
         for r in 0..3 {
             let jr = &j[r * k..(r + 1) * k];
@@ -420,16 +459,19 @@ pub fn noise_sigma(
 /// substitution row by row.
 fn leverages(jac: &[f64], k: usize, rows: usize, kept: &[usize]) -> Option<Vec<f64>> {
     let block = rows * k;
-    let mut upper = vec![0.0; k * k];
-    for &i in kept {
-        crate::identification::system::add_gram(
-            &mut upper,
-            &jac[i * block..(i + 1) * block],
-            rows,
-            k,
-            1.0,
-        );
-    }
+    // S in chunks (in parallel for many points, the same bits on any number of threads).
+    let upper = crate::identification::system::chunked(
+        kept.len(),
+        || vec![0.0; k * k],
+        |m, n| {
+            let i = kept[n];
+            add_gram(m, &jac[i * block..(i + 1) * block], rows, k, 1.0);
+        },
+        |mut a, b| {
+            a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
+            a
+        },
+    );
     // Parameters that do not move the points (a tool orientation identified from 6-DoF data)
     // have no leverage on them: their rows and columns are left out of S.
     let max_diag = (0..k).map(|a| upper[a * k + a]).fold(0.0, f64::max);
@@ -568,6 +610,51 @@ mod tests {
                 (got / reference - 1.0).abs() < 1e-5,
                 "{l:?}: {got} vs {reference}"
             );
+        }
+    }
+
+    /// `J C J^T` through the Cholesky factor equals the direct product.
+    #[test]
+    fn model_covariance_by_the_factor_matches_the_direct_product() {
+        use rand::Rng;
+        let robot = crate::model::presets::preset("kuka-kr480-r3330").unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let k = 30;
+        let a = DMatrix::from_fn(k, k, |_, _| rng.gen_range(-1.0..1.0));
+        let c = &a * a.transpose() + DMatrix::identity(k, k) * 1e-3;
+        let cov: Vec<f64> = (0..k * k).map(|i| c[(i / k, i % k)]).collect();
+        let l = c.clone().cholesky().unwrap().unpack();
+        let direct = Predictor {
+            robot: &robot,
+            index: (0..k).collect(),
+            cov: cov.clone(),
+            factor: None,
+            sigma: 0.01,
+            norms: NormExpectation::new(),
+        };
+        let factored = Predictor {
+            robot: &robot,
+            index: (0..k).collect(),
+            cov,
+            factor: Some((0..k * k).map(|i| l[(i / k, i % k)]).collect()),
+            sigma: 0.01,
+            norms: NormExpectation::new(),
+        };
+        let mut x = vec![0.0; 3 * k];
+        for _ in 0..20 {
+            // Some zero entries, as the Jacobians of parameters that do not move a point have.
+            let j: Vec<f64> = (0..3 * k)
+                .map(|i| {
+                    if i % 7 == 0 {
+                        0.0
+                    } else {
+                        rng.gen_range(-50.0..50.0)
+                    }
+                })
+                .collect();
+            let m1 = direct.model_covariance(&j, &mut x);
+            let m2 = factored.model_covariance(&j, &mut x);
+            assert!((m1 - m2).norm() <= 1e-12 * m1.norm(), "{m1} vs {m2}");
         }
     }
 

@@ -41,12 +41,18 @@ pub(crate) fn chunked<T: Send>(
     add: impl Fn(&mut T, usize) + Sync,
     merge: impl Fn(T, T) -> T,
 ) -> T {
+    // Each chunk runs with AVX where the processor has it (same bits, see `simd`).
     let chunk = |c: usize| {
-        let mut t = new();
-        for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
-            add(&mut t, i);
-        }
-        t
+        crate::identification::simd::with_avx(
+            #[inline(always)]
+            || {
+                let mut t = new();
+                for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                    add(&mut t, i);
+                }
+                t
+            },
+        )
     };
     let chunks = n.div_ceil(CHUNK);
     if n >= PARALLEL_MIN_POINTS {
@@ -183,7 +189,7 @@ impl Acc {
     /// Adds observation `i`: its (weighted) residual rows and Jacobian rows
     /// ([`Problem::observation_rows`]), then `w J^T J`, `w J^T e` (upper triangles) and what the
     /// level adds.
-    #[inline]
+    #[inline(always)]
     fn add_observation(&mut self, p: &Problem, robot: &Robot, loss: &Loss, i: usize) {
         let rows = p.kind.rows();
         let mut e = [0.0; kinds::MAX_ROWS];
@@ -260,11 +266,12 @@ impl Acc {
                 }
                 self.u[a] = s;
             }
+            let u = &self.u[..k];
             for a in 0..k {
-                let ca = c * self.u[a];
-                let row = &mut self.h[a * k..(a + 1) * k];
-                for b in a..k {
-                    row[b] += ca * self.u[b];
+                let ca = c * u[a];
+                let row = &mut self.h[a * k + a..(a + 1) * k];
+                for (x, ub) in row.iter_mut().zip(&u[a..]) {
+                    *x += ca * ub;
                 }
             }
         }
@@ -649,6 +656,7 @@ impl<'a> Problem<'a> {
         let acc = chunked(
             self.len(),
             || Acc::new(k, rows, np, angular, level),
+            #[inline(always)]
             |acc, i| acc.add_observation(self, robot, loss, i),
             Acc::merge,
         );
@@ -808,6 +816,35 @@ mod tests {
             assert!(one.0 == four.0 && one.1 == four.1 && one.2 == four.2 && one.3 == four.3);
             assert_eq!(one.4.to_bits(), four.4.to_bits());
             assert_eq!(one.5.to_bits(), four.5.to_bits());
+        }
+    }
+
+    /// A pass gives the same bits with AVX as with the baseline instructions (on a processor
+    /// without AVX both runs are the baseline). Fewer points than a parallel pass takes, so the
+    /// chunks run on this thread, where the baseline is forced.
+    #[test]
+    fn passes_give_the_same_bits_with_and_without_avx() {
+        let (nominal, obs) = kr480_problem_data(CHUNK + 45, 0.05);
+        let params = nominal.params();
+        let p = Problem::new(&nominal, &params, &obs, &TrackerFrame::identity());
+        for loss in [
+            Loss::SumOfNorms { delta: 1e-6 },
+            Loss::Cauchy { c: 0.05 },
+            Loss::Squared,
+        ] {
+            let run = |baseline: bool| {
+                crate::identification::simd::force_baseline(baseline);
+                let acc = p.accumulate(&nominal, &loss, Level::Full);
+                let f = p.objective(&nominal, &loss);
+                crate::identification::simd::force_baseline(false);
+                (acc, f)
+            };
+            let (wide, fw) = run(false);
+            let (base, fb) = run(true);
+            assert!(wide.a == base.a && wide.b == base.b, "{loss:?}");
+            assert!(wide.s == base.s && wide.h == base.h, "{loss:?}");
+            assert_eq!(wide.objective.to_bits(), base.objective.to_bits());
+            assert_eq!(fw.to_bits(), fb.to_bits());
         }
     }
 }
