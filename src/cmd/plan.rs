@@ -256,6 +256,14 @@ fn print_plan(s: &Settings, p: &Plan) {
             ""
         }
     );
+    if s.plan.tracker_origin.is_some() {
+        // The design is optimal for the fit that weighs each point as this tracker model does.
+        println!(
+            "the figures assume that fit: calibrate these poses with `--tracker-sigma {},{}`, \
+             the measurements in the tracker's own frame (tracker at the origin)",
+            s.plan.noise_mm, s.plan.noise_per_m
+        );
+    }
     println!();
     println!("{:<44}{:>14}{:>14}", "", "planned", "random");
     println!(

@@ -13,6 +13,7 @@ use crate::identification::{
 };
 use crate::model::presets::preset;
 use crate::model::Robot;
+use crate::observations::{TrackerSigma, Weighting};
 use crate::planning::{plan, Criterion, PlanSettings};
 use crate::simulation::{
     random_poses, GeometricErrors, PoseSampler, SimulationConfig, Tracker, DEFAULT_NOISE_MM,
@@ -96,6 +97,26 @@ impl Cell {
         val: &Observations,
         objective: Objective,
     ) -> Calibration {
+        self.calibrate_weighted(cal, val, objective, Weighting::default())
+    }
+
+    /// The calibration that weighs every point by the cell's tracker model: the fit a plan made
+    /// for that tracker assumes.
+    fn calibrate_tracker_weighted(&self, cal: &Observations, val: &Observations) -> Calibration {
+        let weighting = Weighting {
+            tracker: Some(TrackerSigma::new(DEFAULT_NOISE_MM, DEFAULT_NOISE_PER_M).unwrap()),
+            ..Weighting::default()
+        };
+        self.calibrate_weighted(cal, val, Objective::Adaptive, weighting)
+    }
+
+    fn calibrate_weighted(
+        &self,
+        cal: &Observations,
+        val: &Observations,
+        objective: Objective,
+        weighting: Weighting,
+    ) -> Calibration {
         calibrate(
             &self.nominal,
             CalibrationData {
@@ -105,6 +126,7 @@ impl Cell {
             },
             &CalibrationSettings {
                 objective,
+                weighting,
                 ..CalibrationSettings::default()
             },
             &(),
@@ -204,27 +226,31 @@ fn predicted_error_matches_validation() {
     assert!((mean(&r) - 1.0).abs() <= 0.15, "measured/predicted {r:?}");
 }
 
-/// Planned poses leave a smaller model error over the workspace than as many random ones
-/// (seeds 1-2, mean; the Monte Carlo has the figures).
+/// Planned poses leave a smaller model error over the workspace than as many random ones, and
+/// 55 planned poses no larger than 75 random ones (seeds 1-3, mean; every set calibrated with
+/// the tracker model the plan assumed; the Monte Carlo has the figures over 50 seeds).
 #[test]
 fn planned_poses_calibrate_better_than_random_ones() {
-    let (mut planned, mut random) = (Vec::new(), Vec::new());
-    for seed in 1..=2 {
+    let (mut p75, mut p55, mut r75) = (Vec::new(), Vec::new(), Vec::new());
+    for seed in 1..=3 {
         let mut c = Cell::new(seed);
         let ws = c.random(500);
         let qv = c.random(30);
         let val = c.measure(&qv, 0);
         let qr = c.random(75);
-        let qp = c.plan(75, 3000, seed);
-        let r = c.measure(&qr, 0);
-        let p = c.measure(&qp, 0);
-        random.push(c.truth_error(&c.calibrate(&r, &val, Objective::Adaptive), &ws));
-        planned.push(c.truth_error(&c.calibrate(&p, &val, Objective::Adaptive), &ws));
+        let q75 = c.plan(75, 3000, seed);
+        let q55 = c.plan(55, 3000, seed);
+        let mut run = |qs: &[Vec<f64>]| {
+            let obs = c.measure(qs, 0);
+            c.truth_error(&c.calibrate_tracker_weighted(&obs, &val), &ws)
+        };
+        r75.push(run(&qr));
+        p75.push(run(&q75));
+        p55.push(run(&q55));
     }
-    assert!(
-        mean(&planned) < 0.9 * mean(&random),
-        "{planned:?} vs {random:?}"
-    );
+    println!("planned 75 {p75:?}, planned 55 {p55:?}, random 75 {r75:?}");
+    assert!(mean(&p75) < 0.85 * mean(&r75), "{p75:?} vs {r75:?}");
+    assert!(mean(&p55) <= mean(&r75), "{p55:?} vs {r75:?}");
 }
 
 fn summary(name: &str, v: &[f64]) {
@@ -264,7 +290,17 @@ fn monte_carlo() {
         let within = p.iter().filter(|r| (*r - 1.0).abs() <= 0.15).count();
         println!("  within 15%: {within} of {}", p.len());
     }
-    let (mut r75, mut p75, mut p55) = (Vec::new(), Vec::new(), Vec::new());
+    // Planning: each design calibrated with the tracker model the plan assumed (weighted),
+    // and without it (unweighted) for comparison.
+    let names = [
+        "75 random poses, weighted",
+        "75 planned poses, weighted",
+        "55 planned poses, weighted",
+        "75 random poses, unweighted",
+        "75 planned poses, unweighted",
+        "55 planned poses, unweighted",
+    ];
+    let mut runs: Vec<[f64; 6]> = Vec::new();
     for seed in seeds {
         let mut c = Cell::new(seed);
         let ws = c.random(1000);
@@ -275,21 +311,27 @@ fn monte_carlo() {
         let qr = c.random(75);
         let q75 = c.plan(75, 10_000, seed);
         let q55 = c.plan(55, 10_000, seed);
-        let mut run = |qs: &[Vec<f64>]| {
+        let mut row = [0.0; 6];
+        for (i, qs) in [&qr, &q75, &q55].into_iter().enumerate() {
             let obs = c.measure(qs, 0);
+            row[i] = c.truth_error(&c.calibrate_tracker_weighted(&obs, &val), &ws);
             let fit = c.calibrate(&obs, &val, Objective::Adaptive);
-            c.truth_error(&fit, &ws)
-        };
-        r75.push(run(&qr));
-        p75.push(run(&q75));
-        p55.push(run(&q55));
+            row[i + 3] = c.truth_error(&fit, &ws);
+        }
+        runs.push(row);
     }
     println!("model error against the truth over the workspace (mm):");
-    summary("75 random poses", &r75);
-    summary("75 planned poses", &p75);
-    summary("55 planned poses", &p55);
-    let ratio: Vec<f64> = p75.iter().zip(&r75).map(|(p, r)| p / r).collect();
-    summary("planned 75 / random 75", &ratio);
-    let ratio: Vec<f64> = p55.iter().zip(&r75).map(|(p, r)| p / r).collect();
-    summary("planned 55 / random 75", &ratio);
+    for (i, n) in names.iter().enumerate() {
+        let v: Vec<f64> = runs.iter().map(|r| r[i]).collect();
+        summary(n, &v);
+    }
+    for (name, a, b) in [
+        ("planned 75 / random 75, weighted", 1, 0),
+        ("planned 55 / random 75, weighted", 2, 0),
+        ("planned 75 / random 75, unweighted", 4, 3),
+        ("planned 55 / random 75, unweighted", 5, 3),
+    ] {
+        let ratio: Vec<f64> = runs.iter().map(|r| r[a] / r[b]).collect();
+        summary(name, &ratio);
+    }
 }
