@@ -27,12 +27,15 @@ pub fn count(v: &Bound<'_, PyAny>, name: &str, min: u64, max: u64, why: &str) ->
     let Ok(i) = v.py().import("operator")?.call_method1("index", (v,)) else {
         return Err(bad());
     };
+    // Beyond i128: only its sign matters.
     let value: i128 = match i.extract::<i128>() {
         Ok(x) => x,
+        Err(_) if i.lt(0)? => i128::MIN,
         Err(_) => i128::MAX,
     };
     if value < min as i128 {
-        return Err(usage(format!("{name} {value}: must be at least {min}")));
+        let shown: String = i.str()?.to_string();
+        return Err(usage(format!("{name} {shown}: must be at least {min}")));
     }
     if value > max as i128 {
         let shown: String = i.str()?.to_string();

@@ -164,7 +164,7 @@ pub fn plan_poses(
             "noise_mm {noise_mm}: must be a positive length up to 1000 mm"
         )));
     }
-    if !(noise_per_m >= 0.0 && noise_per_m <= 1000.0) {
+    if !(0.0..=1000.0).contains(&noise_per_m) {
         return Err(usage(format!(
             "noise_per_m {noise_per_m}: must be within 0..1000 mm/m"
         )));

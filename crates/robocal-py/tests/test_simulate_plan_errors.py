@@ -27,6 +27,7 @@ def kr():
         (dict(poses=10, validation=-5), robocal.UsageError, "validation -5: must be at least 0"),
         (dict(poses=6_000_000, validation=6_000_000), robocal.UsageError, "12000000 poses in all"),
         (dict(poses=10, seed=-1), robocal.UsageError, "seed -1: must be at least 0"),
+        (dict(poses=-10**40), robocal.UsageError, "poses -10000000000000000000000000000000000000000: must be at least 0"),
         (dict(poses=10, truth="ur6"), robocal.UsageError, "truth: unknown robot preset `ur6`"),
         (dict(poses=10, truth="/nonexistent/t.truth.json"), robocal.FileError, "truth: "),
         (dict(poses=10, truth=3), robocal.UsageError, "truth: expected"),
