@@ -17,6 +17,7 @@ mod plan;
 mod result;
 mod robot;
 mod simulate;
+mod simulation;
 mod written;
 
 use pyo3::prelude::*;
@@ -30,7 +31,7 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate::calibrate_files, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(compensate::compensate_arrays, m)?)?;
-    m.add_class::<simulate::PySimulation>()?;
+    m.add_class::<simulation::PySimulation>()?;
     m.add_function(wrap_pyfunction!(simulate::simulate_session, m)?)?;
     m.add_class::<plan::PyPlan>()?;
     m.add_class::<plan::PyQuality>()?;

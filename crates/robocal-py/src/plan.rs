@@ -5,7 +5,7 @@
 use crate::args::{count, frame, magnitude, range_mm as range_arg};
 use crate::errors::{raise, usage, IntoPy};
 use crate::robot::PyRobot;
-use crate::written::{written, Written};
+use crate::written::{csv_bytes, read_back, Written};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use robocal_core::io::measurements::{read_measurements, Measurement, MeasurementSet, Positions};
@@ -50,6 +50,8 @@ impl PyQuality {
 pub struct PyPlan {
     plan: Plan,
     rows: Written,
+    /// The CSV text `robocal plan --out` writes.
+    csv: Vec<u8>,
     dof: usize,
     units: Vec<&'static str>,
     planned: Py<PyQuality>,
@@ -223,7 +225,8 @@ pub fn plan_poses(
             })
             .collect(),
     };
-    let rows = written(&set)?;
+    let csv = csv_bytes(&set)?;
+    let rows = read_back(&csv, r.dof(), false)?;
     let planned = quality(py, &p.planned, &p)?;
     let random = quality(py, &p.random, &p)?;
     let units = p.identified.iter().map(|q| q.unit().as_str()).collect();
@@ -232,6 +235,7 @@ pub fn plan_poses(
             dof: r.dof(),
             plan: p,
             rows,
+            csv,
             units,
             planned,
             random,
@@ -335,12 +339,12 @@ impl PyPlan {
 
     /// The poses as `robocal plan --out` writes them (CSV text).
     fn to_csv(&self) -> PyResult<String> {
-        String::from_utf8(self.rows.csv.clone()).map_err(|e| raise(1, format!("internal: {e}")))
+        String::from_utf8(self.csv.clone()).map_err(|e| raise(1, format!("internal: {e}")))
     }
 
     /// Writes the poses to `path` as `robocal plan --out` does (atomically).
     fn write(&self, path: PathBuf) -> PyResult<()> {
-        write_all_atomic(&[(path.as_path(), self.rows.csv.as_slice())]).py_err()
+        write_all_atomic(&[(path.as_path(), self.csv.as_slice())]).py_err()
     }
 
     fn __len__(&self) -> usize {

@@ -10,8 +10,6 @@ use robocal_core::io::MeasurementSet;
 
 /// The values of a written measurement set, column by column.
 pub struct Written {
-    /// The CSV text (what `robocal` writes for this set).
-    pub csv: Vec<u8>,
     /// Rows.
     pub rows: usize,
     /// Joint values in interface units (degrees, mm for a prismatic joint), row-major.
@@ -50,27 +48,33 @@ fn number(s: &str, column: &str) -> PyResult<f64> {
     })
 }
 
+/// The CSV text `robocal` writes for `set`.
+pub fn csv_bytes(set: &MeasurementSet) -> PyResult<Vec<u8>> {
+    measurements_csv(set)
+        .map_err(|e| raise(1, format!("internal: cannot format the measurements: {e}")))
+}
+
 /// `set` as the CLI writes it, and its values read back.
 pub fn written(set: &MeasurementSet) -> PyResult<Written> {
-    let csv = measurements_csv(set)
-        .map_err(|e| raise(1, format!("internal: cannot format the measurements: {e}")))?;
-    let dof = set.dof();
-    let with_p = set.has_positions();
+    read_back(&csv_bytes(set)?, set.dof(), set.has_positions())
+}
+
+/// The values of CSV text `csv` written by robocal for a set of `dof` joints, with x,y,z
+/// columns when `with_p`.
+pub fn read_back(csv: &[u8], dof: usize, with_p: bool) -> PyResult<Written> {
     let fixed = dof + if with_p { 3 } else { 0 };
-    let mut reader = csv::ReaderBuilder::new()
-        .has_headers(true)
-        .from_reader(csv.as_slice());
+    let mut reader = csv::ReaderBuilder::new().has_headers(true).from_reader(csv);
     let headers: Vec<String> = reader
         .headers()
         .map_err(|e| raise(1, format!("internal: {e}")))?
         .iter()
         .map(str::to_owned)
         .collect();
-    let mut q = Vec::with_capacity(set.rows.len() * dof);
-    let mut xyz = Vec::with_capacity(if with_p { set.rows.len() * 3 } else { 0 });
+    let mut q = Vec::new();
+    let mut xyz = Vec::new();
     let mut extra: Vec<(String, Vec<String>)> = headers[fixed..]
         .iter()
-        .map(|h| (h.clone(), Vec::with_capacity(set.rows.len())))
+        .map(|h| (h.clone(), Vec::new()))
         .collect();
     let mut rows = 0;
     for record in reader.records() {
@@ -87,7 +91,6 @@ pub fn written(set: &MeasurementSet) -> PyResult<Written> {
         rows += 1;
     }
     Ok(Written {
-        csv,
         rows,
         q,
         xyz: with_p.then_some(xyz),
