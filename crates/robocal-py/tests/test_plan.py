@@ -77,9 +77,11 @@ def test_every_option_is_the_cli(cli, tmp_path):
     assert d.min() >= 1500 and d.max() <= 5500
 
 
-def test_robot_file_plan_is_the_cli(cli, tmp_path):
-    ur5 = robocal.Robot.from_file(example("ur5.toml"))
-    both(cli, tmp_path, example("ur5.toml"), ur5, ["--poses", "40", "--candidates", "2000", "--seed", "3"],
+@pytest.mark.parametrize("robot_file", ["ur5.toml", "kr480-track.toml"])
+def test_robot_file_plan_is_the_cli(cli, tmp_path, robot_file):
+    """Standard DH, and a prismatic track (its poses in mm)."""
+    robot = robocal.Robot.from_file(example(robot_file))
+    both(cli, tmp_path, example(robot_file), robot, ["--poses", "40", "--candidates", "2000", "--seed", "3"],
          poses=40, candidates=2000, seed=3)
 
 

@@ -185,3 +185,15 @@ def test_simulation_timing(cli, tmp_path):
     print(f"\nsimulate {n} poses: Python {py * 1e3:.0f} ms, the whole CLI process {c * 1e3:.0f} ms")
     assert len(sim) == n + 3
     assert py <= 2.0 * c + 0.5, (py, c)
+
+
+@pytest.mark.parametrize("robot_file", ["ur5.toml", "kr480-track.toml", "fanuc-like.toml", "wam.toml"])
+def test_robot_files_simulate_as_the_cli(cli, tmp_path, robot_file):
+    """Standard DH, a prismatic track, a controller coupling, seven joints: the CLI's files."""
+    robot = robocal.Robot.from_file(example(robot_file))
+    sim, c, p = run_both(cli, tmp_path, example(robot_file), robot,
+                         ["--truth", "random", "--poses", "40", "--validation", "10", "--seed", "6"],
+                         truth="random", poses=40, validation=10, seed=6)
+    same_files(c, p)
+    same_files(c.with_suffix(".truth.json"), p.with_suffix(".truth.json"))
+    check_arrays(sim, c, robot.dof)
