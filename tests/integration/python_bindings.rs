@@ -1,7 +1,8 @@
 //! The Python bindings (issue 17): `crates/robocal-py/ci.sh` builds the `robocal` package into a
 //! fresh virtual environment under `target/python-ci` and runs its pytest suite, which compares
 //! Python with this CLI (the same binary these tests run) on the real UR5 data and the demo's
-//! data, times FK and calibration, and feeds the bindings bad input.
+//! data, holds `simulate` and `plan` to the CLI's files for the same seed, times FK,
+//! calibration, simulation and planning, and feeds the bindings bad input.
 //!
 //! Skips, saying why, when python3 or its venv module is missing or PyPI cannot be reached to
 //! install maturin, numpy and pytest (the script's exit status 77); a failed build or test

@@ -62,6 +62,23 @@ const KEYWORDS: &[(&str, &str)] = &[
     ("compliance", "compliance"),
     ("harmonics", "harmonics"),
     ("max_iterations", "max_iterations"),
+    // simulation::SimulationConfig (robocal.simulate)
+    ("tracker_frame", "tracker"),
+    ("floor_z_mm", "floor_mm"),
+    ("footprint_radius_mm", "footprint_mm"),
+    ("plane_points", "plane"),
+    ("validation_poses", "validation"),
+    ("truth.length_sigma_mm", "length_error_mm"),
+    ("truth.angle_sigma_deg", "angle_error_deg"),
+    ("gravity.compliance_rad_per_nm", "compliance"),
+    ("gravity.link_masses_kg", "link_masses_kg"),
+    ("gravity.payload_kg", "payload_kg"),
+    ("outliers.fraction", "outlier_fraction"),
+    ("outliers.min_mm", "outlier_min_mm"),
+    ("outliers.max_mm", "outlier_max_mm"),
+    ("targets", "all_targets"),
+    // planning::PlanSettings (robocal.plan)
+    ("tracker_range", "range_mm"),
 ];
 
 /// Phrases the library uses for a setting that is no field of its settings structs.

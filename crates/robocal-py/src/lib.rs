@@ -6,14 +6,19 @@
 //! (`errors`) with the library's messages, the settings named as this module's keyword
 //! arguments.
 
+mod args;
 mod arrays;
 mod calibrate;
 mod compensate;
 mod errors;
 mod evaluate;
 mod options;
+mod plan;
 mod result;
 mod robot;
+mod simulate;
+mod simulation;
+mod written;
 
 use pyo3::prelude::*;
 
@@ -26,6 +31,11 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate::calibrate_files, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(compensate::compensate_arrays, m)?)?;
+    m.add_class::<simulation::PySimulation>()?;
+    m.add_function(wrap_pyfunction!(simulate::simulate_session, m)?)?;
+    m.add_class::<plan::PyPlan>()?;
+    m.add_class::<plan::PyQuality>()?;
+    m.add_function(wrap_pyfunction!(plan::plan_poses, m)?)?;
     m.add_function(wrap_pyfunction!(result::parse_result, m)?)?;
     m.add_function(wrap_pyfunction!(result::read_result, m)?)?;
     m.add_function(wrap_pyfunction!(result::write_result, m)?)?;

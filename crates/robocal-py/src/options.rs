@@ -71,7 +71,7 @@ fn opt<'py, T: FromPyObjectOwned<'py>>(
 }
 
 /// A value as Python shows it, shortened.
-fn describe(v: &Bound<'_, PyAny>) -> String {
+pub fn describe(v: &Bound<'_, PyAny>) -> String {
     let r = v.repr().map(|s| s.to_string()).unwrap_or_default();
     let t = v
         .get_type()

@@ -27,6 +27,22 @@ def assert_same_numbers(a, b, path="result"):
         assert a == b, f"{path}: {a!r} != {b!r}"
 
 
+def max_abs_diff(a, b):
+    """The largest absolute difference between the numbers of `a` and `b` (same layout)."""
+    if isinstance(a, dict):
+        return max([max_abs_diff(a[k], b[k]) for k in a], default=0.0)
+    if isinstance(a, list):
+        return max([max_abs_diff(x, y) for x, y in zip(a, b)], default=0.0)
+    if isinstance(a, float) or isinstance(b, float):
+        return abs(a - b)
+    return 0.0
+
+
+def identity_figure(py: dict, cli: dict) -> float:
+    """The largest absolute difference over the numeric sections of two results."""
+    return max(max_abs_diff(py[s], cli[s]) for s in SECTIONS if s in py)
+
+
 # The result's sections that hold numbers; `settings` names the files, `points` their lines.
 SECTIONS = ["parameters", "tracker_frame", "errors", "identifiability", "uncertainty",
             "prediction", "registration", "robot", "status", "plausibility", "solver"]
@@ -67,6 +83,7 @@ def test_ur5_arrays_are_the_cli(ur5, real_data, ur5_cli):
     assert q.shape == (1000, 6)
     res = robocal.calibrate(ur5, q, xyz, validate=(vq, vxyz))
     compare(res.data, ur5_cli[0])
+    print(f"\nUR5 real data, Python vs CLI result: max abs difference {identity_figure(res.data, ur5_cli[0]):.1e}")
     assert res.status == robocal.STATUS_CALIBRATED
     p = res.parameters
     assert p["a2"].unit == "mm" and isinstance(p["a2"].fixed, bool)
@@ -125,6 +142,7 @@ def test_demo_data_arrays_are_the_cli(demo):
     res = robocal.calibrate(kr, q[cal], xyz[cal], plane=(q[plane], xyz[plane]), validate=(vq, vxyz),
                             objective="sum-of-norms")
     compare(res.data, cli_res)
+    print(f"\ndemo data, Python vs CLI result: max abs difference {identity_figure(res.data, cli_res):.1e}")
     # And the demo's own result (the library's experiment) says the same.
     demo_res = read_json(run / "result.json")
     for name, e in demo_res["parameters"].items():

@@ -97,6 +97,12 @@ def test_compensate_is_the_clis(fit, real_data, cli, tmp_path):
     cq = np_.column_stack([a[f"q{i}"].astype(float) for i in range(1, 7)])
     # The CLI writes its joints rounded for the file; the same solve otherwise.
     assert np.allclose(c["commanded"], cq, rtol=0, atol=1e-8), np.abs(c["commanded"] - cq).max()
+    # Rounded as the file rounds them, the same digits.
+    text = open(out).read().splitlines()
+    col = text[0].split(",").index("q1")
+    written = [l.split(",")[col:col + 6] for l in text[1:]]
+    digits = len(written[0][0].split(".")[1])
+    assert [[f"{v:.{digits}f}" for v in row] for row in c["commanded"]] == written
     assert all(s == "converged" for s in c["status"])
     # The calibrated model at the commanded joints reaches the nominal model's point.
     cal = fit.calibrated_robot()

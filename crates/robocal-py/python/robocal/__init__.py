@@ -2,8 +2,10 @@
 
 The Python face of the robocal toolkit (the CLI ``robocal`` and the Rust library
 ``robocal-core``): robots from presets, robot files and result files; forward kinematics and
-Jacobians of many poses at once on numpy arrays; and the CLI's calibration with its options,
-returning a :class:`Result` that reads and writes the CLI's result JSON.
+Jacobians of many poses at once on numpy arrays; the CLI's calibration with its options,
+returning a :class:`Result` that reads and writes the CLI's result JSON; evaluation and
+compensation with a result; simulated measurement sessions (:func:`simulate`) and pose plans
+(:func:`plan`), whose arrays hold exactly the numbers the CLI writes for the same seed.
 
 Units are those of every robocal interface: millimetres and degrees (mm for a prismatic
 joint's value). Errors are :class:`RobocalError` subclasses carrying the CLI's exit code in
@@ -16,6 +18,13 @@ Example (the UR5 data of the README)::
     d = np.loadtxt("jacobi_ur5_grid.csv", delimiter=",", skiprows=1)
     res = robocal.calibrate(ur5, d[:, :6], d[:, 6:9])
     print(res.errors["calibration"]["after"]["mean_mm"])
+
+    # The paper's experiment in simulation: plan 75 poses, measure them on a robot with
+    # random errors, calibrate.
+    kr = robocal.Robot.preset("kuka-kr480-r3330")
+    p = robocal.plan(kr, 75, seed=1)
+    sim = robocal.simulate(kr, "random", joints=p.poses, seed=7)
+    res = robocal.calibrate(kr, sim.q, sim.xyz)
 """
 
 from __future__ import annotations
@@ -32,7 +41,10 @@ from ._robocal import (
     InputError,
     NumericalError,
     RobocalError,
+    Plan,
+    PlanQuality,
     Robot,
+    Simulation,
     UsageError,
 )
 
@@ -46,6 +58,11 @@ __all__ = [
     "calibrate_files",
     "evaluate",
     "compensate",
+    "simulate",
+    "Simulation",
+    "plan",
+    "Plan",
+    "PlanQuality",
     "RobocalError",
     "UsageError",
     "InputError",
@@ -371,3 +388,141 @@ def compensate(result: Result, q: ArrayLike, **options: Any) -> Dict[str, Any]:
     """The CLI's ``robocal compensate --params RESULT --joints`` on arrays: see
     :meth:`Result.compensate`."""
     return result.compensate(q, **options)
+
+
+PerJoint = Union[float, Sequence[float]]
+
+
+def simulate(
+    robot: Robot,
+    truth: Union[str, "os.PathLike[str]", Robot] = "random",
+    poses: Optional[int] = None,
+    *,
+    joints: Optional[Union[ArrayLike, str, "os.PathLike[str]"]] = None,
+    seed: int = 1,
+    validation: int = 0,
+    plane: bool = True,
+    plane_z_mm: Optional[float] = None,
+    tracker: Optional[Sequence[float]] = None,
+    noise_mm: float = 0.010,
+    noise_per_m: float = 0.005,
+    length_error_mm: Optional[float] = None,
+    angle_error_deg: Optional[float] = None,
+    tilt_parallel_axes: bool = False,
+    floor_mm: float = 0.0,
+    footprint_mm: Optional[float] = None,
+    compliance: Optional[PerJoint] = None,
+    link_masses_kg: Optional[PerJoint] = None,
+    payload_kg: Optional[float] = None,
+    outlier_fraction: Optional[float] = None,
+    outlier_min_mm: Optional[float] = None,
+    outlier_max_mm: Optional[float] = None,
+    all_targets: bool = False,
+    orientation_sigma_deg: Optional[float] = None,
+) -> Simulation:
+    """Measures a virtual robot with a virtual laser tracker: the CLI's ``robocal simulate``.
+
+    ``robot`` is the nominal robot (what the controller believes); ``truth`` the robot that
+    really moves: ``"random"`` (``robot`` with seeded random geometric errors of
+    ``length_error_mm`` (default 0.5) and ``angle_error_deg`` (default 0.03), and with
+    ``tilt_parallel_axes`` a Hayati tilt of every nominally parallel axis), a preset name, a
+    robot file, an earlier session's truth file (``*.truth.json``: its tracker frame too) or a
+    :class:`Robot`. Either ``poses`` random calibration poses (with the paper's three plane
+    points unless ``plane=False``, at height ``plane_z_mm``, and ``validation`` validation
+    poses) or ``joints``: the joint values to measure, an array (n, dof) in degrees or a joints
+    CSV (e.g. :attr:`Plan.poses`, or commanded joints in the verification phase).
+
+    Every other option is the CLI flag of the same name (README, "simulate"): ``seed`` (same
+    seed, same numbers), ``tracker`` (x, y, z, A, B, C in mm and degrees; the tracker's pose in
+    the base frame), the noise ``noise_mm + noise_per_m * distance`` per axis, the pose rules
+    ``floor_mm`` and ``footprint_mm``, gravity deflection (``compliance`` in rad/(N m), and
+    ``link_masses_kg``, one value or one per joint, ``payload_kg``), gross outliers
+    (``outlier_fraction`` of the readings displaced by ``outlier_min_mm``..``outlier_max_mm``),
+    ``all_targets`` (every reflector of the robot file's ``tools``, a ``target`` per row) and
+    ``orientation_sigma_deg`` (6-DoF readings: ``abc``).
+
+    Returns a :class:`Simulation` whose arrays hold the values ``robocal simulate --out`` writes
+    for the same arguments (joint values to 1e-9 degree, readings to 1e-6 mm), so calibrating
+    them gives the CLI's result; :meth:`Simulation.write` writes the CLI's very files. Bad
+    arguments raise :class:`UsageError`, bad arrays :class:`InputError`. The GIL is released
+    while the session runs.
+    """
+    sim = _robocal.simulate_session(
+        robot,
+        truth,
+        poses,
+        joints=joints,
+        seed=seed,
+        validation=validation,
+        plane=plane,
+        plane_z_mm=plane_z_mm,
+        tracker=tracker,
+        noise_mm=noise_mm,
+        noise_per_m=noise_per_m,
+        length_error_mm=length_error_mm,
+        angle_error_deg=angle_error_deg,
+        tilt_parallel_axes=tilt_parallel_axes,
+        floor_mm=floor_mm,
+        footprint_mm=footprint_mm,
+        compliance=compliance,
+        link_masses_kg=link_masses_kg,
+        payload_kg=payload_kg,
+        outlier_fraction=outlier_fraction,
+        outlier_min_mm=outlier_min_mm,
+        outlier_max_mm=outlier_max_mm,
+        all_targets=all_targets,
+        orientation_sigma_deg=orientation_sigma_deg,
+    )
+    for w in sim.warnings:
+        warnings.warn(w, RuntimeWarning, stacklevel=2)
+    return sim
+
+
+def plan(
+    robot: Robot,
+    poses: int = 75,
+    *,
+    candidates: int = 10000,
+    seed: int = 1,
+    criterion: str = "workspace",
+    tracker: Optional[Sequence[float]] = None,
+    range_mm: Optional[Tuple[float, float]] = None,
+    include: Optional[Union[ArrayLike, str, "os.PathLike[str]"]] = None,
+    floor_mm: float = 0.0,
+    footprint_mm: Optional[float] = None,
+    noise_mm: float = 0.010,
+    noise_per_m: float = 0.005,
+) -> Plan:
+    """The poses worth measuring: the CLI's ``robocal plan``.
+
+    Chooses ``poses`` joint configurations of ``robot`` from ``candidates`` random ones (seeded
+    by ``seed``, under the simulation's rules ``floor_mm`` and ``footprint_mm`` and, with
+    ``range_mm=(min, max)``, the tracker's working range from ``tracker``). ``criterion``:
+    ``"workspace"`` (default; I-optimality, the mean model error the parameters' uncertainty
+    leaves over the workspace) or ``"d-optimal"`` (the parameters' joint confidence region).
+    ``include``: poses measured anyway (an array (m, dof) in degrees or a joints CSV): part of
+    the design, not among the returned poses. ``noise_mm`` (and, with ``tracker``,
+    ``noise_per_m``) is the per-axis noise the standard deviations are predicted at.
+
+    Returns a :class:`Plan`: ``poses`` (n, dof) in degrees, exactly as ``robocal plan --out``
+    writes them for the same arguments, and the quality figures the CLI prints (``planned`` and
+    ``random``: observability, log_det, predicted stds, workspace RMS). The GIL is released
+    while planning.
+    """
+    p, notes = _robocal.plan_poses(
+        robot,
+        poses,
+        candidates=candidates,
+        seed=seed,
+        criterion=criterion,
+        tracker=tracker,
+        range_mm=range_mm,
+        include=include,
+        floor_mm=floor_mm,
+        footprint_mm=footprint_mm,
+        noise_mm=noise_mm,
+        noise_per_m=noise_per_m,
+    )
+    for n in notes:
+        warnings.warn(n, RuntimeWarning, stacklevel=2)
+    return p

@@ -1,7 +1,8 @@
 """Type stubs of robocal's Python bindings (see the docstrings of the package for the details)."""
 
 import os
-from typing import Any, Dict, NamedTuple, Optional, Sequence, Tuple, Union
+import pathlib
+from typing import Any, Dict, List, NamedTuple, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -17,6 +18,8 @@ FloatArray = npt.NDArray[np.float64]
 PathLike = Union[str, os.PathLike]
 Names = Union[str, Sequence[str]]
 Joints = Union[str, Sequence[int]]
+PerJoint = Union[float, Sequence[float]]
+IntArray = npt.NDArray[np.int64]
 
 class RobocalError(Exception):
     """Every error robocal raises; ``exit_code`` is the CLI's exit code for it."""
@@ -187,3 +190,168 @@ def evaluate(result: Result, q: ArrayLike, xyz: ArrayLike, **options: Any) -> Di
 
 def compensate(result: Result, q: ArrayLike, **options: Any) -> Dict[str, Any]:
     """The CLI's ``robocal compensate --joints`` on arrays."""
+
+
+class Simulation:
+    """A simulated measurement session (:func:`simulate`): the rows ``robocal simulate --out``
+    writes, with the values as written (joints to 1e-9 degree, readings to 1e-6 mm)."""
+
+    @property
+    def q(self) -> FloatArray:
+        """(n, dof) joint values of every row, degrees (mm for a prismatic joint)."""
+    @property
+    def xyz(self) -> FloatArray:
+        """(n, 3) tracker readings of every row, mm in the tracker frame."""
+    @property
+    def exact(self) -> FloatArray:
+        """(n, 3) readings without noise or outliers, full precision."""
+    @property
+    def sets(self) -> Optional[List[str]]:
+        """Each row's set: "plane", "calibration", "validation" (None for measured joints)."""
+    @property
+    def ids(self) -> Optional[List[str]]:
+        """Each row's id: P1.., C1.., V1.. (None for measured joints)."""
+    @property
+    def target(self) -> Optional[IntArray]:
+        """(n,) each row's target (1-based), with ``all_targets``."""
+    @property
+    def abc(self) -> Optional[FloatArray]:
+        """(n, 3) measured orientations A, B, C (deg, tracker frame), with
+        ``orientation_sigma_deg``."""
+    @property
+    def columns(self) -> Dict[str, List[str]]:
+        """The CSV's further columns by name (id, set, target, a, b, c, a joints file's own)."""
+    @property
+    def calibration(self) -> Tuple[FloatArray, FloatArray]:
+        """(q, xyz) of the calibration rows."""
+    @property
+    def validation(self) -> Tuple[FloatArray, FloatArray]:
+        """(q, xyz) of the validation rows (empty without ``validation``)."""
+    @property
+    def plane(self) -> Tuple[FloatArray, FloatArray]:
+        """(q, xyz) of the paper's three plane points (empty with ``plane=False``)."""
+    @property
+    def plane_z_mm(self) -> Optional[float]: ...
+    @property
+    def truth(self) -> Robot:
+        """The robot that really moved."""
+    @property
+    def nominal(self) -> Robot: ...
+    @property
+    def tracker_frame(self) -> Dict[str, float]:
+        """The tracker's pose in the base frame: x, y, z (mm), a, b, c (deg)."""
+    @property
+    def seed(self) -> int: ...
+    @property
+    def outlier_rows(self) -> IntArray:
+        """Rows (0-based) given a gross outlier."""
+    @property
+    def outlier_displacements(self) -> FloatArray:
+        """(k, 3) the outliers' displacements, mm."""
+    @property
+    def deflection_mm(self) -> Optional[npt.NDArray[np.float64]]:
+        """(n,) how far gravity moved each tool point, with ``compliance``."""
+    @property
+    def warnings(self) -> List[str]: ...
+    def to_csv(self) -> str:
+        """The measurement CSV, as ``robocal simulate --out`` writes it."""
+    def write(self, path: PathLike, validation_path: Optional[PathLike] = None) -> pathlib.Path:
+        """Writes the CLI's files (CSV, PATH.truth.json, validation CSV); returns the truth
+        file's path."""
+    def __len__(self) -> int: ...
+
+class PlanQuality:
+    """How well a set of poses identifies the parameters."""
+
+    observability: float
+    log_det: float
+    std: List[float]
+    workspace_rms_mm: float
+
+class Plan:
+    """A pose plan (:func:`plan`): what ``robocal plan`` writes and prints."""
+
+    @property
+    def poses(self) -> FloatArray:
+        """(n, dof) the chosen poses in degrees, as ``robocal plan --out`` writes them."""
+    @property
+    def parameters(self) -> List[str]:
+        """The identifiable parameters (the order of ``PlanQuality.std``)."""
+    @property
+    def units(self) -> List[str]: ...
+    @property
+    def planned(self) -> PlanQuality: ...
+    @property
+    def random(self) -> PlanQuality:
+        """As many random poses under the same rules, for comparison."""
+    @property
+    def stds(self) -> Dict[str, Tuple[float, float]]:
+        """Predicted standard deviations {name: (planned, random)}."""
+    @property
+    def criterion(self) -> str: ...
+    @property
+    def criterion_values(self) -> Tuple[float, float]:
+        """The criterion after the greedy selection and after the exchange passes."""
+    @property
+    def exchanges(self) -> Tuple[int, int]:
+        """Exchange passes run and poses they replaced."""
+    @property
+    def included(self) -> int: ...
+    @property
+    def candidates(self) -> int: ...
+    @property
+    def seed(self) -> int: ...
+    @property
+    def noise(self) -> Tuple[float, float]:
+        """(noise_mm, noise_per_m) the standard deviations are predicted at."""
+    def to_csv(self) -> str: ...
+    def write(self, path: PathLike) -> None:
+        """Writes the poses as ``robocal plan --out`` does."""
+    def __len__(self) -> int: ...
+
+def simulate(
+    robot: Robot,
+    truth: Union[str, PathLike, Robot] = "random",
+    poses: Optional[int] = None,
+    *,
+    joints: Optional[Union[ArrayLike, PathLike]] = None,
+    seed: int = 1,
+    validation: int = 0,
+    plane: bool = True,
+    plane_z_mm: Optional[float] = None,
+    tracker: Optional[Sequence[float]] = None,
+    noise_mm: float = 0.010,
+    noise_per_m: float = 0.005,
+    length_error_mm: Optional[float] = None,
+    angle_error_deg: Optional[float] = None,
+    tilt_parallel_axes: bool = False,
+    floor_mm: float = 0.0,
+    footprint_mm: Optional[float] = None,
+    compliance: Optional[PerJoint] = None,
+    link_masses_kg: Optional[PerJoint] = None,
+    payload_kg: Optional[float] = None,
+    outlier_fraction: Optional[float] = None,
+    outlier_min_mm: Optional[float] = None,
+    outlier_max_mm: Optional[float] = None,
+    all_targets: bool = False,
+    orientation_sigma_deg: Optional[float] = None,
+) -> Simulation:
+    """The CLI's ``robocal simulate``: random poses (``poses``, ``validation``, the plane
+    points) or ``joints`` measured on ``truth`` by a virtual tracker."""
+
+def plan(
+    robot: Robot,
+    poses: int = 75,
+    *,
+    candidates: int = 10000,
+    seed: int = 1,
+    criterion: str = "workspace",
+    tracker: Optional[Sequence[float]] = None,
+    range_mm: Optional[Tuple[float, float]] = None,
+    include: Optional[Union[ArrayLike, PathLike]] = None,
+    floor_mm: float = 0.0,
+    footprint_mm: Optional[float] = None,
+    noise_mm: float = 0.010,
+    noise_per_m: float = 0.005,
+) -> Plan:
+    """The CLI's ``robocal plan``: the poses worth measuring, and their predicted quality."""

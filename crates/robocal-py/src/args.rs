@@ -1,0 +1,138 @@
+//! Scalar arguments of `simulate` and `plan` checked as the CLI checks its flags: counts
+//! (refusing negative numbers, bools and floats with a `UsageError` naming the argument rather
+//! than an `OverflowError`), per-joint lists, frame vectors and ranges.
+
+use crate::errors::usage;
+use crate::options::describe;
+use pyo3::prelude::*;
+use pyo3::types::PyBool;
+use robocal_core::io::result::FrameVec;
+
+/// The largest length accepted for a length setting (mm): the library's plausible length (1 km),
+/// as the CLI's `limits::MAX_LENGTH_MM`.
+pub const MAX_LENGTH_MM: f64 = robocal_core::ranges::LENGTH.max;
+
+/// An optional argument, `None` when absent or None.
+pub fn given<'a, 'py>(v: Option<&'a Bound<'py, PyAny>>) -> Option<&'a Bound<'py, PyAny>> {
+    v.filter(|v| !v.is_none())
+}
+
+/// Argument `name`, an int within `min..=max` (`why` says what the upper limit protects).
+pub fn count(v: &Bound<'_, PyAny>, name: &str, min: u64, max: u64, why: &str) -> PyResult<u64> {
+    let bad = || usage(format!("{name}: expected an int, got {}", describe(v)));
+    if v.is_instance_of::<PyBool>() {
+        return Err(bad());
+    }
+    // Python ints of any size, numpy integers: through `operator.index` (floats are refused).
+    let Ok(i) = v.py().import("operator")?.call_method1("index", (v,)) else {
+        return Err(bad());
+    };
+    // Beyond i128: only its sign matters.
+    let value: i128 = match i.extract::<i128>() {
+        Ok(x) => x,
+        Err(_) if i.lt(0)? => i128::MIN,
+        Err(_) => i128::MAX,
+    };
+    if value < min as i128 {
+        let shown: String = i.str()?.to_string();
+        return Err(usage(format!("{name} {shown}: must be at least {min}")));
+    }
+    if value > max as i128 {
+        let shown: String = i.str()?.to_string();
+        return Err(usage(format!("{name} {shown}: at most {max} ({why})")));
+    }
+    Ok(value as u64)
+}
+
+/// Argument `name`, a finite length (mm) of at most [`MAX_LENGTH_MM`] in magnitude, as the CLI's
+/// `limits::magnitude`; non-finite and negative values are left to the setting's own check.
+pub fn magnitude(name: &str, value: f64) -> PyResult<()> {
+    if value.is_finite() && value.abs() > MAX_LENGTH_MM {
+        let shown = if value.abs() >= 1e15 {
+            format!("{value:e}")
+        } else {
+            format!("{value}")
+        };
+        return Err(usage(format!(
+            "{name} {shown}: at most {MAX_LENGTH_MM} mm in magnitude"
+        )));
+    }
+    Ok(())
+}
+
+/// A list of numbers: one value for every joint (a number), or one per joint (a sequence).
+pub fn per_joint(v: &Bound<'_, PyAny>, name: &str, dof: usize) -> PyResult<Vec<f64>> {
+    if !v.is_instance_of::<PyBool>() {
+        if let Ok(x) = v.extract::<f64>() {
+            return Ok(vec![x; dof]);
+        }
+        if let Ok(xs) = v.extract::<Vec<f64>>() {
+            return match xs.len() {
+                1 => Ok(vec![xs[0]; dof]),
+                n if n == dof => Ok(xs),
+                n => Err(usage(format!(
+                    "{name}: {n} values; give one for all joints or one per joint ({dof})"
+                ))),
+            };
+        }
+    }
+    Err(usage(format!(
+        "{name}: expected a number or one number per joint, got {}",
+        describe(v)
+    )))
+}
+
+/// Six numbers x, y, z, A, B, C (mm, deg): a frame vector.
+pub fn frame(v: &Bound<'_, PyAny>, name: &str) -> PyResult<FrameVec> {
+    let xs: Vec<f64> = v.extract().map_err(|_| {
+        usage(format!(
+            "{name}: expected 6 numbers x, y, z, A, B, C (mm, deg), got {}",
+            describe(v)
+        ))
+    })?;
+    let [x, y, z, a, b, c] = xs[..] else {
+        return Err(usage(format!(
+            "{name}: expected 6 values x, y, z, A, B, C (mm, deg), got {}",
+            xs.len()
+        )));
+    };
+    Ok(FrameVec { x, y, z, a, b, c })
+}
+
+/// Two numbers (min, max) of a range of distances (mm), as the CLI's `--range-mm`.
+pub fn range_mm(v: &Bound<'_, PyAny>, name: &str) -> PyResult<(f64, f64)> {
+    let xs: Vec<f64> = v.extract().map_err(|_| {
+        usage(format!(
+            "{name}: expected (min, max) in mm, got {}",
+            describe(v)
+        ))
+    })?;
+    let [a, b] = xs[..] else {
+        return Err(usage(format!(
+            "{name}: expected (min, max) in mm, got {} value(s)",
+            xs.len()
+        )));
+    };
+    if !(a >= 0.0 && b > a && b <= MAX_LENGTH_MM) {
+        return Err(usage(format!(
+            "{name} ({a}, {b}): not a range of distances (0 <= min < max <= {MAX_LENGTH_MM} mm)"
+        )));
+    }
+    Ok((a, b))
+}
+
+/// A frame vector as a dict {x, y, z, a, b, c}.
+pub fn frame_dict<'py>(py: Python<'py>, f: &FrameVec) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+    let d = pyo3::types::PyDict::new(py);
+    for (k, v) in [
+        ("x", f.x),
+        ("y", f.y),
+        ("z", f.z),
+        ("a", f.a),
+        ("b", f.b),
+        ("c", f.c),
+    ] {
+        d.set_item(k, v)?;
+    }
+    Ok(d)
+}
