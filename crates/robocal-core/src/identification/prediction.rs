@@ -11,6 +11,7 @@
 //! them ([`Prediction::mean_mm`]), the figure a validation set measures.
 
 use crate::identification::covariance::Covariance;
+use crate::identification::simd::with_avx;
 use crate::identification::system::add_gram;
 use crate::model::{Param, Robot};
 use crate::observations::Observations;
@@ -262,6 +263,7 @@ impl<'a> Predictor<'a> {
     }
 
     /// `J C J^T` for the 3 x k rows `j` (row-major); `x` is scratch of 3 k.
+    #[inline(always)]
     fn model_covariance(&self, j: &[f64], x: &mut [f64]) -> Matrix3<f64> {
         let k = self.index.len();
         if let Some(l) = &self.factor {
@@ -327,6 +329,7 @@ impl<'a> Predictor<'a> {
     }
 
     /// Tool point of target `t` and `J C J^T` at joints `q`.
+    #[inline(always)]
     fn model_at(&self, s: &mut Scratch, q: &[f64], t: usize) -> (Vector3<f64>, Matrix3<f64>) {
         let p = target_jacobian(self.robot, &self.index, q, t, &mut s.jp, &mut s.j);
         (p, self.model_covariance(&s.j, &mut s.x))
@@ -528,9 +531,15 @@ pub fn predict(
         n,
         || pred.scratch(),
         |s, i| {
-            let q = calibration.q(i);
-            let (p, model) = pred.model_at(s, q, calibration.target(i));
-            (s.j.clone(), model, p.z)
+            // With AVX where the processor has it (the same bits, see `simd`).
+            with_avx(
+                #[inline(always)]
+                || {
+                    let q = calibration.q(i);
+                    let (p, model) = pred.model_at(s, q, calibration.target(i));
+                    (s.j.clone(), model, p.z)
+                },
+            )
         },
     );
     let mut jac = Vec::with_capacity(n * 3 * k);
