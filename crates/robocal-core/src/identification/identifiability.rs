@@ -18,6 +18,7 @@
 
 use crate::error::{Error, Result};
 use crate::frame::TrackerFrame;
+use crate::identification::householder::fold_rows;
 use crate::identification::system::Problem;
 use crate::identification::Observations;
 use crate::model::{Param, Robot};
@@ -224,33 +225,34 @@ pub fn jacobian_r(robot: &Robot, obs: &Observations) -> Reduced {
     let all = robot.param_list();
     let problem = Problem::new(robot, all, obs, &TrackerFrame::identity());
     let idx: Vec<usize> = (0..obs.len()).collect();
-    let r_of = |points: &[usize]| -> (DMatrix<f64>, Vec<f64>) {
-        let mut r = DMatrix::<f64>::zeros(0, n);
+    // Each task folds its blocks of rows into an n x n triangular factor (column-major).
+    let r_of = |points: &[usize]| -> (Vec<f64>, Vec<f64>) {
+        let mut r = vec![0.0; n * n];
         let mut ang = vec![0.0; n];
         let mut jp = vec![Vector3::zeros(); n];
         let mut jw = vec![Vector3::zeros(); n];
         let mut jr = vec![0.0; rows * n];
+        let mut b = vec![0.0; rows * BLOCK_POINTS * n];
         for block in points.chunks(BLOCK_POINTS) {
-            let top = r.nrows();
-            let mut m = DMatrix::<f64>::zeros(top + rows * block.len(), n);
-            m.view_mut((0, 0), (top, n)).copy_from(&r);
-            for (b, &i) in block.iter().enumerate() {
+            let m = rows * block.len();
+            let b = &mut b[..m * n];
+            for (k, &i) in block.iter().enumerate() {
                 problem.model_rows(robot, i, &mut jp, &mut jw, &mut jr);
                 for a in 0..rows {
                     for c in 0..n {
-                        m[(top + rows * b + a, c)] = jr[a * n + c];
+                        b[c * m + rows * k + a] = jr[a * n + c];
                     }
                 }
                 for (s, w) in ang.iter_mut().zip(&jw) {
                     *s += w.norm_squared();
                 }
             }
-            r = upper(m);
+            fold_rows(&mut r, n, b, m);
         }
         (r, ang)
     };
     let tasks = obs.len().div_ceil(TASK_POINTS).max(1);
-    let parts: Vec<(DMatrix<f64>, Vec<f64>)> = if tasks > 1 {
+    let parts: Vec<(Vec<f64>, Vec<f64>)> = if tasks > 1 {
         idx.par_chunks(obs.len().div_ceil(tasks))
             .map(r_of)
             .collect()
@@ -263,34 +265,20 @@ pub fn jacobian_r(robot: &Robot, obs: &Observations) -> Reduced {
             *s += v;
         }
     }
-    let mut r = parts
+    // The parts' factors folded in order (the same bits on any number of threads).
+    let r = parts
         .into_iter()
         .map(|(r, _)| r)
-        .reduce(|a, b| {
-            let mut m = DMatrix::zeros(a.nrows() + b.nrows(), n);
-            m.view_mut((0, 0), (a.nrows(), n)).copy_from(&a);
-            m.view_mut((a.nrows(), 0), (b.nrows(), n)).copy_from(&b);
-            upper(m)
+        .reduce(|mut a, mut b| {
+            fold_rows(&mut a, n, &mut b, n);
+            a
         })
-        .unwrap_or_else(|| DMatrix::zeros(0, n));
-    if r.nrows() < n {
-        // Fewer equations than parameters: pad with zero rows (R^T R is unchanged).
-        let mut p = DMatrix::zeros(n, n);
-        p.view_mut((0, 0), (r.nrows(), n)).copy_from(&r);
-        r = p;
-    }
+        .unwrap_or_else(|| vec![0.0; n * n]);
+    let r = DMatrix::from_column_slice(n, n, &r);
     Reduced {
         r,
         angular: angular.into_iter().map(f64::sqrt).collect(),
     }
-}
-
-/// The upper-triangular factor of a QR decomposition (min(rows, cols) x cols).
-fn upper(m: DMatrix<f64>) -> DMatrix<f64> {
-    if m.nrows() == 0 {
-        return m;
-    }
-    m.qr().r()
 }
 
 /// Decides which parameters of `robot` the poses of `obs` identify (see the module docs).

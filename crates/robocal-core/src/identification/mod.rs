@@ -18,6 +18,7 @@
 //! - [`report`]: the result JSON.
 
 pub mod covariance;
+pub(crate) mod householder;
 pub mod identifiability;
 pub mod objective;
 pub mod param_vector;
