@@ -103,14 +103,11 @@ pub struct CalibrateArgs {
     accept_implausible: bool,
     /// Weighted fitting with a tracker uncertainty model: 1 sigma per axis = FIXED_MM +
     /// PER_M_MM per metre of distance from the tracker. Rows with a `sigma_mm` column keep their
-    /// own. Without either, every point weighs the same.
-    #[arg(
-        long,
-        value_name = "FIXED_MM,PER_M_MM",
-        value_delimiter = ',',
-        allow_hyphen_values = true
-    )]
-    tracker_sigma: Vec<f64>,
+    /// own. Without either, data in a tracker's frame (the registered tracker at least 500 mm
+    /// from the base) are weighted by a typical tracker (0.010,0.005), other data not; `off`
+    /// weighs every point the same.
+    #[arg(long, value_name = "FIXED_MM,PER_M_MM|off", allow_hyphen_values = true)]
+    tracker_sigma: Option<String>,
     /// 6-DoF data (a,b,c columns): how many mm of position error one degree of orientation
     /// error counts as in the fit [default: 3, a 6-DoF probe's typical 0.03 mm against 0.01 deg].
     #[arg(long, value_name = "MM_PER_DEG")]
@@ -147,17 +144,39 @@ enum RobustArg {
 
 /// The weighting of `--tracker-sigma` and `--orientation-weight`.
 pub(crate) fn weighting(
-    tracker_sigma: &[f64],
+    tracker_sigma: Option<&str>,
     orientation_weight: Option<f64>,
 ) -> anyhow::Result<Weighting> {
     let mut w = Weighting::default();
-    if !tracker_sigma.is_empty() && tracker_sigma.len() != 2 {
-        return Err(exit::usage(format!(
-            "--tracker-sigma: expected two numbers FIXED_MM,PER_M_MM (e.g. 0.0075,0.003), got {}",
-            tracker_sigma.len()
-        )));
-    }
-    if let [fixed, per_m] = tracker_sigma {
+    let tracker_sigma: Vec<f64> = match tracker_sigma.map(str::trim) {
+        None => Vec::new(),
+        Some("off") => {
+            w.automatic = false;
+            Vec::new()
+        }
+        Some(text) => {
+            let v: Vec<f64> = text
+                .split(',')
+                .map(|t| t.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| {
+                    exit::usage(format!(
+                        "--tracker-sigma {text}: expected two numbers FIXED_MM,PER_M_MM (e.g. \
+                         0.0075,0.003) or `off`"
+                    ))
+                })?;
+            if v.len() != 2 {
+                return Err(exit::usage(format!(
+                    "--tracker-sigma: expected two numbers FIXED_MM,PER_M_MM (e.g. 0.0075,0.003), \
+                     got {}",
+                    v.len()
+                )));
+            }
+            v
+        }
+    };
+    if let [fixed, per_m] = tracker_sigma[..] {
+        let (fixed, per_m) = (&fixed, &per_m);
         w.tracker = Some(TrackerSigma::new(*fixed, *per_m).map_err(|_| {
             exit::usage(format!(
                 "--tracker-sigma {fixed},{per_m}: expected FIXED_MM,PER_M_MM, both non-negative \
@@ -422,7 +441,7 @@ impl TryFrom<&CalibrateArgs> for Settings {
                 max_iterations: a.max_iterations,
                 ..Default::default()
             },
-            weighting: weighting(&a.tracker_sigma, a.orientation_weight)?,
+            weighting: weighting(a.tracker_sigma.as_deref(), a.orientation_weight)?,
             validation_refit_frame: a.validate_refit_frame,
         };
         Ok(Settings {
@@ -688,6 +707,7 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
         "tracker frame in the base frame (mm, deg): x {:.4}  y {:.4}  z {:.4}  A {:.5}  B {:.5}  C {:.5}",
         tf.x, tf.y, tf.z, tf.a, tf.b, tf.c
     );
+    print_weighting(&c.weighting);
     let before_cols: Vec<(&str, ErrorStats)> =
         std::iter::once(("Calibration", c.calibration.before_stats()))
             .chain(
@@ -858,4 +878,32 @@ fn print_prediction(c: &Calibration) {
             None => String::new(),
         }
     );
+}
+
+/// One line on the point weights the fit used.
+fn print_weighting(w: &robocal_core::observations::AppliedWeighting) {
+    use robocal_core::observations::WeightSource;
+    let model = |t: &Option<robocal_core::observations::TrackerSigma>| {
+        t.map(|t| format!("{} mm + {} mm/m per axis", t.fixed_mm, t.per_m_mm))
+            .unwrap_or_default()
+    };
+    match w.source {
+        WeightSource::Column => println!("points weighted by their sigma_mm column"),
+        WeightSource::Given => println!(
+            "points weighted by the tracker model {} (--tracker-sigma)",
+            model(&w.tracker)
+        ),
+        WeightSource::Automatic => println!(
+            "points weighted by a typical tracker, {}: the data are in a tracker's frame (the \
+             tracker {:.0} mm from the base); --tracker-sigma gives your tracker's model, \
+             --tracker-sigma off weighs every point the same",
+            model(&w.tracker),
+            w.tracker_distance_mm
+        ),
+        WeightSource::None => println!(
+            "every point weighs the same (the measurement frame's origin is {:.0} mm from the \
+             base: not a tracker's own frame, or --tracker-sigma off)",
+            w.tracker_distance_mm
+        ),
+    }
 }

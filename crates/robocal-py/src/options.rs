@@ -314,7 +314,19 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
     }
 
     let mut weighting = Weighting::default();
-    let tracker_sigma: Option<Vec<f64>> = opt(d, "tracker_sigma", "(fixed_mm, per_m_mm)")?;
+    // "off": every point weighs the same, even data in a tracker's frame.
+    let off = match d.get_item("tracker_sigma")? {
+        Some(v) => v.extract::<String>().is_ok_and(|s| s == "off"),
+        None => false,
+    };
+    if off {
+        weighting.automatic = false;
+    }
+    let tracker_sigma: Option<Vec<f64>> = if off {
+        None
+    } else {
+        opt(d, "tracker_sigma", "(fixed_mm, per_m_mm) or \"off\"")?
+    };
     if let Some(ts) = tracker_sigma {
         let [fixed, per_m] = ts[..] else {
             return Err(usage(format!(

@@ -28,6 +28,7 @@ use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
 use crate::observations::Observations;
 use crate::observations::Weighting;
+use crate::observations::{AppliedWeighting, WeightSource};
 use crate::progress::{self, Observer};
 use crate::registration::{
     fit_tools, register, Registration, RegistrationObjective, RegistrationOptions, ToolFit,
@@ -201,6 +202,8 @@ pub struct Calibration {
     pub plausibility: Plausibility,
     /// The settings used.
     pub settings: CalibrationSettings,
+    /// The weighting the fit used (with an automatic tracker model, which).
+    pub weighting: AppliedWeighting,
 }
 
 impl Calibration {
@@ -303,6 +306,22 @@ pub fn calibrate(
         ..Default::default()
     };
     let registration = register(nominal, cal, data.plane, &reg_opts)?;
+    // The automatic tracker model needs to know where the tracker stands: the registration
+    // (which does not weight points) tells.
+    let weighting = settings
+        .weighting
+        .resolve(data.calibration, registration.frame.origin().norm());
+    let reweighted;
+    let cal = if weighting.source == WeightSource::Automatic {
+        reweighted = Weighting {
+            tracker: weighting.tracker,
+            ..settings.weighting
+        }
+        .apply(data.calibration)?;
+        &reweighted
+    } else {
+        cal
+    };
     let mut tool_fit = fit_tools(nominal, cal, &registration.frame)?;
     // Only where the nominal geometry with the fitted tools fits the data as a calibration's
     // start can (the gate's nominal-error limit): on data in the wrong unit or of another robot
@@ -541,6 +560,7 @@ pub fn calibrate(
         downweighted,
         plausibility,
         settings: settings.clone(),
+        weighting,
     })
 }
 

@@ -229,6 +229,7 @@ impl Calibration {
             validate: None,
             nominal_limits: None,
             rows_outside_limits: None,
+            weighting: Some(self.weighting),
             other: Default::default(),
         };
         let most_correlated = self

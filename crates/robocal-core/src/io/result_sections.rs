@@ -152,6 +152,10 @@ pub struct Settings {
     /// Rows outside the joint limits that were used anyway.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rows_outside_limits: Option<Vec<RowsOutside>>,
+    /// The point weights the fit used: `source` (`column`, `given`, `automatic`, `none`), the
+    /// tracker model applied and the registered tracker's distance from the base (mm).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub weighting: Option<crate::observations::AppliedWeighting>,
     /// Further settings a caller recorded.
     #[serde(flatten)]
     pub other: serde_json::Map<String, serde_json::Value>,

@@ -6,7 +6,10 @@
 pub mod kinds;
 mod weighting;
 
-pub use weighting::{TrackerSigma, Weighting, DEFAULT_MM_PER_DEG};
+pub use weighting::{
+    AppliedWeighting, TrackerSigma, WeightSource, Weighting, DEFAULT_MM_PER_DEG,
+    TRACKER_FRAME_MIN_DISTANCE_MM, TYPICAL_TRACKER,
+};
 
 use crate::error::{Error, Result};
 use crate::model::Robot;

@@ -46,12 +46,32 @@ impl TrackerSigma {
     }
 }
 
+/// The tracker model a fit applies by default ([`Weighting::automatic`]): a typical laser
+/// tracker's 1-sigma per axis, 0.010 mm plus 0.005 mm per metre of distance (the simulation's
+/// default tracker; a Leica AT960's specification, 15 um + 6 um/m maximum permissible error, is
+/// about twice these sigmas: the weights, ratios of sigmas, depend only on their ratio).
+pub const TYPICAL_TRACKER: TrackerSigma = TrackerSigma {
+    fixed_mm: 0.010,
+    per_m_mm: 0.005,
+};
+
+/// The least distance (mm) between the origin of the measurement frame and the robot's base for
+/// the data to be taken as given in a tracker's own frame (the tracker at the origin). Nearer,
+/// the data are in the robot's base frame or in a frame close to it (a tracker cannot stand
+/// inside the robot's base), and a point's distance from the origin says nothing about its
+/// distance from the tracker.
+pub const TRACKER_FRAME_MIN_DISTANCE_MM: f64 = 500.0;
+
 /// How a fit weights observations (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Weighting {
     /// The tracker model for points without a `sigma_mm` cell; `None` leaves them unweighted
-    /// (when no point has a cell).
+    /// (when no point has a cell), unless `automatic` applies.
     pub tracker: Option<TrackerSigma>,
+    /// Without a tracker model and without `sigma_mm` cells: weight by [`TYPICAL_TRACKER`] when
+    /// the data are in a tracker's own frame (the registered tracker at least
+    /// [`TRACKER_FRAME_MIN_DISTANCE_MM`] from the robot's base). Default on.
+    pub automatic: bool,
     /// How many mm of position error one degree of orientation error counts as.
     pub mm_per_deg: f64,
 }
@@ -60,12 +80,59 @@ impl Default for Weighting {
     fn default() -> Self {
         Weighting {
             tracker: None,
+            automatic: true,
             mm_per_deg: DEFAULT_MM_PER_DEG,
         }
     }
 }
 
+/// Where a fit's point weights came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WeightSource {
+    /// The measurement file's `sigma_mm` column.
+    Column,
+    /// The tracker model given in the settings.
+    Given,
+    /// [`TYPICAL_TRACKER`], the data being in a tracker's frame ([`Weighting::automatic`]).
+    Automatic,
+    /// None: every point counts the same.
+    None,
+}
+
+/// The weighting a fit used.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct AppliedWeighting {
+    /// Where the point weights came from.
+    pub source: WeightSource,
+    /// The tracker model applied (given or automatic).
+    pub tracker: Option<TrackerSigma>,
+    /// The distance of the registered tracker (the measurement frame's origin) from the robot's
+    /// base (mm).
+    pub tracker_distance_mm: f64,
+}
+
 impl Weighting {
+    /// The weighting for data whose registered tracker (the measurement frame's origin) is
+    /// `tracker_distance_mm` from the robot's base: the tracker model to apply, and where it
+    /// comes from.
+    pub fn resolve(&self, obs: &Observations, tracker_distance_mm: f64) -> AppliedWeighting {
+        let (source, tracker) = if obs.has_sigma() {
+            (WeightSource::Column, None)
+        } else if let Some(t) = self.tracker {
+            (WeightSource::Given, Some(t))
+        } else if self.automatic && tracker_distance_mm >= TRACKER_FRAME_MIN_DISTANCE_MM {
+            (WeightSource::Automatic, Some(TYPICAL_TRACKER))
+        } else {
+            (WeightSource::None, None)
+        };
+        AppliedWeighting {
+            source,
+            tracker,
+            tracker_distance_mm,
+        }
+    }
+
     /// `obs` with these weights applied: the tracker model's sigmas where the observations have
     /// none, and the orientation weight.
     pub fn apply(&self, obs: &Observations) -> Result<Observations> {

@@ -168,7 +168,7 @@ def calibrate(
     affine: bool = False,
     rank_tol: Optional[float] = None,
     max_iterations: int = 1000,
-    tracker_sigma: Optional[Tuple[float, float]] = None,
+    tracker_sigma: Optional[Union[Tuple[float, float], str]] = None,
     orientation_weight: Optional[float] = None,
     validate_refit_frame: bool = False,
     nominal_limits: bool = False,
