@@ -151,6 +151,18 @@ impl TryFrom<&CompensateArgs> for Settings {
             limits::MAX_LENGTH_MM,
             "mm",
         )?;
+        if a.program.is_none() {
+            for (given, flag) in [
+                (a.keep_going, "--keep-going"),
+                (a.changes.is_some(), "--changes"),
+            ] {
+                if given {
+                    return Err(exit::usage(format!(
+                        "{flag} applies to a robot program: give --program FILE"
+                    )));
+                }
+            }
+        }
         let program = match &a.program {
             Some(p) => Some((
                 p.clone(),

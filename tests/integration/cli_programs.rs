@@ -110,12 +110,8 @@ fn program_round_trip(name: &str) {
                 // The controller's nominal inverse kinematics of the written pose, on the branch
                 // its configuration data (or the previous joints) give.
                 let branch = b.branch(previous.as_deref());
-                let found = branch_joints(
-                    &nom,
-                    &PoseNewton::default(),
-                    &format.pose_of(&new),
-                    &branch,
-                );
+                let found =
+                    branch_joints(&nom, &PoseNewton::default(), &format.pose_of(&new), &branch);
                 let BranchJoints::Found(q) = found else {
                     panic!("{name}: {} line {}: {found:?}", b.name, b.line)
                 };
@@ -131,13 +127,18 @@ fn program_round_trip(name: &str) {
         );
         // Listed with its line.
         assert!(
-            o.stdout().contains(&format!("{:<16} {:>6}", a.name, a.line)),
+            o.stdout()
+                .contains(&format!("{:<16} {:>6}", a.name, a.line)),
             "{}",
             o.stdout()
         );
         previous = Some(reached);
     }
-    assert!(o.stdout().contains("6 compensated, 0 left unchanged"), "{}", o.stdout());
+    assert!(
+        o.stdout().contains("6 compensated, 0 left unchanged"),
+        "{}",
+        o.stdout()
+    );
     let csv = std::fs::read_to_string(&changes).unwrap();
     assert_eq!(csv.lines().count(), 7, "{csv}");
 }
@@ -161,7 +162,10 @@ fn a_urscript_program_is_compensated_and_checked_by_fk() {
 fn with_unreachable(dir: &Dir) -> PathBuf {
     let mut text = std::fs::read_to_string(shipped("kr480.src")).unwrap();
     let end = text.rfind("END").unwrap();
-    text.insert_str(end, "LIN {X 9000, Y 0, Z 1000, A 0, B 90, C 0} ; too far\r\n");
+    text.insert_str(
+        end,
+        "LIN {X 9000, Y 0, Z 1000, A 0, B 90, C 0} ; too far\r\n",
+    );
     dir.write("far.src", text)
 }
 
@@ -196,7 +200,8 @@ fn a_target_that_cannot_be_compensated_stops_the_run_unless_keep_going() {
     let o = robocal(&args(&[]));
     o.assert_code(5);
     assert!(
-        o.stderr().contains(&format!("LIN (line {line}): unreachable")),
+        o.stderr()
+            .contains(&format!("LIN (line {line}): unreachable")),
         "{}",
         o.stderr()
     );
@@ -227,7 +232,10 @@ fn a_target_that_cannot_be_compensated_stops_the_run_unless_keep_going() {
     );
     assert_eq!(rows.len(), 8);
     let far = &rows[7];
-    assert_eq!(far[..5], ["LIN", &line.to_string(), "pose", "unreachable", "false"]);
+    assert_eq!(
+        far[..5],
+        ["LIN", &line.to_string(), "pose", "unreachable", "false"]
+    );
     assert_eq!(far[5], "");
     assert_eq!(far[9], "9000 0 1000 0 90 0");
     assert_eq!(far[9], far[10]);
@@ -302,7 +310,10 @@ fn bad_program_arguments_are_refused() {
     ]);
     o.assert_code(2);
     // A malformed target: exit 3 naming the file and line.
-    let bad = dir.write("bad.src", "DEF m()\r\nPTP {A1 0, A2 -90, A3 x, A4 0, A5 30, A6 0}\r\nEND\r\n");
+    let bad = dir.write(
+        "bad.src",
+        "DEF m()\r\nPTP {A1 0, A2 -90, A3 x, A4 0, A5 30, A6 0}\r\nEND\r\n",
+    );
     let o = robocal(&[
         "compensate",
         "--params",

@@ -302,7 +302,10 @@ mod tests {
     fn a_malformed_target_is_an_error_naming_its_line_and_field() {
         let src = "DEF m()\n\nPTP {A1 1, A2 -90, A3 9O, A4 0, A5 30, A6 0}\nEND\n";
         let e = targets(Path::new("m.src"), src).unwrap_err().to_string();
-        assert!(e.contains("m.src:3") && e.contains("A3") && e.contains("9O"), "{e}");
+        assert!(
+            e.contains("m.src:3") && e.contains("A3") && e.contains("9O"),
+            "{e}"
+        );
         let src = "DEF m()\nLIN {X 1, Y 2, Z 3, A 0, B 90, C 0, S 'B2', T 0}\nEND\n";
         let e = targets(Path::new("m.src"), src).unwrap_err().to_string();
         assert!(e.contains("m.src:2") && e.contains("`S`"), "{e}");

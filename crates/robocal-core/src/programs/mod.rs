@@ -298,9 +298,12 @@ pub fn compensate_program(
             previous = desired;
         }
         if c.applied {
+            // A number the compensation leaves as it was (after rounding) keeps its text.
             for (k, (f, v)) in t.fields.iter().zip(&c.new).enumerate() {
-                let d = format.decimals(t.kind, k, settings.decimals);
-                splices.push((f.span.clone(), krl::format_number(*v, d)));
+                if *v != f.value {
+                    let d = format.decimals(t.kind, k, settings.decimals);
+                    splices.push((f.span.clone(), krl::format_number(*v, d)));
+                }
             }
             if let (Some(span), Some(old), Some(new)) = (&t.turn_span, t.turn, c.new_turn) {
                 if old != new {
@@ -468,8 +471,15 @@ fn commanded_branch_ok(
             // The turn follows the commanded joints where an axis of the desired joints lies
             // within TURN_ADJUST_DEG of 0 (compensation may move it across); elsewhere a
             // different sign is another branch.
+            // A bit changes only where the commanded axis has the other sign beyond
+            // seed::ZERO_DEG (a target written at 0 comes back as +-1e-4).
             let axes = js.axes_from_joints(desired);
-            let new_turn = turn_of(nominal, q);
+            let mut new_turn = tt;
+            for (i, a) in js.axes_from_joints(q).iter().enumerate() {
+                if a.abs() >= seed::ZERO_DEG {
+                    new_turn = (new_turn & !(1 << i)) | (u32::from(*a < 0.0) << i);
+                }
+            }
             let fixed = axes
                 .iter()
                 .enumerate()

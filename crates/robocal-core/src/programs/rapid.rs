@@ -10,8 +10,8 @@
 //!   alone. The quaternion is written normalized, with the sign of the input's `q1`.
 //!
 //! What is read: declarations `CONST|PERS|VAR [LOCAL|TASK] robtarget|jointtarget name := [...];`
-//! (also arrays `name{n} := [[...], ...]`: targets `name{1}`, ...) written on one line, and in
-//! any other statement
+//! (also arrays `name{n} := [[...], ...]`: targets `name{1}`, ...; the declaration's words on
+//! the line where its `[` opens), and in any other statement
 //! (`MoveJ [[...], ...], v100, z10, tool0;`, `p := [...];`) every bracket aggregate with the
 //! shape of a robtarget or a jointtarget. Aggregates of other types (`tooldata`, `wobjdata`,
 //! `pose`, ...) are left alone; in a motion instruction (`Move...`) an aggregate of neither
@@ -211,7 +211,14 @@ fn statement_targets(
         if let Node::List(items) = node {
             if !items.is_empty() && items.iter().all(|n| kind_of(n) == Some(kind)) {
                 for (k, n) in items.iter().enumerate() {
-                    out.push(target(path, text, n, kind, format!("{name}{{{}}}", k + 1), line)?);
+                    out.push(target(
+                        path,
+                        text,
+                        n,
+                        kind,
+                        format!("{name}{{{}}}", k + 1),
+                        line,
+                    )?);
                 }
                 return Ok(());
             }
@@ -315,10 +322,7 @@ fn target(
                     path,
                     Some(line),
                     Some("q1"),
-                    format!(
-                        "{name}: the quaternion's norm is {:.6}, not 1",
-                        qn.sqrt()
-                    ),
+                    format!("{name}: the quaternion's norm is {:.6}, not 1", qn.sqrt()),
                 ));
             }
             let mut c = [0i64; 4];
@@ -402,11 +406,19 @@ mod tests {
         assert_eq!(names, ["p10", "jhome", "path{1}", "path{2}", "MoveL"]);
         assert_eq!(t[0].kind, TargetKind::Pose);
         assert_eq!(t[0].line, 3);
-        let got: Vec<&str> = t[0].fields.iter().map(|f| &MODULE[f.span.clone()]).collect();
+        let got: Vec<&str> = t[0]
+            .fields
+            .iter()
+            .map(|f| &MODULE[f.span.clone()])
+            .collect();
         assert_eq!(got, ["1500", "-20.5", "1800", "0.5", "0.5", "0.5", "0.5"]);
         assert_eq!(t[0].conf, Some([0, -1, 0, 1]));
         assert_eq!(t[1].kind, TargetKind::Joints);
-        let got: Vec<&str> = t[1].fields.iter().map(|f| &MODULE[f.span.clone()]).collect();
+        let got: Vec<&str> = t[1]
+            .fields
+            .iter()
+            .map(|f| &MODULE[f.span.clone()])
+            .collect();
         assert_eq!(got, ["0", "0", "0", "0", "30", "0"]);
         assert_eq!(t[3].conf, Some([1, 0, 1, 0]));
         assert_eq!(t[4].line, 9);

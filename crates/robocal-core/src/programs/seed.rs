@@ -235,7 +235,12 @@ fn wrist_flip(robot: &Robot, q: &[f64]) -> Vec<f64> {
 /// The `k`-th start configuration: the spread seeds of [`crate::compensation::default_seeds`]
 /// turned towards the target, each also turned half a turn about axis 1 (the wrist point behind
 /// axis 1: KUKA's overhead area).
-pub(crate) fn spread_start(robot: &Robot, seeds: &[Vec<f64>], target: &Frame, k: usize) -> Option<Vec<f64>> {
+pub(crate) fn spread_start(
+    robot: &Robot,
+    seeds: &[Vec<f64>],
+    target: &Frame,
+    k: usize,
+) -> Option<Vec<f64>> {
     let mut s = seeds.get(k / 2)?.clone();
     crate::compensation::turn_towards(robot, &target.translation.vector, &mut s);
     if k % 2 == 1 {

@@ -120,8 +120,7 @@ pub fn targets(path: &Path, text: &str) -> Result<Vec<ProgramTarget>> {
                         (i, word)
                     };
                     let j = skip_ws(b, name_end);
-                    if !name.is_empty() && b.get(j) == Some(&b'=') && b.get(j + 1) != Some(&b'=')
-                    {
+                    if !name.is_empty() && b.get(j) == Some(&b'=') && b.get(j + 1) != Some(&b'=') {
                         let k = skip_ws(b, j + 1);
                         if let Some((end, l)) = value_list(b, k, &line_of) {
                             assigned.push((name.to_owned(), k, l));
@@ -136,10 +135,8 @@ pub fn targets(path: &Path, text: &str) -> Result<Vec<ProgramTarget>> {
             }
         }
     }
-    let mut found: Vec<(usize, String, std::result::Result<List, usize>)> = direct
-        .into_iter()
-        .map(|(n, at, l)| (at, n, l))
-        .collect();
+    let mut found: Vec<(usize, String, std::result::Result<List, usize>)> =
+        direct.into_iter().map(|(n, at, l)| (at, n, l)).collect();
     for (name, at, l) in assigned {
         if used.contains(&name) {
             found.push((at, name, l));
@@ -327,9 +324,17 @@ mod tests {
         assert_eq!(lines, [3, 5, 9, 10]);
         assert_eq!(t[0].kind, TargetKind::Joints);
         assert_eq!(t[1].kind, TargetKind::Pose);
-        let got: Vec<&str> = t[1].fields.iter().map(|f| &SCRIPT[f.span.clone()]).collect();
+        let got: Vec<&str> = t[1]
+            .fields
+            .iter()
+            .map(|f| &SCRIPT[f.span.clone()])
+            .collect();
         assert_eq!(got, ["0.4", "-0.1", "0.3", "0", "3.1416", "0"]);
-        let got: Vec<&str> = t[2].fields.iter().map(|f| &SCRIPT[f.span.clone()]).collect();
+        let got: Vec<&str> = t[2]
+            .fields
+            .iter()
+            .map(|f| &SCRIPT[f.span.clone()])
+            .collect();
         assert_eq!(got, ["0.1", "-1.2", "1.4", "-1.7", "-1.5", "0.2"]);
         assert_eq!(t[3].kind, TargetKind::Pose);
     }
@@ -338,12 +343,17 @@ mod tests {
     fn malformed_targets_are_errors_naming_the_line() {
         let cases = [
             ("def a():\n  movej([1, 2, 3, 4, 5])\nend\n", "a.script:2"),
-            ("def a():\n\n  movel(p[0.1, 0.2, z, 0, 0, 0])\nend\n", "a.script:3"),
+            (
+                "def a():\n\n  movel(p[0.1, 0.2, z, 0, 0, 0])\nend\n",
+                "a.script:3",
+            ),
             ("def a():\n  x = [1, 2, 3]\n  movej(x)\nend\n", "a.script:2"),
             ("def a():\n  movej([1, 2, 3, 4, 5, 6\nend\n", "a.script:2"),
         ];
         for (text, want) in cases {
-            let e = targets(Path::new("a.script"), text).unwrap_err().to_string();
+            let e = targets(Path::new("a.script"), text)
+                .unwrap_err()
+                .to_string();
             assert!(e.contains(want), "{want}: {e}");
         }
     }
@@ -360,6 +370,9 @@ mod tests {
         assert!((v[4] - 3.2).abs() < 1e-12, "{v:?}");
         let old = [0.1, 0.0, 0.0, 0.0, 3.0, 0.0];
         let v = pose_values(&pose_of(&old), &old);
-        assert!((v[4] - 3.0).abs() < 1e-12 && (v[0] - 0.1).abs() < 1e-15, "{v:?}");
+        assert!(
+            (v[4] - 3.0).abs() < 1e-12 && (v[0] - 0.1).abs() < 1e-15,
+            "{v:?}"
+        );
     }
 }
