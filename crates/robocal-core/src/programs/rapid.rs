@@ -260,7 +260,7 @@ fn original_case(text: &str, line: usize, word: &str) -> String {
     }
 }
 
-fn scalars<'a>(n: &'a Node, k: usize) -> &'a [Node] {
+fn scalars(n: &Node, k: usize) -> &[Node] {
     match n {
         Node::List(v) => match &v[k] {
             Node::List(s) => s,

@@ -154,7 +154,7 @@ pub(crate) fn matches_turn(robot: &Robot, q: &[f64], t: u32, zero_deg: f64) -> b
 pub fn matches(robot: &Robot, q: &[f64], branch: &Branch) -> bool {
     match branch {
         Branch::Krl { status, turn } => {
-            let t_ok = turn.is_none_or(|t| matches_turn(robot, q, t, ZERO_DEG));
+            let t_ok = turn.map_or(true, |t| matches_turn(robot, q, t, ZERO_DEG));
             let a5_zero = robot.joint_space().axes_from_joints(q)[4].abs() < ZERO_DEG;
             let s_ok = match (status, krl_status(robot, q)) {
                 (Some(want), Some(have)) => {
@@ -208,7 +208,7 @@ fn fit(robot: &Robot, q: &[f64], branch: &Branch) -> Option<Vec<f64>> {
                 Branch::Nearest(r) => (v[i] - r[i]).abs(),
                 _ => f64::from(k).abs(),
             };
-            if best.is_none_or(|(c, _)| cost < c) {
+            if best.map_or(true, |(c, _)| cost < c) {
                 best = Some((cost, v[i]));
             }
         }

@@ -120,7 +120,7 @@ pub(crate) fn rapid_program(nominal: &Robot) -> String {
 
 /// Joint values (rad) of the UR5 fixture's joint targets.
 const UR_JOINTS: [[f64; 6]; 3] = [
-    [0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0],
+    [0.0, -1.6, 1.55, -1.5, -1.55, 0.0],
     [0.5, -1.2, 1.4, -1.7, -1.4, 0.3],
     [-0.8, -1.9, 2.0, -1.2, -1.7, -0.4],
 ];
