@@ -1,7 +1,9 @@
 //! `robocal compensate`: commanded joint values from the calibrated model (paper, section V.A,
 //! eq. 12-14), for desired joint vectors or for Cartesian targets: the whole tool pose by default
 //! (position and orientation, on the desired configuration), the tool position with
-//! `--position-only`.
+//! `--position-only`; or for the targets of a robot program (`--program`, see [`program`]).
+
+mod program;
 
 use super::evaluate::calibrated_model;
 use super::io_plan::IoPlan;
@@ -35,7 +37,11 @@ pub struct CompensateArgs {
     /// joint) or axis1..axisN (controller values, through the robot's [controller]). Each row's
     /// target is its nominal tool position (eq. 13); the solve starts from the row's joints.
     /// Other columns are carried; x,y,z (old measurements), if present, are not.
-    #[arg(long, value_name = "DESIRED.csv", required_unless_present = "targets")]
+    #[arg(
+        long,
+        value_name = "DESIRED.csv",
+        required_unless_present_any = ["targets", "program"]
+    )]
     joints: Option<PathBuf>,
     /// Cartesian targets instead: CSV with x,y,z (mm, robot base frame), optionally a,b,c (deg,
     /// the tool orientation as A, B, C; without them the targets are position-only) and
@@ -43,7 +49,22 @@ pub struct CompensateArgs {
     /// configurations are tried.
     #[arg(long, value_name = "XYZ.csv", conflicts_with = "joints")]
     targets: Option<PathBuf>,
-    /// Output: commanded joints q1..qn (degrees, mm for a prismatic joint) and, when the robot
+    /// A robot program instead: KUKA KRL (.src, .dat), ABB RAPID (.mod, .modx, .prg) or
+    /// URScript (.script, .urscript), by its extension. Every joint and Cartesian target is
+    /// replaced by its compensated value in the controller's units and axis conventions; the
+    /// rest of the file is kept byte for byte. `--out` is then the compensated program.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["joints", "targets", "strict"])]
+    program: Option<PathBuf>,
+    /// With `--program`: also write the list of targets as CSV (name, line, kind, status,
+    /// applied, correction_mm, correction_deg, verified_mm, verified_deg, old, new).
+    #[arg(long, value_name = "CHANGES.csv", requires = "program")]
+    changes: Option<PathBuf>,
+    /// With `--program`: a target that cannot be compensated is left unchanged and listed with
+    /// its status, and the rest is written (exit 0). Without it such a target stops the run
+    /// (exit 5, nothing written).
+    #[arg(long, requires = "program")]
+    keep_going: bool,
+    /// Output: with `--program`, the compensated program. Otherwise: commanded joints q1..qn (degrees, mm for a prismatic joint) and, when the robot
     /// has a controller map, the controller's axis1..axisN, with status, residual and the
     /// desired values. `-`: standard output (written when complete; the summary then goes to
     /// standard error).
@@ -90,6 +111,9 @@ struct Settings {
     outputs: super::io_plan::Outputs,
     strict: bool,
     params: PathBuf,
+    program: Option<(PathBuf, robocal_core::programs::Format)>,
+    changes: Option<PathBuf>,
+    keep_going: bool,
 }
 
 impl TryFrom<&CompensateArgs> for Settings {
@@ -127,14 +151,38 @@ impl TryFrom<&CompensateArgs> for Settings {
             limits::MAX_LENGTH_MM,
             "mm",
         )?;
-        let outputs = IoPlan::new()
-            .robot_opt("--robot", a.robot.as_deref())
+        if a.program.is_none() {
+            for (given, flag) in [
+                (a.keep_going, "--keep-going"),
+                (a.changes.is_some(), "--changes"),
+            ] {
+                if given {
+                    return Err(exit::usage(format!(
+                        "{flag} applies to a robot program: give --program FILE"
+                    )));
+                }
+            }
+        }
+        let program = match &a.program {
+            Some(p) => Some((
+                p.clone(),
+                robocal_core::programs::Format::from_path(p)
+                    .map_err(|e| exit::usage(super::flags::cli_text(&e)))?,
+            )),
+            None => None,
+        };
+        let mut plan = IoPlan::new();
+        plan.robot_opt("--robot", a.robot.as_deref())
             .input("--params", &a.params)
             .recorded_in("--params", &a.params)
             .input_opt("--joints", a.joints.as_deref())
             .input_opt("--targets", a.targets.as_deref())
-            .output_or_stdout("--out", &a.out)
-            .check()?;
+            .input_opt("--program", a.program.as_deref())
+            .output_or_stdout("--out", &a.out);
+        if let Some(c) = &a.changes {
+            plan.output_or_stdout("--changes", c);
+        }
+        let outputs = plan.check()?;
         let (nominal, mut calibrated, res) = calibrated_model(a.robot.as_deref(), &a.params)?;
         super::common::apply_payload(&mut calibrated, a.payload_kg)?;
         if let Some(why) = res.partial_reason() {
@@ -173,6 +221,9 @@ impl TryFrom<&CompensateArgs> for Settings {
             outputs,
             strict: a.strict,
             params: a.params.clone(),
+            program,
+            changes: a.changes.clone(),
+            keep_going: a.keep_going,
         })
     }
 }
@@ -190,6 +241,9 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         mut outputs,
         strict,
         params,
+        program: program_file,
+        changes,
+        keep_going,
     } = Settings::try_from(&a)?;
     let dof = nominal.dof();
     let joints = nominal.joint_space();
@@ -197,6 +251,18 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
     let tolerance_deg = pose_solver.tolerance_deg;
     let mut comp = Compensator::new(&nominal, &cal, solver)?;
     comp.pose_solver = pose_solver;
+    if let Some((path, format)) = &program_file {
+        let run = program::ProgramRun {
+            program: path,
+            format: *format,
+            out: &out,
+            changes: changes.as_deref(),
+            keep_going,
+            full_pose: !position_only,
+            params: &params,
+        };
+        return program::run(&run, &comp, &mut outputs);
+    }
     let mut full_pose = !position_only;
     let pb = crate::progress::spinner("compensating");
     let mut tally = Tally::default();

@@ -51,6 +51,8 @@ const FLAGS: &[(&str, &str)] = &[
     ("max_iterations", "--max-iterations"),
     // compensation::PoseNewton
     ("tolerance_deg", "--tolerance-deg"),
+    // programs (compensate --program)
+    ("program", "--program"),
 ];
 
 /// The flag that sets a library setting, if there is one.

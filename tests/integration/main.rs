@@ -30,6 +30,7 @@ mod cli_demo;
 mod cli_evaluate;
 mod cli_joints;
 mod cli_plan;
+mod cli_programs;
 mod cli_report;
 mod cli_result_self_contained;
 mod cli_robot;

@@ -11,13 +11,18 @@
 //! parser: KRL has no maintained Rust parser, and this is all robocal needs of it.
 
 use super::{Field, ProgramTarget, TargetKind};
+use crate::error::{Error, Result};
+use crate::frame::{frame_vector, pose, Frame};
 use std::ops::Range;
+use std::path::Path;
 
 const JOINT_FIELDS: [&str; 6] = ["A1", "A2", "A3", "A4", "A5", "A6"];
 const POSE_FIELDS: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
 
-/// Finds the targets of a KRL file's text, in file order.
-pub fn targets(text: &str) -> Vec<ProgramTarget> {
+/// Finds the targets of a KRL file's text, in file order. An aggregate that names every field of
+/// a target but holds something else than a number in one of them (or in `S` or `T`) is an error
+/// naming its line and field.
+pub fn targets(path: &Path, text: &str) -> Result<Vec<ProgramTarget>> {
     let b = text.as_bytes();
     let mut out = Vec::new();
     let mut i = 0;
@@ -49,7 +54,7 @@ pub fn targets(text: &str) -> Vec<ProgramTarget> {
                     continue;
                 }
                 let body = i + 1..i + end;
-                if let Some(t) = aggregate(text, i, body) {
+                if let Some(t) = aggregate(path, text, i, body)? {
                     out.push(t);
                 }
                 i += end + 1;
@@ -57,7 +62,7 @@ pub fn targets(text: &str) -> Vec<ProgramTarget> {
             _ => i += 1,
         }
     }
-    out
+    Ok(out)
 }
 
 /// The statement text before the aggregate at `open`, on its line.
@@ -66,12 +71,26 @@ fn statement_before(text: &str, open: usize) -> &str {
     &text[start..open]
 }
 
-fn aggregate(text: &str, open: usize, body: Range<usize>) -> Option<ProgramTarget> {
+fn aggregate(
+    path: &Path,
+    text: &str,
+    open: usize,
+    body: Range<usize>,
+) -> Result<Option<ProgramTarget>> {
     let before = statement_before(text, open).trim();
     let upper = before.to_ascii_uppercase();
     if upper.starts_with('$') || upper.contains("_REL") {
-        return None;
+        return Ok(None);
     }
+    let line = text[..open].matches('\n').count() + 1;
+    let bad = |field: &str, value: &str| {
+        Error::parse(
+            path,
+            Some(line),
+            Some(field),
+            format!("`{value}` is not a number"),
+        )
+    };
     let mut inner = &text[body.clone()];
     let mut offset = body.start;
     // An optional type prefix `E6POS:`.
@@ -96,56 +115,90 @@ fn aggregate(text: &str, open: usize, body: Range<usize>) -> Option<ProgramTarge
         let rest = &trimmed[name_len..];
         let value = rest.trim();
         if name.is_empty() || value.is_empty() {
-            return None;
+            return Ok(None);
         }
         let vstart = part_start + lead + name_len + (rest.len() - rest.trim_start().len());
         let span = vstart..vstart + value.len();
         let v = value.parse::<f64>().ok();
         fields.push((name.to_ascii_uppercase(), v, span, value.to_owned()));
     }
-    let has = |names: &[&str]| {
-        names
-            .iter()
-            .all(|n| fields.iter().any(|f| f.0 == *n && f.1.is_some()))
-    };
+    let has = |names: &[&str]| names.iter().all(|n| fields.iter().any(|f| f.0 == *n));
     let kind = if has(&JOINT_FIELDS) {
         TargetKind::Joints
     } else if has(&POSE_FIELDS) {
         TargetKind::Pose
     } else {
-        return None;
+        return Ok(None);
     };
     let wanted: &[&str] = match kind {
         TargetKind::Joints => &JOINT_FIELDS,
         TargetKind::Pose => &POSE_FIELDS,
     };
-    let picked: Vec<Field> = wanted
-        .iter()
-        .map(|n| {
-            let f = fields.iter().find(|f| f.0 == *n).expect("checked above");
-            Field {
-                name: (*n).to_owned(),
-                value: f.1.expect("checked above"),
-                span: f.2.clone(),
-            }
-        })
-        .collect();
-    let t_field = fields.iter().find(|f| f.0 == "T");
-    let turn = t_field.and_then(|f| parse_krl_int(&f.3));
-    let turn_span = t_field.filter(|_| turn.is_some()).map(|f| f.2.clone());
-    let status = fields
-        .iter()
-        .find(|f| f.0 == "S")
-        .and_then(|f| parse_krl_int(&f.3));
-    Some(ProgramTarget {
+    let mut picked = Vec::with_capacity(6);
+    for n in wanted {
+        let Some(f) = fields.iter().find(|f| f.0 == *n) else {
+            return Ok(None);
+        };
+        let value = f.1.filter(|v| v.is_finite()).ok_or_else(|| bad(n, &f.3))?;
+        picked.push(Field {
+            name: (*n).to_owned(),
+            value,
+            span: f.2.clone(),
+        });
+    }
+    let int = |name: &str| -> Result<Option<(u32, Range<usize>)>> {
+        match fields.iter().find(|f| f.0 == name) {
+            None => Ok(None),
+            Some(f) => parse_krl_int(&f.3)
+                .map(|v| Some((v, f.2.clone())))
+                .ok_or_else(|| bad(name, &f.3)),
+        }
+    };
+    let t = if kind == TargetKind::Pose {
+        int("T")?
+    } else {
+        None
+    };
+    let status = if kind == TargetKind::Pose {
+        int("S")?.map(|s| s.0)
+    } else {
+        None
+    };
+    Ok(Some(ProgramTarget {
         name: target_name(before),
-        line: text[..open].matches('\n').count() + 1,
+        line,
         kind,
         fields: picked,
-        turn,
-        turn_span,
+        turn: t.as_ref().map(|t| t.0),
+        turn_span: t.map(|t| t.1),
         status,
-    })
+        conf: None,
+    }))
+}
+
+/// The tool frame of a KRL pose `X, Y, Z` (mm), `A, B, C` (deg).
+pub fn pose_of(values: &[f64]) -> Frame {
+    pose(&[
+        values[0],
+        values[1],
+        values[2],
+        values[3].to_radians(),
+        values[4].to_radians(),
+        values[5].to_radians(),
+    ])
+}
+
+/// The KRL pose values of a tool frame.
+pub fn pose_values(f: &Frame) -> Vec<f64> {
+    let v = frame_vector(f);
+    vec![
+        v[0],
+        v[1],
+        v[2],
+        v[3].to_degrees(),
+        v[4].to_degrees(),
+        v[5].to_degrees(),
+    ]
 }
 
 /// A KRL integer: decimal or a binary literal `'B010'`.
@@ -216,7 +269,7 @@ mod tests {
 
     #[test]
     fn finds_complete_targets_and_their_spans() {
-        let t = targets(DAT);
+        let t = targets(Path::new("demo.dat"), DAT).unwrap();
         assert_eq!(t.len(), 2, "{t:?}");
         assert_eq!(t[0].name, "XHOME");
         assert_eq!(t[0].kind, TargetKind::Joints);
@@ -236,13 +289,40 @@ mod tests {
             "DEF m()\n$BASE={X 0,Y 0,Z 0,A 0,B 0,C 0}\nPTP_REL {A1 10,A2 0,A3 0,A4 0,A5 0,A6 0}\n\
                    PTP {A1 10}\nPTP {E6AXIS: A1 1,A2 -90,A3 90,A4 0,A5 30,A6 0} ; go\n\
                    LIN {X 2000,Y 0,Z 1000,A 0,B 90,C 0} C_DIS\nEND\n";
-        let t = targets(src);
+        let t = targets(Path::new("m.src"), src).unwrap();
         assert_eq!(t.len(), 2, "{t:?}");
         assert_eq!(t[0].name, "PTP");
         assert_eq!(t[0].line, 5);
         assert_eq!(&src[t[0].fields[0].span.clone()], "1");
         assert_eq!(t[1].name, "LIN");
         assert_eq!(t[1].status, None);
+    }
+
+    #[test]
+    fn a_malformed_target_is_an_error_naming_its_line_and_field() {
+        let src = "DEF m()\n\nPTP {A1 1, A2 -90, A3 9O, A4 0, A5 30, A6 0}\nEND\n";
+        let e = targets(Path::new("m.src"), src).unwrap_err().to_string();
+        assert!(
+            e.contains("m.src:3") && e.contains("A3") && e.contains("9O"),
+            "{e}"
+        );
+        let src = "DEF m()\nLIN {X 1, Y 2, Z 3, A 0, B 90, C 0, S 'B2', T 0}\nEND\n";
+        let e = targets(Path::new("m.src"), src).unwrap_err().to_string();
+        assert!(e.contains("m.src:2") && e.contains("`S`"), "{e}");
+    }
+
+    #[test]
+    fn odd_spacing_tabs_and_case_are_read_with_exact_spans() {
+        let src = "ptp {e6axis:a1\t1.5 ,  A2  -90,a3 90.25,A4 0,A5 30,A6 -0.0}\r\n";
+        let t = targets(Path::new("m.src"), src).unwrap();
+        assert_eq!(t.len(), 1);
+        let got: Vec<&str> = t[0].fields.iter().map(|f| &src[f.span.clone()]).collect();
+        assert_eq!(got, ["1.5", "-90", "90.25", "0", "30", "-0.0"]);
+    }
+
+    #[test]
+    fn random_byte_edits_never_panic() {
+        crate::programs::tests::edits_never_panic(super::super::Format::Krl, DAT);
     }
 
     #[test]

@@ -4,41 +4,55 @@
 //! A format's reader finds the targets and the byte spans of their numeric fields
 //! ([`ProgramTarget`]); [`compensate_program`] compensates each (full pose by default, see
 //! [`crate::compensation`]) and splices the new numbers into exactly those spans, so the text
-//! outside them is unchanged. Formats: KUKA KRL ([`krl`]).
+//! outside them is unchanged. Formats ([`Format`]): KUKA KRL ([`krl`]), ABB RAPID ([`rapid`]),
+//! URScript ([`urscript`]). The readers are hand-written: no maintained Rust parser exists for
+//! these languages, and robocal needs only their targets.
 //!
-//! - **Joint targets** (KRL AXIS/E6AXIS): the controller's axis values (deg) go through the
-//!   robot's controller map ([`crate::model::JointSpace::joints_from_axes`]; the KUKA presets:
-//!   q = (-A1, A2, A3, -A4, A5, -A6)) to the desired model joints; the commanded joints go back
-//!   to axis values.
-//! - **Cartesian targets** (KRL POS/E6POS/FRAME): the pose is taken as the tool frame (target 1,
-//!   [`crate::Robot::tool_pose`]) in the robot's base frame; a `$BASE` or `$TOOL` set elsewhere
-//!   in the program is not followed. The desired joints are the nominal model's inverse
-//!   kinematics on the branch the target's turn `T` gives (bit i set: axis i+1 negative; `S` is
-//!   kept as written); the compensated pose written is the nominal model's pose at the commanded
-//!   joints, so that the controller, which believes the nominal model, drives the robot to the
-//!   commanded joints. `S` is kept; `T` is kept where the commanded axes keep their signs, and
-//!   follows an axis that compensation moves across 0 from within 1 degree of it (a target at
-//!   A4 = 0 may need A4 = -0.002); any other sign change is another branch
-//!   ([`IkStatus::ConfigurationChange`]).
+//! - **Joint targets** (KRL AXIS/E6AXIS, RAPID jointtarget, URScript joint lists): the
+//!   controller's axis values (deg; URScript rad) go through the robot's controller map
+//!   ([`crate::model::JointSpace::joints_from_axes`]; the KUKA presets: q = (-A1, A2, A3, -A4,
+//!   A5, -A6); robots without a map: the identity) to the desired model joints; the commanded
+//!   joints go back to axis values.
+//! - **Cartesian targets** (KRL POS/E6POS/FRAME, RAPID robtarget, URScript `p[...]`): the pose is
+//!   taken as the tool frame (target 1, [`crate::Robot::tool_pose`]) in the robot's base frame,
+//!   i.e. the program's base/work object and tool are those of the robot description: a `$BASE`
+//!   or `$TOOL` set in a KRL program, a RAPID wobj other than `wobj0` or a tool other than the
+//!   robot file's, a URScript `set_tcp` are not followed. The desired joints are the nominal
+//!   model's inverse kinematics on the branch the target's configuration data give
+//!   ([`seed::Branch`]: KRL `S` and `T`, RAPID confdata; a URScript pose, which has none, takes
+//!   the solution nearest the previous target's joints, as the controller takes the one nearest
+//!   its current joints). The compensated pose written is the nominal model's pose at the
+//!   commanded joints, so that the controller, which believes the nominal model, drives the
+//!   robot to the commanded joints. The configuration data are kept, and must still hold at the
+//!   commanded joints ([`IkStatus::ConfigurationChange`] otherwise), with one exception: a KRL
+//!   `T` follows an axis that compensation moves across 0 from within 1 degree of it (a target
+//!   at A4 = 0 may need A4 = -0.002).
 //!
-//! Numbers are written with [`ProgramSettings::decimals`] decimals, and every written target is
-//! verified after rounding: read back as the controller would (joints, or the nominal inverse
-//! kinematics of the written pose from the commanded joints), the calibrated model's tool must be
-//! within [`ProgramSettings::verify_mm`] and [`ProgramSettings::verify_deg`] of the desired pose.
+//! Numbers are written with [`ProgramSettings::decimals`] decimals in mm and deg (3 more in m and
+//! rad, 4 more for a quaternion), and every written target is verified after rounding: read back
+//! as the controller would (joints, or the nominal inverse kinematics of the written pose from
+//! the commanded joints, on the target's branch), the calibrated model's tool must be within
+//! [`ProgramSettings::verify_mm`] and [`ProgramSettings::verify_deg`] of the desired pose.
 
 pub mod krl;
+pub mod rapid;
+pub mod seed;
+pub mod urscript;
 
-use crate::compensation::{Compensator, DampedLeastSquares, IkStatus, PoseNewton};
+use crate::compensation::{Compensator, DampedLeastSquares, IkStatus};
 use crate::error::{Error, Result};
-use crate::frame::{frame_vector, pose, Frame};
+use crate::frame::Frame;
 use crate::model::Robot;
+use seed::{branch_joints, matches, Branch, BranchJoints};
 use std::ops::Range;
 use std::path::Path;
+
+pub use seed::turn_of;
 
 /// One numeric field of a target: its name in the program, its value, its byte span.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Field {
-    /// The field's name (`A1`, `X`, ...).
+    /// The field's name (`A1`, `X`, `q1`, ...).
     pub name: String,
     /// Its value as written (controller units).
     pub value: f64,
@@ -51,7 +65,7 @@ pub struct Field {
 pub enum TargetKind {
     /// Controller axis values.
     Joints,
-    /// A Cartesian pose `x, y, z, a, b, c` (mm, deg).
+    /// A Cartesian pose (the format's units and orientation representation).
     Pose,
 }
 
@@ -64,7 +78,7 @@ pub struct ProgramTarget {
     pub line: usize,
     /// Joints or pose.
     pub kind: TargetKind,
-    /// The numeric fields compensation replaces, in order (`A1..A6` or `X, Y, Z, A, B, C`).
+    /// The numeric fields compensation replaces, in order (`A1..A6`, `X, Y, Z, A, B, C`, ...).
     pub fields: Vec<Field>,
     /// KRL's turn `T`, when given.
     pub turn: Option<u32>,
@@ -72,6 +86,27 @@ pub struct ProgramTarget {
     pub turn_span: Option<Range<usize>>,
     /// KRL's status `S`, when given.
     pub status: Option<u32>,
+    /// RAPID's confdata `[cf1, cf4, cf6, cfx]`, for a robtarget.
+    pub conf: Option<[i64; 4]>,
+}
+
+impl ProgramTarget {
+    /// The branch a Cartesian target asks for; `previous`: the joints (model values, rad) of the
+    /// target before it in the program, for a target without configuration data.
+    pub fn branch(&self, previous: Option<&[f64]>) -> Branch {
+        if let Some(c) = self.conf {
+            Branch::Rapid(c)
+        } else if self.turn.is_some() || self.status.is_some() {
+            Branch::Krl {
+                status: self.status,
+                turn: self.turn,
+            }
+        } else if let Some(p) = previous {
+            Branch::Nearest(p.to_vec())
+        } else {
+            Branch::Any
+        }
+    }
 }
 
 /// A program format.
@@ -79,6 +114,10 @@ pub struct ProgramTarget {
 pub enum Format {
     /// KUKA KRL (`.src`, `.dat`).
     Krl,
+    /// ABB RAPID (`.mod`, `.modx`, `.prg`).
+    Rapid,
+    /// Universal Robots URScript (`.script`, `.urscript`).
+    UrScript,
 }
 
 impl Format {
@@ -90,20 +129,70 @@ impl Format {
             .map(str::to_ascii_lowercase);
         match ext.as_deref() {
             Some("src") | Some("dat") => Ok(Format::Krl),
+            Some("mod") | Some("modx") | Some("prg") => Ok(Format::Rapid),
+            Some("script") | Some("urscript") => Ok(Format::UrScript),
             _ => Err(Error::invalid(
                 "program",
                 format!(
-                    "{}: unknown program format (KUKA KRL .src/.dat is supported)",
+                    "{}: unknown program format from its extension (known: KUKA KRL .src/.dat, \
+                     ABB RAPID .mod/.modx/.prg, URScript .script/.urscript)",
                     path.display()
                 ),
             )),
         }
     }
 
-    /// The targets of a program text.
-    pub fn targets(self, text: &str) -> Vec<ProgramTarget> {
+    /// The targets of a program text, in file order; `path` names the program in errors (a
+    /// malformed target: its line and field).
+    pub fn targets(self, path: &Path, text: &str) -> Result<Vec<ProgramTarget>> {
         match self {
-            Format::Krl => krl::targets(text),
+            Format::Krl => krl::targets(path, text),
+            Format::Rapid => rapid::targets(path, text),
+            Format::UrScript => urscript::targets(path, text),
+        }
+    }
+
+    /// The tool frame (mm) of a Cartesian target's values.
+    pub fn pose_of(self, values: &[f64]) -> Frame {
+        match self {
+            Format::Krl => krl::pose_of(values),
+            Format::Rapid => rapid::pose_of(values),
+            Format::UrScript => urscript::pose_of(values),
+        }
+    }
+
+    /// The values of a Cartesian target at tool frame `f`, written like `old` (the target's
+    /// values in the input: quaternion sign, rotation vector turn).
+    pub fn pose_values(self, f: &Frame, old: &[f64]) -> Vec<f64> {
+        match self {
+            Format::Krl => krl::pose_values(f),
+            Format::Rapid => rapid::pose_values(f, old),
+            Format::UrScript => urscript::pose_values(f, old),
+        }
+    }
+
+    /// Controller axis values in the robot's display units (deg, mm) from a joint target's values.
+    pub fn axes_of(self, values: &[f64]) -> Vec<f64> {
+        match self {
+            Format::UrScript => values.iter().map(|v| v.to_degrees()).collect(),
+            _ => values.to_vec(),
+        }
+    }
+
+    /// A joint target's values from controller axis values (display units).
+    pub fn joint_values(self, axes: &[f64]) -> Vec<f64> {
+        match self {
+            Format::UrScript => axes.iter().map(|v| v.to_radians()).collect(),
+            _ => axes.to_vec(),
+        }
+    }
+
+    /// Decimals of field `i` of a target of `kind`, for `base` decimals in mm and deg.
+    pub fn decimals(self, kind: TargetKind, i: usize, base: usize) -> usize {
+        match (self, kind) {
+            (Format::UrScript, _) => base + 3,
+            (Format::Rapid, TargetKind::Pose) if i >= 3 => base + 4,
+            _ => base,
         }
     }
 }
@@ -113,7 +202,8 @@ impl Format {
 pub struct ProgramSettings {
     /// Whole pose (default) or position only.
     pub full_pose: bool,
-    /// Decimals of the numbers written (mm and deg). Default 4.
+    /// Decimals of the numbers written in mm and deg (m and rad: 3 more; quaternions: 4 more).
+    /// Default 4.
     pub decimals: usize,
     /// Largest position error (mm) of a written target after rounding. Default 0.01: a joint
     /// rounded to 5e-5 deg moves the tool of a 3.6 m arm by up to 3e-3 mm.
@@ -174,18 +264,20 @@ pub struct CompensatedProgram {
     pub changes: Vec<Change>,
 }
 
-/// Compensates every target of `text` (a program in `format`) with `comp` (nominal = what the
-/// controller believes, calibrated = the real robot). Targets that cannot be compensated (status
-/// other than converged, or failing the check after rounding) are left unchanged and listed with
-/// `applied = false`; the caller decides whether that stops the run.
+/// Compensates every target of `text` (a program in `format`, named `path` in errors) with
+/// `comp` (nominal = what the controller believes, calibrated = the real robot). Targets that
+/// cannot be compensated (status other than converged, or failing the check after rounding) are
+/// left unchanged and listed with `applied = false`; the caller decides whether that stops the
+/// run. A malformed target is an error naming its line.
 pub fn compensate_program(
+    path: &Path,
     text: &str,
     format: Format,
     comp: &Compensator<'_, DampedLeastSquares>,
     settings: &ProgramSettings,
 ) -> Result<CompensatedProgram> {
     let nominal = comp.nominal();
-    let targets = format.targets(text);
+    let targets = format.targets(path, text)?;
     if !targets.is_empty() && nominal.dof() != 6 {
         return Err(Error::invalid(
             "program",
@@ -197,11 +289,21 @@ pub fn compensate_program(
     }
     let mut changes = Vec::with_capacity(targets.len());
     let mut splices: Vec<(Range<usize>, String)> = Vec::new();
+    // The joints of the previous target (desired, model values): where a controller without
+    // configuration data starts a Cartesian target's inverse kinematics.
+    let mut previous: Option<Vec<f64>> = None;
     for t in &targets {
-        let c = compensate_target(t, comp, settings);
+        let (c, desired) = compensate_target(t, format, comp, settings, previous.as_deref());
+        if desired.is_some() {
+            previous = desired;
+        }
         if c.applied {
-            for (f, v) in t.fields.iter().zip(&c.new) {
-                splices.push((f.span.clone(), krl::format_number(*v, settings.decimals)));
+            // A number the compensation leaves as it was (after rounding) keeps its text.
+            for (k, (f, v)) in t.fields.iter().zip(&c.new).enumerate() {
+                if *v != f.value {
+                    let d = format.decimals(t.kind, k, settings.decimals);
+                    splices.push((f.span.clone(), krl::format_number(*v, d)));
+                }
             }
             if let (Some(span), Some(old), Some(new)) = (&t.turn_span, t.turn, c.new_turn) {
                 if old != new {
@@ -237,101 +339,18 @@ fn round(v: f64, decimals: usize) -> f64 {
     krl::format_number(v, decimals).parse().unwrap_or(v)
 }
 
-fn pose_of(values: &[f64]) -> Frame {
-    pose(&[
-        values[0],
-        values[1],
-        values[2],
-        values[3].to_radians(),
-        values[4].to_radians(),
-        values[5].to_radians(),
-    ])
-}
-
-fn values_of(f: &Frame) -> Vec<f64> {
-    let v = frame_vector(f);
-    vec![
-        v[0],
-        v[1],
-        v[2],
-        v[3].to_degrees(),
-        v[4].to_degrees(),
-        v[5].to_degrees(),
-    ]
-}
-
-/// The turn of joints `q`: bit i set when controller axis i+1 is negative.
-pub fn turn_of(robot: &Robot, q: &[f64]) -> u32 {
-    let axes = robot.joint_space().axes_from_joints(q);
-    axes.iter()
-        .enumerate()
-        .filter(|(_, a)| **a < 0.0)
-        .map(|(i, _)| 1u32 << i)
-        .sum()
-}
-
-/// Axes within this of zero (deg) match either sign of a turn: a target written at exactly 0
-/// comes back from inverse kinematics as +-1e-12.
-const TURN_ZERO_DEG: f64 = 1e-6;
-
-/// Whether the controller axes of `q` have the signs turn `t` gives (bit i: axis i+1 < 0); an
-/// axis within `zero_deg` of 0 matches either sign.
-fn matches_turn(robot: &Robot, q: &[f64], t: u32, zero_deg: f64) -> bool {
-    let axes = robot.joint_space().axes_from_joints(q);
-    axes.iter()
-        .enumerate()
-        .all(|(i, a)| a.abs() < zero_deg || (t & (1 << i) != 0) == (*a < 0.0))
-}
-
-/// Axes of the desired joints within this of 0 (deg) may change sign by compensation: the turn
-/// written follows the commanded joints there.
+/// Axes of the desired joints within this of 0 (deg) may change sign by compensation: the KRL
+/// turn written follows the commanded joints there.
 const TURN_ADJUST_DEG: f64 = 1.0;
 
-/// The nominal model's joints at a Cartesian target on the branch of its turn: start
-/// configurations with the turn's axis signs, the first solution matching the turn.
-fn desired_joints(
-    nominal: &Robot,
-    solver: &PoseNewton,
-    target: &Frame,
-    turn: Option<u32>,
-) -> Option<Vec<f64>> {
-    let n = nominal.dof();
-    let js = nominal.joint_space();
-    let mut q = vec![0.0; n];
-    let mut fallback = None;
-    for k in 0..32 {
-        let mut start = crate::compensation::default_seeds(nominal, k + 1).pop()?;
-        crate::compensation::turn_towards(nominal, &target.translation.vector, &mut start);
-        if let Some(t) = turn {
-            let mut axes = js.axes_from_joints(&start);
-            for (i, a) in axes.iter_mut().enumerate() {
-                let neg = t & (1 << i) != 0;
-                if neg != (*a < 0.0) {
-                    *a = -*a;
-                }
-            }
-            start = js.joints_from_axes(&axes);
-        }
-        let rep = solver.solve(nominal, target, 0, &start, &mut q);
-        if !rep.status.is_converged() {
-            continue;
-        }
-        match turn {
-            Some(t) if !matches_turn(nominal, &q, t, TURN_ZERO_DEG) => {
-                fallback.get_or_insert_with(|| q.clone());
-            }
-            _ => return Some(q),
-        }
-    }
-    // No solution on the turn's branch: the nearest other one (the status then says so).
-    fallback
-}
-
+/// Compensates one target; also returns its desired joints (model values), when known.
 fn compensate_target(
     t: &ProgramTarget,
+    format: Format,
     comp: &Compensator<'_, DampedLeastSquares>,
     s: &ProgramSettings,
-) -> Change {
+    previous: Option<&[f64]>,
+) -> (Change, Option<Vec<f64>>) {
     let nominal = comp.nominal();
     let cal = comp.calibrated();
     let js = nominal.joint_space();
@@ -351,28 +370,24 @@ fn compensate_target(
         applied: false,
     };
     let mut q = vec![0.0; nominal.dof()];
+    let branch = t.branch(previous);
     // Desired joints (model values) and the desired tool pose.
     let (desired, mut branch_ok) = match t.kind {
-        TargetKind::Joints => (js.joints_from_axes(&old), true),
+        TargetKind::Joints => (js.joints_from_axes(&format.axes_of(&old)), true),
         TargetKind::Pose => {
-            match desired_joints(nominal, &comp.pose_solver, &pose_of(&old), t.turn) {
-                Some(d) => {
-                    let ok = match t.turn {
-                        Some(tt) => matches_turn(nominal, &d, tt, TURN_ZERO_DEG),
-                        None => true,
-                    };
-                    (d, ok)
-                }
-                None => {
+            match branch_joints(nominal, &comp.pose_solver, &format.pose_of(&old), &branch) {
+                BranchJoints::Found(d) => (d, true),
+                BranchJoints::Other(d) => (d, false),
+                BranchJoints::Unreachable => {
                     change.status = IkStatus::Unreachable;
-                    return change;
+                    return (change, None);
                 }
             }
         }
     };
     let desired_pose = match t.kind {
         TargetKind::Joints => nominal.tool_pose(&desired),
-        TargetKind::Pose => pose_of(&old),
+        TargetKind::Pose => format.pose_of(&old),
     };
     let rep = if s.full_pose {
         comp.compensate_pose(&desired, &mut q).1
@@ -380,56 +395,38 @@ fn compensate_target(
         comp.compensate(&desired, &mut q).1
     };
     change.status = rep.status;
-    if rep.status.is_converged() {
-        if let (TargetKind::Pose, Some(tt)) = (t.kind, t.turn) {
-            // The turn follows the commanded joints where an axis of the desired joints lies
-            // within TURN_ADJUST_DEG of 0 (compensation may move it across); elsewhere a
-            // different sign is another branch.
-            let axes = js.axes_from_joints(&desired);
-            let mut mask = tt;
-            for (i, a) in axes.iter().enumerate() {
-                if a.abs() < TURN_ADJUST_DEG {
-                    mask &= !(1 << i);
-                }
-            }
-            let new_turn = turn_of(nominal, &q);
-            let fixed = axes
-                .iter()
-                .enumerate()
-                .filter(|(_, a)| a.abs() >= TURN_ADJUST_DEG)
-                .all(|(i, _)| (new_turn ^ mask) & (1 << i) == 0);
-            branch_ok &= fixed;
-            change.new_turn = Some(new_turn);
-        }
-        if !branch_ok {
-            change.status = IkStatus::ConfigurationChange;
-        }
+    if rep.status.is_converged() && t.kind == TargetKind::Pose {
+        branch_ok &= commanded_branch_ok(t, nominal, &desired, &q, &branch, &mut change);
+    }
+    if rep.status.is_converged() && !branch_ok {
+        change.status = IkStatus::ConfigurationChange;
     }
     if !change.status.is_converged() {
-        return change;
+        return (change, Some(desired));
     }
     // The values to write, rounded as written, and their check on the calibrated model.
     let new: Vec<f64> = match t.kind {
-        TargetKind::Joints => js.axes_from_joints(&q),
-        TargetKind::Pose => values_of(&nominal.tool_pose(&q)),
+        TargetKind::Joints => format.joint_values(&js.axes_from_joints(&q)),
+        TargetKind::Pose => format.pose_values(&nominal.tool_pose(&q), &old),
     }
     .iter()
-    .map(|v| round(*v, s.decimals))
+    .enumerate()
+    .map(|(k, v)| round(*v, format.decimals(t.kind, k, s.decimals)))
     .collect();
     let reached = match t.kind {
-        TargetKind::Joints => Some(js.joints_from_axes(&new)),
+        TargetKind::Joints => Some(js.joints_from_axes(&format.axes_of(&new))),
         TargetKind::Pose => {
             // The controller's inverse kinematics of the written pose, on the commanded branch.
             let mut qw = vec![0.0; nominal.dof()];
             let r = comp
                 .pose_solver
-                .solve(nominal, &pose_of(&new), 0, &q, &mut qw);
+                .solve(nominal, &format.pose_of(&new), 0, &q, &mut qw);
             r.status.is_converged().then_some(qw)
         }
     };
     let Some(qw) = reached else {
         change.status = IkStatus::NotConverged;
-        return change;
+        return (change, Some(desired));
     };
     let actual = cal.tool_pose(&qw);
     let (vm, vd) = if s.full_pose {
@@ -444,22 +441,59 @@ fn compensate_target(
     change.verified_deg = vd;
     if vm > s.verify_mm || vd > s.verify_deg {
         change.status = IkStatus::NotConverged;
-        return change;
+        return (change, Some(desired));
     }
-    let before = match t.kind {
-        TargetKind::Joints => nominal.tool_pose(&desired),
-        TargetKind::Pose => pose_of(&old),
-    };
     let after = match t.kind {
         TargetKind::Joints => nominal.tool_pose(&qw),
-        TargetKind::Pose => pose_of(&new),
+        TargetKind::Pose => format.pose_of(&new),
     };
-    let (cm, cd) = pose_distance(&before, &after);
+    let (cm, cd) = pose_distance(&desired_pose, &after);
     change.correction_mm = cm;
     change.correction_deg = cd;
     change.new = new;
     change.applied = true;
-    change
+    (change, Some(desired))
+}
+
+/// Whether the commanded joints `q` of a Cartesian target keep its configuration data (see the
+/// module documentation); sets the KRL turn to write.
+fn commanded_branch_ok(
+    t: &ProgramTarget,
+    nominal: &Robot,
+    desired: &[f64],
+    q: &[f64],
+    branch: &Branch,
+    change: &mut Change,
+) -> bool {
+    let js = nominal.joint_space();
+    match (branch, t.turn) {
+        (Branch::Krl { status, .. }, Some(tt)) => {
+            // The turn follows the commanded joints where an axis of the desired joints lies
+            // within TURN_ADJUST_DEG of 0 (compensation may move it across); elsewhere a
+            // different sign is another branch.
+            // A bit changes only where the commanded axis has the other sign beyond
+            // seed::ZERO_DEG (a target written at 0 comes back as +-1e-4).
+            let axes = js.axes_from_joints(desired);
+            let mut new_turn = tt;
+            for (i, a) in js.axes_from_joints(q).iter().enumerate() {
+                if a.abs() >= seed::ZERO_DEG {
+                    new_turn = (new_turn & !(1 << i)) | (u32::from(*a < 0.0) << i);
+                }
+            }
+            let fixed = axes
+                .iter()
+                .enumerate()
+                .filter(|(_, a)| a.abs() >= TURN_ADJUST_DEG)
+                .all(|(i, _)| (new_turn ^ tt) & (1 << i) == 0);
+            change.new_turn = Some(new_turn);
+            let s_branch = Branch::Krl {
+                status: *status,
+                turn: None,
+            };
+            fixed && matches(nominal, q, &s_branch)
+        }
+        _ => matches(nominal, q, branch),
+    }
 }
 
 #[cfg(test)]

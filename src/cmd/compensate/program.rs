@@ -1,0 +1,231 @@
+//! `robocal compensate --program FILE --out FILE`: a robot program (KUKA KRL, ABB RAPID,
+//! URScript) with every target replaced by its compensated value, the rest kept byte for byte
+//! ([`robocal_core::programs`]); the changed targets listed, and written as CSV with `--changes`.
+
+use crate::exit;
+use robocal_core::io::atomic::{commit_all, AtomicFile};
+use robocal_core::programs::{
+    compensate_program, Change, CompensatedProgram, Format, ProgramSettings, TargetKind,
+};
+use robocal_core::{Compensator, DampedLeastSquares};
+use std::io::Write;
+use std::path::Path;
+
+/// What a program run needs beside the compensator.
+pub(super) struct ProgramRun<'a> {
+    pub program: &'a Path,
+    pub format: Format,
+    pub out: &'a Path,
+    pub changes: Option<&'a Path>,
+    pub keep_going: bool,
+    pub full_pose: bool,
+    pub params: &'a Path,
+}
+
+/// The header of the `--changes` CSV (README, "Robot programs").
+pub(super) const CHANGES_HEADER: &str = "name,line,kind,status,applied,correction_mm,\
+    correction_deg,verified_mm,verified_deg,old,new";
+
+/// Targets listed one by one before the rest are counted.
+const LISTED: usize = 50;
+
+pub(super) fn run(
+    r: &ProgramRun<'_>,
+    comp: &Compensator<'_, DampedLeastSquares>,
+    outputs: &mut super::super::io_plan::Outputs,
+) -> anyhow::Result<()> {
+    let bytes = std::fs::read(r.program)
+        .map_err(|e| anyhow::anyhow!(e).context(format!("--program {}", r.program.display())))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        exit::input(format!(
+            "--program {}: not UTF-8 text (byte {}); save the program as UTF-8 (or ASCII)",
+            r.program.display(),
+            e.utf8_error().valid_up_to()
+        ))
+    })?;
+    let settings = ProgramSettings {
+        full_pose: r.full_pose,
+        ..ProgramSettings::default()
+    };
+    let pb = crate::progress::spinner("compensating the program's targets");
+    let res = compensate_program(r.program, &text, r.format, comp, &settings);
+    pb.finish_and_clear();
+    let res = res?;
+    let failed: Vec<&Change> = res.changes.iter().filter(|c| !c.applied).collect();
+    if !failed.is_empty() && !r.keep_going {
+        let lines: Vec<String> = failed.iter().map(|c| describe(c)).collect();
+        return Err(exit::numerical(format!(
+            "{} of {} target(s) of {} cannot be compensated; nothing written (give \
+             --keep-going to leave them unchanged and write the rest):\n  {}",
+            failed.len(),
+            res.changes.len(),
+            r.program.display(),
+            lines.join("\n  ")
+        )));
+    }
+    let mut files = vec![write(outputs, r.out, res.text.as_bytes())?];
+    if let Some(p) = r.changes {
+        files.push(write(outputs, p, changes_csv(&res).as_bytes())?);
+    }
+    commit_all(files)?;
+    print_listing(r, &res, &settings);
+    Ok(())
+}
+
+fn write(
+    outputs: &mut super::super::io_plan::Outputs,
+    path: &Path,
+    bytes: &[u8],
+) -> anyhow::Result<AtomicFile> {
+    let mut f = outputs.open(path)?;
+    f.write_all(bytes)
+        .map_err(|e| anyhow::anyhow!(e).context(path.display().to_string()))?;
+    Ok(f)
+}
+
+/// One line of a target that could not be compensated.
+fn describe(c: &Change) -> String {
+    let why = match c.status {
+        robocal_core::compensation::IkStatus::Converged => format!(
+            "the written value misses the target by {:.4} mm, {:.4} deg after rounding",
+            c.verified_mm, c.verified_deg
+        ),
+        s => s.to_string(),
+    };
+    format!("{} (line {}): {why}", c.name, c.line)
+}
+
+fn kind(k: TargetKind) -> &'static str {
+    match k {
+        TargetKind::Joints => "joints",
+        TargetKind::Pose => "pose",
+    }
+}
+
+/// A CSV field: quoted when it holds a comma, quote or line break.
+fn field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_owned()
+    }
+}
+
+fn values(v: &[f64]) -> String {
+    v.iter()
+        .map(|x| format!("{x}"))
+        .collect::<Vec<_>>()
+        .join(" ")
+}
+
+/// The `--changes` CSV: one row per target, in file order.
+pub(super) fn changes_csv(res: &CompensatedProgram) -> String {
+    let mut s = String::from(CHANGES_HEADER);
+    s.push('\n');
+    for c in &res.changes {
+        let num = |v: f64| {
+            if v.is_finite() {
+                format!("{v:.6}")
+            } else {
+                String::new()
+            }
+        };
+        let (cm, cd) = if c.applied {
+            (num(c.correction_mm), num(c.correction_deg))
+        } else {
+            (String::new(), String::new())
+        };
+        s += &format!(
+            "{},{},{},{},{},{cm},{cd},{},{},{},{}\n",
+            field(&c.name),
+            c.line,
+            kind(c.kind),
+            c.status,
+            c.applied,
+            num(c.verified_mm),
+            num(c.verified_deg),
+            values(&c.old),
+            values(&c.new)
+        );
+    }
+    s
+}
+
+fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettings) {
+    let n = res.changes.len();
+    let applied = res.changes.iter().filter(|c| c.applied).count();
+    let poses = res
+        .changes
+        .iter()
+        .filter(|c| c.kind == TargetKind::Pose)
+        .count();
+    println!(
+        "{}: {n} target(s) ({} joint, {poses} Cartesian), {}; solved on the calibrated model of {}",
+        r.program.display(),
+        n - poses,
+        if r.full_pose {
+            "full pose"
+        } else {
+            "position only"
+        },
+        r.params.display()
+    );
+    if n > 0 {
+        println!(
+            "  {:<16} {:>6}  {:<6}  {:>11}  {:>11}  status",
+            "target", "line", "kind", "corr. mm", "corr. deg"
+        );
+    }
+    for c in res.changes.iter().take(LISTED) {
+        let (cm, cd) = if c.applied {
+            (
+                format!("{:.4}", c.correction_mm),
+                format!("{:.4}", c.correction_deg),
+            )
+        } else {
+            ("-".to_owned(), "-".to_owned())
+        };
+        println!(
+            "  {:<16} {:>6}  {:<6}  {cm:>11}  {cd:>11}  {}{}",
+            c.name,
+            c.line,
+            kind(c.kind),
+            c.status,
+            if c.applied { "" } else { " (left unchanged)" }
+        );
+    }
+    if n > LISTED {
+        println!("  ... and {} more (see --changes)", n - LISTED);
+    }
+    let max = |f: fn(&Change) -> f64| {
+        res.changes
+            .iter()
+            .filter(|c| c.applied)
+            .map(f)
+            .fold(0.0, f64::max)
+    };
+    println!(
+        "  {applied} compensated, {} left unchanged; largest correction {:.4} mm, {:.4} deg; \
+         checked by forward kinematics on the calibrated model after rounding: within {:.4} mm, \
+         {:.4} deg (limit {} mm, {} deg)",
+        n - applied,
+        max(|c| c.correction_mm),
+        max(|c| c.correction_deg),
+        max(|c| c.verified_mm),
+        max(|c| c.verified_deg),
+        s.verify_mm,
+        s.verify_deg
+    );
+    for c in res.changes.iter().filter(|c| !c.applied) {
+        eprintln!(
+            "warning: {}: {}; left unchanged (--keep-going)",
+            r.program.display(),
+            describe(c)
+        );
+    }
+    let shown = super::super::io_plan::shown;
+    match r.changes {
+        Some(p) => println!("wrote {} and {}", shown(r.out), shown(p)),
+        None => println!("wrote {}", shown(r.out)),
+    }
+}
