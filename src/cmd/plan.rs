@@ -259,8 +259,9 @@ fn print_plan(s: &Settings, p: &Plan) {
     if s.plan.tracker_origin.is_some() {
         // The design is optimal for the fit that weighs each point as this tracker model does.
         println!(
-            "the figures assume that fit: calibrate these poses with `--tracker-sigma {},{}`, \
-             the measurements in the tracker's own frame (tracker at the origin)",
+            "the figures assume a fit that weighs each point by this tracker model: calibrate \
+             does so by default for measurements in the tracker's own frame with the typical \
+             model (0.010 mm + 0.005 mm/m); for another give `--tracker-sigma {},{}`",
             s.plan.noise_mm, s.plan.noise_per_m
         );
     }

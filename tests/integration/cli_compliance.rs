@@ -77,7 +77,14 @@ fn the_payload_known_compliance_transfers_to_another_payload() {
     };
     let (_, geo) = cal("geo.json", &[]);
     let (stdout, el) = cal("el.json", &["--compliance", "auto", "--payload-kg", "300"]);
-    assert!(stdout.contains("compliance2"), "{stdout}");
+    assert!(stdout.contains("compliance (urad/Nm)"), "{stdout}");
+    let c2 = &el["parameters"]["compliance2"];
+    assert_eq!(c2["fixed"], false, "compliance2 identified: {c2}");
+    let c2 = c2["calibrated"].as_f64().unwrap();
+    assert!(
+        (c2 - 0.02).abs() < 0.004,
+        "compliance2 {c2} µrad/(N·m), true 0.02"
+    );
     assert_eq!(el["payload_kg"], 300.0);
     assert_eq!(el["parameters"]["compliance3"]["unit"], "urad/Nm");
     assert_eq!(el["parameters"]["grav2_o3"]["unit"], "urad/m");

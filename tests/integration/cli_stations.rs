@@ -334,7 +334,9 @@ fn another_station_is_refused_or_fitted_with_refit_frame() {
 }
 
 /// `--tracker-sigma F,P` as the README writes it: weighted fitting whose standard deviations are
-/// in physical units; a malformed value is a usage error.
+/// in physical units; `off` weighs every point the same; without the flag, these data (in the
+/// tracker's frame, about 4 m from the base) are weighted by the typical tracker, here the same
+/// model as given; a malformed value is a usage error.
 #[test]
 fn tracker_sigma_weights_the_fit() {
     let dir = Dir::new();
@@ -342,6 +344,7 @@ fn tracker_sigma_weights_the_fit() {
     let data = kr480_cell(d, "8");
     let plain = d.join("plain.json");
     let weighted = d.join("weighted.json");
+    let default = d.join("default.json");
     ok(&[
         "calibrate",
         "--robot",
@@ -350,7 +353,23 @@ fn tracker_sigma_weights_the_fit() {
         p(&data),
         "--out",
         p(&plain),
+        "--tracker-sigma",
+        "off",
     ]);
+    let o = ok(&[
+        "calibrate",
+        "--robot",
+        "kuka-kr480-r3330",
+        "--data",
+        p(&data),
+        "--out",
+        p(&default),
+    ]);
+    assert!(
+        o.stdout().contains("points weighted by a typical tracker"),
+        "{}",
+        o.stdout()
+    );
     ok(&[
         "calibrate",
         "--robot",
@@ -372,6 +391,19 @@ fn tracker_sigma_weights_the_fit() {
     );
     assert!(xa != xb, "the weights change the estimate");
     assert!((xa - xb).abs() < 0.05, "{xa} vs {xb}");
+    assert_eq!(a["settings"]["weighting"]["source"], "none");
+    assert_eq!(b["settings"]["weighting"]["source"], "given");
+    let c = read(&default);
+    assert_eq!(c["settings"]["weighting"]["source"], "automatic");
+    assert_eq!(c["settings"]["weighting"]["tracker"]["per_m_mm"], 0.005);
+    let dist = c["settings"]["weighting"]["tracker_distance_mm"]
+        .as_f64()
+        .unwrap();
+    assert!(dist > 3000.0 && dist < 5000.0, "{dist}");
+    assert_eq!(
+        c["parameters"]["a2"]["calibrated"], b["parameters"]["a2"]["calibrated"],
+        "the automatic model is the given one"
+    );
     for bad in ["1", "0.01,0.005,1", "-1,0", "x,1"] {
         let o = robocal(&[
             "calibrate",

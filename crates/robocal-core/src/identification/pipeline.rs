@@ -306,11 +306,23 @@ pub fn calibrate(
         ..Default::default()
     };
     let registration = register(nominal, cal, data.plane, &reg_opts)?;
+    let mut tool_fit = fit_tools(nominal, cal, &registration.frame)?;
+    // Only where the nominal geometry with the fitted tools fits the data as a calibration's
+    // start can (the gate's nominal-error limit): on data in the wrong unit or of another robot
+    // the fitted tools mean nothing, and the gate names the cause.
+    tool_fit.applied = tool_fit.converged
+        && tool_fit.stats.rms_mm
+            <= plausibility::NOMINAL_ERROR_LIMIT * plausibility::reach_mm(nominal);
     // The automatic tracker model needs to know where the tracker stands: the registration
-    // (which does not weight points) tells.
-    let weighting = settings
+    // (which, like the tool fit, does not weight points) tells, where the nominal model fits
+    // the data at all (on data in the wrong unit or of another robot the frame means nothing).
+    let mut weighting = settings
         .weighting
         .resolve(data.calibration, registration.frame.origin().norm());
+    if weighting.source == WeightSource::Automatic && !tool_fit.applied {
+        weighting.source = WeightSource::None;
+        weighting.tracker = None;
+    }
     let reweighted;
     let cal = if weighting.source == WeightSource::Automatic {
         reweighted = Weighting {
@@ -322,13 +334,6 @@ pub fn calibrate(
     } else {
         cal
     };
-    let mut tool_fit = fit_tools(nominal, cal, &registration.frame)?;
-    // Only where the nominal geometry with the fitted tools fits the data as a calibration's
-    // start can (the gate's nominal-error limit): on data in the wrong unit or of another robot
-    // the fitted tools mean nothing, and the gate names the cause.
-    tool_fit.applied = tool_fit.converged
-        && tool_fit.stats.rms_mm
-            <= plausibility::NOMINAL_ERROR_LIMIT * plausibility::reach_mm(nominal);
     // The identification starts from the nominal geometry with the fitted tools, in the frame
     // fitted with them: neither it nor the identifiability depends on the nominal tool's guess.
     let (start, frame) = if tool_fit.applied {

@@ -70,7 +70,9 @@ pub struct Weighting {
     pub tracker: Option<TrackerSigma>,
     /// Without a tracker model and without `sigma_mm` cells: weight by [`TYPICAL_TRACKER`] when
     /// the data are in a tracker's own frame (the registered tracker at least
-    /// [`TRACKER_FRAME_MIN_DISTANCE_MM`] from the robot's base). Default on.
+    /// [`TRACKER_FRAME_MIN_DISTANCE_MM`] from the robot's base; the calibration also asks that
+    /// the nominal model fit the data, without which the registered frame means nothing).
+    /// Default on.
     pub automatic: bool,
     /// How many mm of position error one degree of orientation error counts as.
     pub mm_per_deg: f64,
@@ -145,5 +147,69 @@ impl Weighting {
             out.set_sigmas(Some(s))?;
         }
         Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Vector3;
+
+    fn points(with_sigma: bool) -> Observations {
+        let mut obs = Observations::new(1);
+        for i in 0..3 {
+            obs.push(
+                &[i as f64],
+                Vector3::new(1000.0 * i as f64, 0.0, 0.0),
+                i + 2,
+            )
+            .unwrap();
+        }
+        if with_sigma {
+            obs.set_sigmas(Some(vec![0.01, 0.02, 0.03])).unwrap();
+        }
+        obs
+    }
+
+    /// The typical tracker is the simulation's default one (the weights of simulated data are
+    /// then the true noise's).
+    #[test]
+    fn the_typical_tracker_is_the_simulated_one() {
+        assert_eq!(
+            TYPICAL_TRACKER.fixed_mm,
+            crate::simulation::DEFAULT_NOISE_MM
+        );
+        assert_eq!(
+            TYPICAL_TRACKER.per_m_mm,
+            crate::simulation::DEFAULT_NOISE_PER_M
+        );
+    }
+
+    /// A `sigma_mm` column wins, then a given model; the typical tracker applies only to data
+    /// in a tracker's frame, and only when automatic.
+    #[test]
+    fn resolution_order_and_the_tracker_frame_rule() {
+        let given = TrackerSigma::new(0.02, 0.01).unwrap();
+        let w = Weighting::default();
+        let far = TRACKER_FRAME_MIN_DISTANCE_MM;
+        let near = far - 1.0;
+        assert_eq!(w.resolve(&points(true), far).source, WeightSource::Column);
+        let g = Weighting {
+            tracker: Some(given),
+            ..w
+        };
+        let r = g.resolve(&points(false), near);
+        assert_eq!((r.source, r.tracker), (WeightSource::Given, Some(given)));
+        let r = w.resolve(&points(false), far);
+        assert_eq!(
+            (r.source, r.tracker),
+            (WeightSource::Automatic, Some(TYPICAL_TRACKER))
+        );
+        assert_eq!(w.resolve(&points(false), near).source, WeightSource::None);
+        let off = Weighting {
+            automatic: false,
+            ..w
+        };
+        assert_eq!(off.resolve(&points(false), far).source, WeightSource::None);
     }
 }
