@@ -266,60 +266,39 @@ impl<'a> Predictor<'a> {
     #[inline(always)]
     fn model_covariance(&self, j: &[f64], x: &mut [f64]) -> Matrix3<f64> {
         let k = self.index.len();
-        if let Some(l) = &self.factor {
-            // x = J L (L lower: row a reaches columns 0..=a).
-            for r in 0..3 {
-                let jr = &j[r * k..(r + 1) * k];
-                let xr = &mut x[r * k..(r + 1) * k];
-                xr.fill(0.0);
-                for (a, &ja) in jr.iter().enumerate() {
-                    if ja != 0.0 {
-                        for (xv, lv) in xr[..=a].iter_mut().zip(&l[a * k..a * k + a + 1]) {
-                            *xv += ja * lv;
-                        }
-                    }
-                }
-            }
-            let mut m = Matrix3::zeros();
-            for r in 0..3 {
-                for c in r..3 {
-                    let v: f64 = x[r * k..(r + 1) * k]
-                        .iter()
-                        .zip(&x[c * k..(c + 1) * k])
-                        .map(|(a, b)| a * b)
-                        .sum();
-                    m[(r, c)] = v;
-                    m[(c, r)] = v;
-                }
-            }
-            return m;
-        }
-        // x = J C (C symmetric, read by rows).
+        // x = J L (L lower: row a reaches columns 0..=a), then (J L)(J L)^T; or x = J C (C
+        // symmetric, read by rows), then (J C) J^T.
+        let (m, width) = match &self.factor {
+            Some(l) => (l, 0),
+            None => (&self.cov, k),
+        };
         for r in 0..3 {
             let jr = &j[r * k..(r + 1) * k];
             let xr = &mut x[r * k..(r + 1) * k];
             xr.fill(0.0);
             for (a, &ja) in jr.iter().enumerate() {
                 if ja != 0.0 {
-                    for (xv, cv) in xr.iter_mut().zip(&self.cov[a * k..(a + 1) * k]) {
-                        *xv += ja * cv;
+                    let n = (a + 1).max(width);
+                    for (xv, mv) in xr[..n].iter_mut().zip(&m[a * k..a * k + n]) {
+                        *xv += ja * mv;
                     }
                 }
             }
         }
-        let mut m = Matrix3::zeros();
+        let y = if self.factor.is_some() { &*x } else { j };
+        let mut out = Matrix3::zeros();
         for r in 0..3 {
             for c in r..3 {
                 let v: f64 = x[r * k..(r + 1) * k]
                     .iter()
-                    .zip(&j[c * k..(c + 1) * k])
+                    .zip(&y[c * k..(c + 1) * k])
                     .map(|(a, b)| a * b)
                     .sum();
-                m[(r, c)] = v;
-                m[(c, r)] = v;
+                out[(r, c)] = v;
+                out[(c, r)] = v;
             }
         }
-        m
+        out
     }
 
     /// The expected error norm of a measurement whose model error has covariance `model`.
