@@ -10,6 +10,7 @@
 //! `LIN_REL`), and incomplete aggregates (`{A1 10}`: "the other axes unchanged"). A hand-written
 //! parser: KRL has no maintained Rust parser, and this is all robocal needs of it.
 
+use super::lex::{line_end, past_string};
 use super::{Field, ProgramTarget, TargetKind};
 use crate::error::{Error, Result};
 use crate::frame::{frame_vector, pose, Frame};
@@ -28,18 +29,8 @@ pub fn targets(path: &Path, text: &str) -> Result<Vec<ProgramTarget>> {
     let mut i = 0;
     while i < b.len() {
         match b[i] {
-            b';' => {
-                while i < b.len() && b[i] != b'\n' {
-                    i += 1;
-                }
-            }
-            b'"' => {
-                i += 1;
-                while i < b.len() && b[i] != b'"' && b[i] != b'\n' {
-                    i += 1;
-                }
-                i += 1;
-            }
+            b';' => i = line_end(b, i),
+            b'"' => i = past_string(b, i),
             b'{' => {
                 // The aggregate ends at `}`; a `;`, `{` or the end of the text first: not one.
                 let Some(end) = b[i + 1..]

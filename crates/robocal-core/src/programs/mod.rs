@@ -35,6 +35,7 @@
 //! [`ProgramSettings::verify_mm`] and [`ProgramSettings::verify_deg`] of the desired pose.
 
 pub mod krl;
+mod lex;
 pub mod rapid;
 pub mod seed;
 pub mod urscript;

@@ -18,6 +18,7 @@
 //! shape is an error. Comments (`!` to the end of the line) and strings are skipped. A
 //! hand-written reader: there is no maintained Rust parser of RAPID.
 
+use super::lex::{line_end, past_string};
 use super::{Field, ProgramTarget, TargetKind};
 use crate::error::{Error, Result};
 use crate::frame::Frame;
@@ -86,9 +87,7 @@ fn aggregate(b: &[u8], open: usize, depth: usize) -> Option<(Node, usize)> {
 fn skip_space(b: &[u8], mut i: usize) -> usize {
     while i < b.len() {
         if b[i] == b'!' {
-            while i < b.len() && b[i] != b'\n' {
-                i += 1;
-            }
+            i = line_end(b, i);
         } else if b[i].is_ascii_whitespace() {
             i += 1;
         } else {
@@ -132,18 +131,8 @@ pub fn targets(path: &Path, text: &str) -> Result<Vec<ProgramTarget>> {
     let mut i = 0;
     while i < b.len() {
         match b[i] {
-            b'!' => {
-                while i < b.len() && b[i] != b'\n' {
-                    i += 1;
-                }
-            }
-            b'"' => {
-                i += 1;
-                while i < b.len() && b[i] != b'"' && b[i] != b'\n' {
-                    i += 1;
-                }
-                i += 1;
-            }
+            b'!' => i = line_end(b, i),
+            b'"' => i = past_string(b, i),
             b';' | b'\n' => {
                 words.clear();
                 i += 1;

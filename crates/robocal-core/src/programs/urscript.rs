@@ -13,6 +13,7 @@
 //! line) and strings are skipped. A hand-written reader: there is no maintained Rust parser of
 //! URScript.
 
+use super::lex::{line_end, past_string};
 use super::{Field, ProgramTarget, TargetKind};
 use crate::error::{Error, Result};
 use crate::frame::Frame;
@@ -81,19 +82,8 @@ pub fn targets(path: &Path, text: &str) -> Result<Vec<ProgramTarget>> {
     let mut i = 0;
     while i < b.len() {
         match b[i] {
-            b'#' => {
-                while i < b.len() && b[i] != b'\n' {
-                    i += 1;
-                }
-            }
-            b'"' | b'\'' => {
-                let q = b[i];
-                i += 1;
-                while i < b.len() && b[i] != q && b[i] != b'\n' {
-                    i += 1;
-                }
-                i += 1;
-            }
+            b'#' => i = line_end(b, i),
+            b'"' | b'\'' => i = past_string(b, i),
             b'\n' => {
                 line_start = true;
                 i += 1;
