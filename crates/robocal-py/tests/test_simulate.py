@@ -197,3 +197,22 @@ def test_robot_files_simulate_as_the_cli(cli, tmp_path, robot_file):
     same_files(c, p)
     same_files(c.with_suffix(".truth.json"), p.with_suffix(".truth.json"))
     check_arrays(sim, c, robot.dof)
+
+
+def test_tracker_weighting_default_and_off_are_the_cli(cli, tmp_path):
+    """Data in a tracker's frame are weighted by the typical tracker by default; "off" (the
+    CLI's `--tracker-sigma off`) weighs every point the same; both as the CLI does."""
+    kr = robocal.Robot.preset(KR)
+    c = tmp_path / "cell.csv"
+    cli("simulate", "--robot", KR, "--truth", "random", "--poses", "75", "--seed", "12",
+        "--out", str(c))
+    sim = robocal.simulate(kr, "random", 75, seed=12)
+    for extra, source in [((), "automatic"), (("--tracker-sigma", "off"), "none")]:
+        out = tmp_path / f"{source}.json"
+        cli("calibrate", "--robot", KR, "--data", str(c), "--out", str(out), *extra)
+        kw = {"tracker_sigma": "off"} if extra else {}
+        res = robocal.calibrate(kr, *sim.calibration, plane=sim.plane, **kw)
+        cli_res = read_json(out)
+        assert cli_res["settings"]["weighting"]["source"] == source
+        assert res.data["settings"]["weighting"]["source"] == source
+        compare(res.data, cli_res)
