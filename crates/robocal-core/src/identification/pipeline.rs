@@ -26,9 +26,9 @@ use crate::identification::prediction::{predict, Prediction};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
+use crate::observations::AppliedWeighting;
 use crate::observations::Observations;
 use crate::observations::Weighting;
-use crate::observations::{AppliedWeighting, WeightSource};
 use crate::progress::{self, Observer};
 use crate::registration::{
     fit_tools, register, Registration, RegistrationObjective, RegistrationOptions, ToolFit,
@@ -263,8 +263,6 @@ pub fn calibrate(
         obs.check_targets(nominal)?;
     }
     cal.check_no_duplicate_poses()?;
-    let weighted = settings.weighting.apply(cal)?;
-    let cal = &weighted;
     let idopts = &settings.identifiability;
     if let Some(p) = idopts.fix.iter().find(|p| idopts.free.contains(p)) {
         return Err(Error::invalid(
@@ -313,27 +311,19 @@ pub fn calibrate(
     tool_fit.applied = tool_fit.converged
         && tool_fit.stats.rms_mm
             <= plausibility::NOMINAL_ERROR_LIMIT * plausibility::reach_mm(nominal);
-    // The automatic tracker model needs to know where the tracker stands: the registration
-    // (which, like the tool fit, does not weight points) tells, where the nominal model fits
-    // the data at all (on data in the wrong unit or of another robot the frame means nothing).
-    let mut weighting = settings
-        .weighting
-        .resolve(data.calibration, registration.frame.origin().norm());
-    if weighting.source == WeightSource::Automatic && !tool_fit.applied {
-        weighting.source = WeightSource::None;
-        weighting.tracker = None;
+    // The weights, from here on: the registration and the tool fit weight no point, and the
+    // automatic tracker model needs what they tell (where the tracker stands, whether the
+    // nominal model fits the data at all).
+    let weighting =
+        settings
+            .weighting
+            .resolve(cal, registration.frame.origin().norm(), tool_fit.applied);
+    let weighted = Weighting {
+        tracker: weighting.tracker,
+        ..settings.weighting
     }
-    let reweighted;
-    let cal = if weighting.source == WeightSource::Automatic {
-        reweighted = Weighting {
-            tracker: weighting.tracker,
-            ..settings.weighting
-        }
-        .apply(data.calibration)?;
-        &reweighted
-    } else {
-        cal
-    };
+    .apply(cal)?;
+    let cal = &weighted;
     // The identification starts from the nominal geometry with the fitted tools, in the frame
     // fitted with them: neither it nor the identifiability depends on the nominal tool's guess.
     let (start, frame) = if tool_fit.applied {

@@ -70,9 +70,8 @@ pub struct Weighting {
     pub tracker: Option<TrackerSigma>,
     /// Without a tracker model and without `sigma_mm` cells: weight by [`TYPICAL_TRACKER`] when
     /// the data are in a tracker's own frame (the registered tracker at least
-    /// [`TRACKER_FRAME_MIN_DISTANCE_MM`] from the robot's base; the calibration also asks that
-    /// the nominal model fit the data, without which the registered frame means nothing).
-    /// Default on.
+    /// [`TRACKER_FRAME_MIN_DISTANCE_MM`] from the robot's base, and the nominal model fitting
+    /// the data, without which the registered frame means nothing). Default on.
     pub automatic: bool,
     /// How many mm of position error one degree of orientation error counts as.
     pub mm_per_deg: f64,
@@ -116,14 +115,23 @@ pub struct AppliedWeighting {
 
 impl Weighting {
     /// The weighting for data whose registered tracker (the measurement frame's origin) is
-    /// `tracker_distance_mm` from the robot's base: the tracker model to apply, and where it
+    /// `tracker_distance_mm` from the robot's base, `nominal_fits` telling whether the nominal
+    /// model fits the data (the fitted tool's test): the tracker model to apply, and where it
     /// comes from.
-    pub fn resolve(&self, obs: &Observations, tracker_distance_mm: f64) -> AppliedWeighting {
+    pub fn resolve(
+        &self,
+        obs: &Observations,
+        tracker_distance_mm: f64,
+        nominal_fits: bool,
+    ) -> AppliedWeighting {
         let (source, tracker) = if obs.has_sigma() {
             (WeightSource::Column, None)
         } else if let Some(t) = self.tracker {
             (WeightSource::Given, Some(t))
-        } else if self.automatic && tracker_distance_mm >= TRACKER_FRAME_MIN_DISTANCE_MM {
+        } else if self.automatic
+            && nominal_fits
+            && tracker_distance_mm >= TRACKER_FRAME_MIN_DISTANCE_MM
+        {
             (WeightSource::Automatic, Some(TYPICAL_TRACKER))
         } else {
             (WeightSource::None, None)
@@ -186,30 +194,44 @@ mod tests {
     }
 
     /// A `sigma_mm` column wins, then a given model; the typical tracker applies only to data
-    /// in a tracker's frame, and only when automatic.
+    /// in a tracker's frame that the nominal model fits, and only when automatic.
     #[test]
     fn resolution_order_and_the_tracker_frame_rule() {
         let given = TrackerSigma::new(0.02, 0.01).unwrap();
         let w = Weighting::default();
         let far = TRACKER_FRAME_MIN_DISTANCE_MM;
         let near = far - 1.0;
-        assert_eq!(w.resolve(&points(true), far).source, WeightSource::Column);
+        assert_eq!(
+            w.resolve(&points(true), far, true).source,
+            WeightSource::Column
+        );
         let g = Weighting {
             tracker: Some(given),
             ..w
         };
-        let r = g.resolve(&points(false), near);
+        let r = g.resolve(&points(false), near, false);
         assert_eq!((r.source, r.tracker), (WeightSource::Given, Some(given)));
-        let r = w.resolve(&points(false), far);
+        let r = w.resolve(&points(false), far, true);
         assert_eq!(
             (r.source, r.tracker),
             (WeightSource::Automatic, Some(TYPICAL_TRACKER))
         );
-        assert_eq!(w.resolve(&points(false), near).source, WeightSource::None);
+        assert_eq!(
+            w.resolve(&points(false), near, true).source,
+            WeightSource::None
+        );
+        // Data the nominal model does not fit: their frame says nothing of the tracker.
+        assert_eq!(
+            w.resolve(&points(false), far, false).source,
+            WeightSource::None
+        );
         let off = Weighting {
             automatic: false,
             ..w
         };
-        assert_eq!(off.resolve(&points(false), far).source, WeightSource::None);
+        assert_eq!(
+            off.resolve(&points(false), far, true).source,
+            WeightSource::None
+        );
     }
 }
