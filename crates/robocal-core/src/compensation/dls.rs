@@ -25,11 +25,11 @@
 //! [`IkStatus::Unreachable`]; a run still making progress when the budget ran out gives
 //! [`IkStatus::NotConverged`].
 
-use super::stop::{stop_point, StopPoint};
+use super::damped::{self, Iteration};
 use super::{IkReport, IkSolver, IkStatus};
 use crate::error::Result;
 use crate::model::{JointType, Robot, MAX_JOINTS};
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
 /// Damped least-squares / Levenberg–Marquardt position IK (see the module documentation).
 ///
@@ -54,11 +54,6 @@ pub struct DampedLeastSquares {
     pub stationary_cosine: f64,
 }
 
-/// Largest relative damping before a solve is declared stalled.
-const MAX_DAMPING: f64 = 1e8;
-/// Smallest relative damping (keeps `J J^T + lambda^2 I` positive definite).
-const MIN_DAMPING: f64 = 1e-14;
-
 impl Default for DampedLeastSquares {
     fn default() -> Self {
         DampedLeastSquares {
@@ -72,24 +67,8 @@ impl Default for DampedLeastSquares {
     }
 }
 
-/// Relative decrease of the residual over the second half of the iteration budget below which a
-/// run that used up its budget counts as stopped at a stationary point (a plateau).
-const PLATEAU: f64 = 1e-3;
-
-/// Where one run of the iteration stopped.
-#[derive(Clone, Copy)]
-struct Run {
-    residual: f64,
-    iterations: usize,
-    /// The joints at a limit whose descent direction points out of the range (bit mask).
-    blocking: u32,
-    /// The joints at a limit (bit mask).
-    at_limit: u32,
-    /// Whether the run stopped at a stationary point of the distance: no step with any damping
-    /// reduced the error, or no free joint's tool motion has a direction cosine with the error
-    /// above [`DampedLeastSquares::stationary_cosine`], or the residual reached a plateau.
-    stationary: bool,
-}
+/// Where one run stopped: the residual (mm).
+type Run = damped::Run<f64>;
 
 impl DampedLeastSquares {
     /// The defaults (tolerance 1e-6 mm, 500 iterations).
@@ -111,7 +90,6 @@ impl DampedLeastSquares {
     /// The iteration on `q[..n]` (in place). With `limits`, joints stay within the robot's limits.
     fn run(&self, robot: &Robot, target: &Vector3<f64>, q: &mut [f64], limits: bool) -> Run {
         let n = robot.dof();
-        let lim = robot.limits();
         // Joint i's change is measured in units of sc[i]: rad, or prismatic_scale_mm mm.
         let mut sc = [1.0; MAX_JOINTS];
         for (s, t) in sc.iter_mut().zip(robot.joint_types()) {
@@ -119,126 +97,23 @@ impl DampedLeastSquares {
                 *s = self.prismatic_scale_mm;
             }
         }
-        let mut jq = [Vector3::zeros(); MAX_JOINTS];
-        let mut jt = [Vector3::zeros(); MAX_JOINTS];
-        let mut qt = [0.0; MAX_JOINTS];
-        let mut e = target - robot.tool_position_jacobians(q, Some(&mut jq[..n]), None);
-        let mut r = e.norm();
-        let mut mu = self.initial_damping;
-        let mut iterations = 1;
-        let mut stalled = false;
-        let mut r_half = f64::INFINITY;
-        loop {
-            if r_half.is_infinite() && 2 * iterations >= self.max_iterations {
-                r_half = r;
+        let iteration = Iteration {
+            max_iterations: self.max_iterations,
+            max_step: self.max_step_rad,
+            initial_damping: self.initial_damping,
+            stationary_cosine: self.stationary_cosine,
+        };
+        // The residual (mm) and the columns per scaled joint unit, c_i = sc_i j_i.
+        let eval = |q: &[f64], cols: &mut [Vector3<f64>; MAX_JOINTS]| {
+            let e = target - robot.tool_position_jacobians(q, Some(&mut cols[..n]), None);
+            for (c, s) in cols[..n].iter_mut().zip(&sc) {
+                *c *= *s;
             }
-            // Free joints: those not held at a limit by the descent direction g_i = j_i . e.
-            let mut free = 0u32;
-            for i in 0..n {
-                let g = jq[i].dot(&e);
-                let blocked =
-                    limits && ((q[i] <= lim[i].min && g < 0.0) || (q[i] >= lim[i].max && g > 0.0));
-                if !blocked {
-                    free |= 1 << i;
-                }
-            }
-            if r <= self.tolerance_mm || iterations >= self.max_iterations {
-                break;
-            }
-            let mut a = Matrix3::zeros();
-            for i in (0..n).filter(|i| free & (1 << i) != 0) {
-                a += jq[i] * jq[i].transpose() * (sc[i] * sc[i]);
-            }
-            let scale = a.trace() / 3.0;
-            if scale <= 0.0 || !scale.is_finite() {
-                stalled = true;
-                break;
-            }
-            // Levenberg–Marquardt: retry with more damping until the error decreases; the
-            // damping follows the gain ratio (Nielsen's update).
-            let mut accepted = false;
-            let mut nu = 2.0;
-            while mu <= MAX_DAMPING {
-                let m = a + Matrix3::identity() * (mu * scale);
-                let Some(ch) = m.cholesky() else {
-                    mu *= nu;
-                    nu *= 2.0;
-                    continue;
-                };
-                let y = ch.solve(&e);
-                // The step in scaled units u = S J^T y (S = diag(sc)); the joints move by S u.
-                let mut largest = 0.0f64;
-                for i in 0..n {
-                    qt[i] = if free & (1 << i) != 0 {
-                        sc[i] * jq[i].dot(&y)
-                    } else {
-                        0.0
-                    };
-                    largest = largest.max(qt[i].abs());
-                }
-                let shrink = if largest > self.max_step_rad {
-                    self.max_step_rad / largest
-                } else {
-                    1.0
-                };
-                // Predicted error after the step actually taken (after shrinking and clamping).
-                let mut predicted = e;
-                for i in 0..n {
-                    let mut v = q[i] + sc[i] * qt[i] * shrink;
-                    if limits {
-                        v = v.clamp(lim[i].min, lim[i].max);
-                    }
-                    predicted -= jq[i] * (v - q[i]);
-                    qt[i] = v;
-                }
-                let pt = robot.tool_position_jacobians(&qt[..n], Some(&mut jt[..n]), None);
-                iterations += 1;
-                let et = target - pt;
-                let rt = et.norm();
-                if rt < r {
-                    let gain = (r * r - rt * rt) / (r * r - predicted.norm_squared()).max(1e-300);
-                    q.copy_from_slice(&qt[..n]);
-                    std::mem::swap(&mut jq, &mut jt);
-                    e = et;
-                    r = rt;
-                    mu = (mu * (1.0 / 3.0f64).max(1.0 - (2.0 * gain - 1.0).powi(3)))
-                        .max(MIN_DAMPING);
-                    accepted = true;
-                    break;
-                }
-                mu *= nu;
-                nu *= 2.0;
-                if iterations >= self.max_iterations {
-                    break;
-                }
-            }
-            if !accepted {
-                stalled = mu > MAX_DAMPING;
-                break;
-            }
-        }
-        // Classify the stopping point.
-        let StopPoint {
-            blocking,
-            at_limit,
-            max_cosine,
-        } = stop_point(
-            &jq[..n],
-            &e,
-            r,
-            &q[..n],
-            lim,
-            limits,
-            self.stationary_cosine,
-        );
-        let plateau = iterations >= self.max_iterations && r_half - r < PLATEAU * r_half;
-        Run {
-            residual: r,
-            iterations,
-            blocking,
-            at_limit,
-            stationary: stalled || plateau || max_cosine < self.stationary_cosine,
-        }
+            (e, e.norm())
+        };
+        damped::run(n, robot.limits(), &sc, q, limits, &iteration, eval, |&r| {
+            r <= self.tolerance_mm
+        })
     }
 }
 
@@ -259,12 +134,12 @@ impl IkSolver for DampedLeastSquares {
         let run = self.run(robot, target, q, true);
         let report = |status| IkReport {
             status,
-            residual_mm: run.residual,
+            residual_mm: run.at,
             residual_deg: 0.0,
             iterations: run.iterations,
             joints_at_limit: run.at_limit,
         };
-        if run.residual <= self.tolerance_mm {
+        if run.at <= self.tolerance_mm {
             return report(IkStatus::Converged);
         }
         // Where would the solve end without the limits? Continue from here, unconstrained.
@@ -275,7 +150,7 @@ impl IkSolver for DampedLeastSquares {
         } else {
             run
         };
-        if unc.residual <= self.tolerance_mm {
+        if unc.at <= self.tolerance_mm {
             report(IkStatus::JointLimit)
         } else if unc.stationary {
             report(IkStatus::Unreachable)

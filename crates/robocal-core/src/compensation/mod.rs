@@ -22,6 +22,7 @@
 mod checks;
 pub mod commanded;
 pub mod configuration;
+mod damped;
 mod dls;
 mod pose;
 mod stop;

@@ -31,12 +31,12 @@
 //! Allocation-free: everything lives on the stack (`Matrix6`, `Vector6`, arrays of
 //! [`MAX_JOINTS`]).
 
-use super::stop::{stop_point, StopPoint};
+use super::damped::{self, Iteration};
 use super::{IkReport, IkStatus};
 use crate::error::{Error, Result};
 use crate::frame::Frame;
 use crate::model::{JointType, Robot, MAX_JOINTS};
-use nalgebra::{Matrix6, Vector3, Vector6};
+use nalgebra::{Vector3, Vector6};
 
 /// Damped Newton inverse kinematics for the whole tool pose (see the module documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -84,29 +84,8 @@ impl Default for PoseNewton {
     }
 }
 
-const MAX_DAMPING: f64 = 1e8;
-const MIN_DAMPING: f64 = 1e-14;
-/// Relative decrease of the residual over the second half of the budget below which a run that
-/// used it up counts as stopped on a plateau.
-const PLATEAU: f64 = 1e-3;
-
-/// Where one run stopped.
-#[derive(Clone, Copy)]
-struct Run {
-    residual_mm: f64,
-    residual_rad: f64,
-    iterations: usize,
-    blocking: u32,
-    at_limit: u32,
-    stationary: bool,
-}
-
-/// The residual of a pose and the scaled Jacobian columns at it.
-struct Eval {
-    e: Vector6<f64>,
-    ep: f64,
-    ew: f64,
-}
+/// Where one run stopped: the position (mm) and orientation (rad) residuals.
+type Run = damped::Run<(f64, f64)>;
 
 impl PoseNewton {
     /// The defaults.
@@ -160,12 +139,12 @@ impl PoseNewton {
         let run = self.run(robot, target, t, q, true);
         let report = |status| IkReport {
             status,
-            residual_mm: run.residual_mm,
-            residual_deg: run.residual_rad.to_degrees(),
+            residual_mm: run.at.0,
+            residual_deg: run.at.1.to_degrees(),
             iterations: run.iterations,
             joints_at_limit: run.at_limit,
         };
-        if self.within_tolerance(run.residual_mm, run.residual_rad) {
+        if self.within_tolerance(run.at.0, run.at.1) {
             return report(IkStatus::Converged);
         }
         let unc = if run.blocking != 0 {
@@ -175,7 +154,7 @@ impl PoseNewton {
         } else {
             run
         };
-        if self.within_tolerance(unc.residual_mm, unc.residual_rad) {
+        if self.within_tolerance(unc.at.0, unc.at.1) {
             report(IkStatus::JointLimit)
         } else if unc.stationary {
             report(IkStatus::Unreachable)
@@ -188,8 +167,9 @@ impl PoseNewton {
         mm <= self.tolerance_mm && rad.to_degrees() <= self.tolerance_deg
     }
 
-    /// The residual at `q` and the scaled Jacobian columns (one per joint, per scaled joint
-    /// unit) into `cols`.
+    /// The residual at `q` (position rows in units of the length scale) with its position (mm)
+    /// and orientation (rad) norms, and the scaled Jacobian columns (one per joint, per scaled
+    /// joint unit) into `cols`.
     fn eval(
         &self,
         robot: &Robot,
@@ -198,7 +178,7 @@ impl PoseNewton {
         q: &[f64],
         sc: &[f64; MAX_JOINTS],
         cols: &mut [Vector6<f64>; MAX_JOINTS],
-    ) -> Eval {
+    ) -> (Vector6<f64>, (f64, f64)) {
         let n = robot.dof();
         let frames = robot.pose_frames_target(q, t);
         let tool = frames.flange * robot.target_tool_frame(t);
@@ -228,139 +208,32 @@ impl PoseNewton {
             );
         }
         let e = Vector6::new(ep.x / l, ep.y / l, ep.z / l, ew.x, ew.y, ew.z);
-        Eval {
-            e,
-            ep: ep.norm(),
-            ew: ew.norm(),
-        }
+        (e, (ep.norm(), ew.norm()))
     }
 
     /// The iteration on `q` (in place); with `limits`, joints stay within the robot's limits.
     fn run(&self, robot: &Robot, target: &Frame, t: usize, q: &mut [f64], limits: bool) -> Run {
-        let n = robot.dof();
-        let lim = robot.limits();
         let mut sc = [1.0; MAX_JOINTS];
         for (s, ty) in sc.iter_mut().zip(robot.joint_types()) {
             if *ty == JointType::Prismatic {
                 *s = self.prismatic_scale_mm;
             }
         }
-        let mut cols = [Vector6::zeros(); MAX_JOINTS];
-        let mut cols_t = [Vector6::zeros(); MAX_JOINTS];
-        let mut qt = [0.0; MAX_JOINTS];
-        let mut ev = self.eval(robot, target, t, q, &sc, &mut cols);
-        let mut r = ev.e.norm();
-        let mut mu = self.initial_damping;
-        let mut iterations = 1;
-        let mut stalled = false;
-        let mut r_half = f64::INFINITY;
-        loop {
-            if r_half.is_infinite() && 2 * iterations >= self.max_iterations {
-                r_half = r;
-            }
-            let mut free = 0u32;
-            for i in 0..n {
-                let g = cols[i].dot(&ev.e);
-                let blocked =
-                    limits && ((q[i] <= lim[i].min && g < 0.0) || (q[i] >= lim[i].max && g > 0.0));
-                if !blocked {
-                    free |= 1 << i;
-                }
-            }
-            if self.within_tolerance(ev.ep, ev.ew) || iterations >= self.max_iterations {
-                break;
-            }
-            let mut a = Matrix6::zeros();
-            for i in (0..n).filter(|i| free & (1 << i) != 0) {
-                a += cols[i] * cols[i].transpose();
-            }
-            let scale = a.trace() / 6.0;
-            if scale <= 0.0 || !scale.is_finite() {
-                stalled = true;
-                break;
-            }
-            let mut accepted = false;
-            let mut nu = 2.0;
-            while mu <= MAX_DAMPING {
-                let m = a + Matrix6::identity() * (mu * scale);
-                let Some(ch) = m.cholesky() else {
-                    mu *= nu;
-                    nu *= 2.0;
-                    continue;
-                };
-                let y = ch.solve(&ev.e);
-                let mut largest = 0.0f64;
-                for i in 0..n {
-                    qt[i] = if free & (1 << i) != 0 {
-                        cols[i].dot(&y)
-                    } else {
-                        0.0
-                    };
-                    largest = largest.max(qt[i].abs());
-                }
-                let shrink = if largest > self.max_step_rad {
-                    self.max_step_rad / largest
-                } else {
-                    1.0
-                };
-                let mut predicted = ev.e;
-                for i in 0..n {
-                    let mut v = q[i] + sc[i] * qt[i] * shrink;
-                    if limits {
-                        v = v.clamp(lim[i].min, lim[i].max);
-                    }
-                    predicted -= cols[i] * ((v - q[i]) / sc[i]);
-                    qt[i] = v;
-                }
-                let et = self.eval(robot, target, t, &qt[..n], &sc, &mut cols_t);
-                iterations += 1;
-                let rt = et.e.norm();
-                if rt < r {
-                    let gain = (r * r - rt * rt) / (r * r - predicted.norm_squared()).max(1e-300);
-                    q.copy_from_slice(&qt[..n]);
-                    std::mem::swap(&mut cols, &mut cols_t);
-                    ev = et;
-                    r = rt;
-                    mu = (mu * (1.0 / 3.0f64).max(1.0 - (2.0 * gain - 1.0).powi(3)))
-                        .max(MIN_DAMPING);
-                    accepted = true;
-                    break;
-                }
-                mu *= nu;
-                nu *= 2.0;
-                if iterations >= self.max_iterations {
-                    break;
-                }
-            }
-            if !accepted {
-                stalled = mu > MAX_DAMPING;
-                break;
-            }
-        }
-        // Classify the stopping point.
-        let StopPoint {
-            blocking,
-            at_limit,
-            max_cosine,
-        } = stop_point(
-            &cols[..n],
-            &ev.e,
-            r,
-            &q[..n],
-            lim,
+        let iteration = Iteration {
+            max_iterations: self.max_iterations,
+            max_step: self.max_step_rad,
+            initial_damping: self.initial_damping,
+            stationary_cosine: self.stationary_cosine,
+        };
+        damped::run(
+            robot.dof(),
+            robot.limits(),
+            &sc,
+            q,
             limits,
-            self.stationary_cosine,
-        );
-        let plateau = iterations >= self.max_iterations && r_half - r < PLATEAU * r_half;
-        // With fewer joints than equations, every column orthogonal to the residual is the
-        // least-squares optimum: stationary too.
-        Run {
-            residual_mm: ev.ep,
-            residual_rad: ev.ew,
-            iterations,
-            blocking,
-            at_limit,
-            stationary: stalled || plateau || max_cosine < self.stationary_cosine,
-        }
+            &iteration,
+            |q, cols| self.eval(robot, target, t, q, &sc, cols),
+            |&(mm, rad)| self.within_tolerance(mm, rad),
+        )
     }
 }

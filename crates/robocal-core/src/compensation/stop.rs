@@ -1,4 +1,4 @@
-//! Where an inverse-kinematics run stopped, for both solvers (the tool point's
+//! Where an inverse-kinematics run stopped ([`super::damped`], for both solvers: the tool point's
 //! [`super::DampedLeastSquares`] and the full pose's [`super::PoseNewton`]): which joints sit at a
 //! limit, which of those block the way to the target, and how far the residual is from
 //! orthogonal to the free joints' columns (a stationary point of the distance).
