@@ -109,6 +109,17 @@ pub enum FixReason {
         /// The limit it exceeds (display unit).
         limit: f64,
     },
+    /// Held at the bound of its plausible values ([`crate::model::family::plausible`]): the fit
+    /// put it beyond the bound by less than 3 standard deviations, so the data cannot tell it
+    /// from the bound ([`crate::identification::bounds`]).
+    AtBound {
+        /// The value the fit wanted (display unit).
+        value: f64,
+        /// Its standard deviation (display unit).
+        std: f64,
+        /// The bound it is held at (display unit).
+        bound: f64,
+    },
 }
 
 /// A parameter held at its nominal value, with the reason.
@@ -132,6 +143,13 @@ impl FixedParam {
                 format!(
                     "not determined by these data: predicted std {std:.3} {u}, above {limit:.3} \
                      {u} (a third of the largest plausible move)"
+                )
+            }
+            FixReason::AtBound { value, std, bound } => {
+                let u = self.param.unit().as_str();
+                format!(
+                    "held at its plausible bound {bound} {u}: the fit gave {value:.3} +- {std:.3} \
+                     {u}, beyond the bound by less than 3 standard deviations"
                 )
             }
             FixReason::Duplicate { of, .. } => {

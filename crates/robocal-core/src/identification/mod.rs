@@ -14,9 +14,12 @@
 //! - [`prediction`]: the expected error at new poses (noise plus parameter uncertainty);
 //! - [`pipeline`]: registration + all of the above ([`calibrate`]);
 //! - [`plausibility`]: the gate run after every fit (units, handedness, nominal error, parameter
-//!   moves, convergence) and the likely cause of a failure;
+//!   moves and ranges, convergence) and the likely cause of a failure;
+//! - [`bounds`]: bounded parameters (a physical compliance) held at their bound when the data
+//!   cannot tell them from it;
 //! - [`report`]: the result JSON.
 
+pub mod bounds;
 pub mod covariance;
 pub(crate) mod householder;
 pub mod identifiability;

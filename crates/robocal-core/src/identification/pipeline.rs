@@ -10,6 +10,7 @@
 //! errors, for the calibration and for the validation points alike.
 
 use crate::error::{Error, Result};
+use crate::identification::bounds;
 use crate::identification::covariance::Covariance;
 use crate::identification::identifiability::{
     analyze_reduced, jacobian_r, FixReason, Identifiability, IdentifiabilityOptions,
@@ -232,7 +233,45 @@ impl Calibration {
 /// Runs a calibration of `nominal` (see the module docs). `observer` hears the stages
 /// (registration, identifiability, the solver's iterations per objective, uncertainty,
 /// plausibility) as the work advances.
+///
+/// A bounded parameter (a physical compliance) that the fit puts just beyond its bound is held
+/// at it and the calibration repeated ([`bounds`]).
 pub fn calibrate(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    observer: &dyn Observer,
+) -> Result<Calibration> {
+    let first = calibrate_once(nominal, data, settings, observer)?;
+    let start = if first.tool_fit.applied {
+        first.tool_fit.apply(nominal)
+    } else {
+        nominal.clone()
+    };
+    let held = bounds::to_hold(&start, &first.calibrated, &first.covariance);
+    if held.is_empty() {
+        return Ok(first);
+    }
+    let mut again = settings.clone();
+    again
+        .identifiability
+        .fix
+        .extend(held.iter().map(|h| h.param));
+    let mut c = calibrate_once(nominal, data, &again, observer)?;
+    for f in &mut c.identifiability.fixed {
+        if let Some(h) = held.iter().find(|h| h.param == f.param) {
+            f.reason = FixReason::AtBound {
+                value: h.value,
+                std: h.std,
+                bound: h.bound,
+            };
+        }
+    }
+    c.settings = settings.clone();
+    Ok(c)
+}
+
+fn calibrate_once(
     nominal: &Robot,
     data: CalibrationData,
     settings: &CalibrationSettings,

@@ -9,27 +9,26 @@
 //! predicted as `sigma0^2 (J^T W J)^-1` with `sigma0` the per-axis RMS error of the nominal
 //! geometry with the fitted tools (an upper bound of the noise: it still contains the geometric
 //! errors, so the prediction is conservative). A parameter whose predicted standard deviation
-//! exceeds a third of the largest move the plausibility gate accepts (3 sigma beyond it: 5% of
-//! the reach for lengths, 10 degrees for angles) is fixed, the worst first, and the others are
+//! exceeds a third of the largest move the plausibility gate accepts (3 sigma beyond it: its
+//! family's plausible move, [`crate::model::family::plausible`]: 5% of the reach for lengths, 10
+//! degrees for angles, one degree of joint deflection for compliances and transmission errors)
+//! is fixed, the worst first, and the others are
 //! predicted again without it, until every identified parameter is within its limit. The pass
 //! is skipped when the nominal model misses the data by more than the gate's nominal-error limit
 //! (wrong units, another robot): the bound then means nothing and the gate names the cause.
 
 use crate::identification::objective::Loss;
-use crate::identification::plausibility::{ANGLE_MOVE_LIMIT_DEG, LENGTH_MOVE_LIMIT};
 use crate::identification::system::{Level, Problem};
-use crate::model::{Param, Robot, Unit};
+use crate::model::family::plausible;
+use crate::model::{Param, Robot};
 use nalgebra::DMatrix;
 
-/// The limit of a parameter's predicted standard deviation (display unit): a third of the
-/// plausibility gate's largest move, for lengths and angles; `None` for parameters of other
-/// units (compliances), which the gate does not bound.
+/// The limit of a parameter's predicted standard deviation (display unit): a third of its
+/// family's plausible move ([`plausible::Plausible::max_move`]), for every family: lengths,
+/// angles, compliances, transmission harmonics, reflector offsets.
 pub fn std_limit(robot: &Robot, p: Param) -> Option<f64> {
-    match p.unit() {
-        Unit::Mm => Some(LENGTH_MOVE_LIMIT * robot.reach_mm() / 3.0),
-        Unit::Deg => Some(ANGLE_MOVE_LIMIT_DEG / 3.0),
-        _ => None,
-    }
+    let m = plausible::of(robot, p).max_move;
+    (m.is_finite() && m > 0.0).then_some(m / 3.0)
 }
 
 /// A parameter the data cannot pin, with its predicted standard deviation and the limit (display

@@ -118,6 +118,7 @@ impl Calibration {
                         (FixKind::NoEffect, None, None)
                     }
                     FixReason::Undetermined { .. } => (FixKind::Undetermined, None, None),
+                    FixReason::AtBound { .. } => (FixKind::AtBound, None, None),
                     FixReason::Duplicate { of, independence } => (
                         FixKind::Duplicate,
                         Some(*independence),

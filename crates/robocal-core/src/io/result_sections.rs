@@ -286,6 +286,9 @@ pub enum FixKind {
     Duplicate,
     /// The data cannot pin it (predicted std above a third of the plausible move).
     Undetermined,
+    /// Held at the bound of its plausible values (a physical compliance at 0): the fit wanted a
+    /// value beyond it by less than 3 standard deviations.
+    AtBound,
 }
 
 /// A parameter whose effect another one duplicates, with the coefficient.

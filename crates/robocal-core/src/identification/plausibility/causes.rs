@@ -60,6 +60,12 @@ impl Causes<'_> {
             );
         }
         match kind {
+            CheckKind::ParameterRanges => "the data ask more of a compliance or transmission \
+                 error than a real joint can give: the family absorbs an error of another kind \
+                 (a wrong payload, a geometric error the model lacks, outliers), or the poses \
+                 hardly excite it. Fix that parameter (identification setting `fix`), leave the \
+                 family out, or measure poses that load the joint"
+                .to_string(),
             CheckKind::Units => format!(
                 "the data are {} times the size of the nominal model, which is no length unit: a \
                  different robot{radians_hint}",

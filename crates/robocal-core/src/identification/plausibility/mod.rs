@@ -19,6 +19,7 @@
 
 mod causes;
 pub mod diagnosis;
+mod ranges;
 pub mod similarity;
 
 #[cfg(test)]
@@ -26,6 +27,7 @@ mod tests;
 
 use crate::identification::solver::SolverReport;
 use crate::io::result_sections::{CauseEntry, CheckEntry, PlausibilitySection};
+use crate::model::family::plausible;
 use crate::model::{Param, Robot, Unit};
 use crate::observations::Observations;
 use crate::registration::Registration;
@@ -68,19 +70,13 @@ pub const HANDEDNESS_LIMIT: f64 = 0.5;
 /// realistic); bad data: 14.3% and more.
 pub const NOMINAL_ERROR_LIMIT: f64 = 0.05;
 
-/// Parameter moves: no identified length (link, base or tool) may move by more than this fraction
-/// of the reach. The registration absorbs the rigid motion between the tracker and the base, so
-/// the base moves only by the residual corrections (and what it absorbs of d1, a1, alpha1,
-/// phi1), the same size as the links'; the tool moves by the uncertainty of its nominal value,
-/// a few millimetres, so it shares the limit. Good data: at most 1.08% (real WAM, tool_z 11 mm),
-/// 0.17% (simulated, realistic errors), 1.7% (10 times realistic); bad data: 27.6% and more.
-pub const LENGTH_MOVE_LIMIT: f64 = 0.05;
+/// Parameter moves: no identified length may move by more than this fraction of the reach
+/// (see [`plausible::LENGTH_MOVE_FRACTION`], the families' table).
+pub const LENGTH_MOVE_LIMIT: f64 = plausible::LENGTH_MOVE_FRACTION;
 
-/// Parameter moves: no identified angle may move by more than this (degrees). Good data: at most
-/// 3.18 degrees (real WAM alpha6, where a 104 mm wrist-to-tool distance is a short lever), 0.46
-/// (simulated, realistic errors), 4.5 (10 times realistic); bad data: 82 degrees and more where
-/// angles move at all (a unit error on the KR 480 or the WAM moves only lengths, which fail).
-pub const ANGLE_MOVE_LIMIT_DEG: f64 = 10.0;
+/// Parameter moves: no identified geometric angle may move by more than this (degrees; see
+/// [`plausible::ANGLE_MOVE_DEG`]).
+pub const ANGLE_MOVE_LIMIT_DEG: f64 = plausible::ANGLE_MOVE_DEG;
 
 /// What a check measures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -99,6 +95,9 @@ pub enum CheckKind {
     LengthMoves,
     /// The largest move of an identified angle.
     AngleMoves,
+    /// Every identified parameter of a family acting through the joints (compliance,
+    /// transmission errors) within its family's plausible range.
+    ParameterRanges,
 }
 
 impl CheckKind {
@@ -112,6 +111,7 @@ impl CheckKind {
             CheckKind::ValidationNominalError => "validation_nominal_error",
             CheckKind::LengthMoves => "length_moves",
             CheckKind::AngleMoves => "angle_moves",
+            CheckKind::ParameterRanges => "parameter_ranges",
         }
     }
 }
@@ -214,7 +214,7 @@ fn check(
 fn largest_move(fit: &Fit, unit: Unit) -> Option<(Param, f64)> {
     fit.identified
         .iter()
-        .filter(|p| p.unit() == unit)
+        .filter(|p| p.unit() == unit && !p.family().deflects_joints(fit.start))
         .map(|&p| {
             let nominal = if fit.start.has_param(p) {
                 fit.start.get(p)
@@ -392,6 +392,8 @@ pub fn assess(fit: &Fit) -> Plausibility {
             None => "no angle identified".into(),
         },
     ));
+
+    checks.push(ranges::check_non_geometric(fit));
 
     let data_suspect = checks
         .iter()

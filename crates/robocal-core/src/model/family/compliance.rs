@@ -180,6 +180,30 @@ impl ParameterFamily for Compliance {
         super::priority::NON_GEOMETRIC + 100 * p.index() as u32 + p.template() as u32
     }
 
+    /// Lumped coefficients: one degree of joint deflection at the reach, either sign (a
+    /// counterbalance or a lumped point beyond a mass can turn the lever). A physical compliance:
+    /// never negative, at most [`super::plausible::COMPLIANCE_MAX_URAD_PER_NM`] and at most one
+    /// degree of deflection under the payload at the reach.
+    fn plausible(&self, robot: &Robot, p: Param) -> super::plausible::Plausible {
+        use super::plausible::{Plausible, COMPLIANCE_MAX_URAD_PER_NM, JOINT_DEFLECTION_DEG};
+        if p.template() != COMPLIANCE {
+            return Plausible::geometric(robot, Unit::MicroradPerM);
+        }
+        let torque_nm = payload_kg(robot).unwrap_or(0.0) * G0 * robot.reach_mm() / 1000.0;
+        let by_deflection = JOINT_DEFLECTION_DEG.to_radians() * 1e6 / torque_nm;
+        let max = COMPLIANCE_MAX_URAD_PER_NM.min(by_deflection);
+        Plausible {
+            max_move: max,
+            min: 0.0,
+            max,
+            why: if max < COMPLIANCE_MAX_URAD_PER_NM {
+                "never negative, at most 1 degree of deflection under the payload at the reach"
+            } else {
+                "never negative, at most 1e-3 rad per N·m"
+            },
+        }
+    }
+
     fn enable(&self, robot: &mut Robot, p: Param) -> Result<()> {
         let i = p.index();
         if i >= robot.dof() || robot.joint_type(i) != JointType::Revolute {

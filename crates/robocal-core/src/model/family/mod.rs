@@ -26,6 +26,7 @@ pub mod base;
 pub mod beta;
 pub mod compliance;
 pub mod link;
+pub mod plausible;
 pub mod reflector;
 pub mod tool;
 pub mod transmission;
@@ -103,6 +104,13 @@ pub trait ParameterFamily: Sync {
 
     /// The parameter's priority class for the identifiability analysis (see [`priority`]).
     fn priority(&self, robot: &Robot, p: Param) -> u32;
+
+    /// The parameter's plausible range on `robot` (see [`plausible`]): the identifiability
+    /// analysis, the plausibility gate and the bounds of the fit all read it. The default is the
+    /// geometric one of its unit ([`plausible::Plausible::geometric`]).
+    fn plausible(&self, robot: &Robot, p: Param) -> plausible::Plausible {
+        plausible::Plausible::geometric(robot, self.unit(p))
+    }
 
     /// The Jacobian columns of this family's parameters (in [`ParameterFamily::params`] order) at
     /// one pose: `dp[k]`, the tool point's velocity, and, when `dw` is given, the tool frame's

@@ -113,6 +113,15 @@ impl ParameterFamily for Transmission {
         super::priority::NON_GEOMETRIC + 50_000 + 100 * p.index() as u32 + p.template() as u32
     }
 
+    /// An amplitude of at most [`super::plausible::JOINT_DEFLECTION_DEG`]: sixty times a robot
+    /// gear's transmission error of about one arc minute.
+    fn plausible(&self, _robot: &Robot, _p: Param) -> super::plausible::Plausible {
+        super::plausible::Plausible::moving(
+            super::plausible::JOINT_DEFLECTION_DEG,
+            "1 degree, sixty times a gear's transmission error",
+        )
+    }
+
     fn enable(&self, robot: &mut Robot, p: Param) -> Result<()> {
         let i = p.index();
         if i >= robot.dof() || robot.joint_type(i) != JointType::Revolute {
