@@ -566,6 +566,17 @@ fn calibrate_once(
         downweighted.sort_by(|a, b| b.error_mm.total_cmp(&a.error_mm));
     }
     observer.progress(progress::Stage::Plausibility, 0, 1);
+    // The gate judges the model the identification started from (the nominal geometry with
+    // the fitted tools): Table II's second line, and the validation points under it.
+    let (nominal_rms_mm, validation_start) = if tool_fit.applied {
+        let v = data
+            .validation
+            .filter(|v| !v.is_empty() && !settings.validation_refit_frame)
+            .map(|v| Problem::new(&start, &[], v, frame).error_norms(&start));
+        (tool_fit.stats.rms_mm, v)
+    } else {
+        (registration.stats.rms_mm, None)
+    };
     let plausibility = plausibility::assess(&plausibility::Fit {
         nominal,
         start: &start,
@@ -573,7 +584,10 @@ fn calibrate_once(
         identified: &ident.identified,
         calibration: cal,
         registration: &registration,
-        validation_before: validation.as_ref().map(|v| v.before.as_slice()),
+        nominal_rms_mm,
+        validation_before: validation_start
+            .as_deref()
+            .or(validation.as_ref().map(|v| v.before.as_slice())),
         solver: &stages.last().expect("at least one stage").report,
         max_iterations: settings.solver.max_iterations,
     });

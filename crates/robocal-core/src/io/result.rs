@@ -262,11 +262,26 @@ impl CalibrationResult {
         Ok(r)
     }
 
-    /// Writes the result atomically as pretty JSON.
+    /// Writes the result atomically as pretty JSON, after reading the text back as every command
+    /// that takes a result does ([`CalibrationResult::parse`], then the calibrated model): what
+    /// robocal writes, robocal reads. A result its readers would refuse (a value outside its
+    /// range) is not written: [`Error::Implausible`] names the field.
     pub fn write(&self, path: &Path) -> Result<()> {
         let mut s = serde_json::to_string_pretty(self)
             .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
         s.push('\n');
+        let readable = Self::parse(&s, path).and_then(|back| {
+            match back.robot.nominal_robot(path, Some(&s))? {
+                Some(nominal) => back.calibrated_robot(&nominal, path).map(|_| ()),
+                None => Ok(()),
+            }
+        });
+        if let Err(e) = readable {
+            return Err(Error::Implausible(format!(
+                "the result cannot be right: robocal's own readers (evaluate, compensate, report, \
+                 export, fk) would refuse it, so it is not written: {e}"
+            )));
+        }
         crate::io::atomic::write_atomic(path, s.as_bytes())
     }
 

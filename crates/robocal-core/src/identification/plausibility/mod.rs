@@ -163,7 +163,11 @@ pub struct Fit<'a> {
     pub calibration: &'a Observations,
     /// The fitted measurement frame and Table II.
     pub registration: &'a Registration,
-    /// Table II error norms of the validation points, if any (mm).
+    /// The RMS error (mm) of the model the identification started from ([`Fit::start`]) in its
+    /// frame: Table II's second line (the nominal geometry with the fitted tools) when the tools
+    /// were fitted, else its first. A tool the user did not know is not an error of the robot.
+    pub nominal_rms_mm: f64,
+    /// Error norms of the validation points under the same model (mm), if any.
     pub validation_before: Option<&'a [f64]>,
     /// The last solver run.
     pub solver: &'a SolverReport,
@@ -233,7 +237,7 @@ fn largest_move(fit: &Fit, unit: Unit) -> Option<(Param, f64)> {
 
 /// Runs every check on a fit and, if one fails, looks for the likely cause.
 pub fn assess(fit: &Fit) -> Plausibility {
-    let reach = reach_mm(fit.nominal);
+    let reach = reach_mm(fit.start);
     let mut checks = Vec::new();
 
     let converged = fit.solver.termination.converged();
@@ -252,7 +256,7 @@ pub fn assess(fit: &Fit) -> Plausibility {
     ));
 
     let measured = fit.calibration.measured();
-    let model = fit.calibration.model_positions(fit.nominal);
+    let model = fit.calibration.model_positions(fit.start);
     let rigid = fit_similarity(measured, &model, Handedness::Rotation, false);
     let scaled = fit_similarity(measured, &model, Handedness::Rotation, true);
     let mirrored = fit_similarity(measured, &model, Handedness::Reflection, true);
@@ -336,7 +340,7 @@ pub fn assess(fit: &Fit) -> Plausibility {
             100.0 * NOMINAL_ERROR_LIMIT
         )
     };
-    let rms2 = fit.registration.stats.rms_mm;
+    let rms2 = fit.nominal_rms_mm;
     checks.push(check(
         CheckKind::NominalError,
         rms2,

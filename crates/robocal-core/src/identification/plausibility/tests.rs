@@ -322,6 +322,7 @@ fn parameter_move_checks_catch_lengths_and_angles_beyond_calibration() {
             identified: &c.identifiability.identified,
             calibration: &obs,
             registration: &c.registration,
+            nominal_rms_mm: c.registration.stats.rms_mm,
             validation_before: None,
             solver: c.solver(),
             max_iterations: 1000,
