@@ -588,6 +588,15 @@ fn calibrate_once(
         validation_before: validation_start
             .as_deref()
             .or(validation.as_ref().map(|v| v.before.as_slice())),
+        validation_after: validation.as_ref().map(|v| v.after.as_slice()),
+        calibration_before: if tool_fit.applied {
+            &tool_fit.residuals
+        } else {
+            &calibration.before
+        },
+        downweighted: downweighted.len(),
+        prediction_mean_mm: prediction.as_ref().map(|p| p.mean_mm),
+        noise_sigma_mm: prediction.as_ref().map(|p| p.noise_sigma_mm),
         solver: &stages.last().expect("at least one stage").report,
         max_iterations: settings.solver.max_iterations,
     });

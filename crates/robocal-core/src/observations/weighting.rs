@@ -62,6 +62,48 @@ pub const TYPICAL_TRACKER: TrackerSigma = TrackerSigma {
 /// distance from the tracker.
 pub const TRACKER_FRAME_MIN_DISTANCE_MM: f64 = 500.0;
 
+/// The smallest `sigma_mm` accepted, as a fraction of the median `sigma_mm`: a point ten times
+/// more certain than the typical one weighs a hundred of them in a fit, enough to pin the fit to
+/// it alone when it is wrong (one point 3 mm off with a sigma a hundredth of the others' dragged
+/// a fit to worse than the nominal model). Real uncertainties of one tracker session differ by
+/// the distance term, a factor of 2 to 5.
+pub const SIGMA_FLOOR_RATIO: f64 = 0.1;
+
+/// The largest `sigma_mm` accepted, as a multiple of the median `sigma_mm`: a point a hundred
+/// times less certain than the typical one weighs a ten-thousandth of it, which is leaving it
+/// out without saying so; such a point is better removed.
+pub const SIGMA_CEILING_RATIO: f64 = 100.0;
+
+/// Checks that every observation's `sigma_mm` lies within [`SIGMA_FLOOR_RATIO`] and
+/// [`SIGMA_CEILING_RATIO`] of their median, naming the first that does not (file, line, field).
+pub fn check_sigma_spread(obs: &Observations) -> Result<()> {
+    let sigmas: Vec<f64> = (0..obs.len()).filter_map(|i| obs.sigma_mm(i)).collect();
+    if sigmas.len() != obs.len() || sigmas.is_empty() {
+        return Ok(());
+    }
+    let median = crate::stats::percentile(&sigmas, 0.5);
+    for (i, &s) in sigmas.iter().enumerate() {
+        let (limit, what) = if s < SIGMA_FLOOR_RATIO * median {
+            (SIGMA_FLOOR_RATIO, "below")
+        } else if s > SIGMA_CEILING_RATIO * median {
+            (SIGMA_CEILING_RATIO, "above")
+        } else {
+            continue;
+        };
+        return Err(Error::invalid(
+            format!("{}: sigma_mm", obs.describe(obs.line(i))),
+            format!(
+                "{s} mm is {what} {limit} times the median uncertainty of the points ({median} \
+                 mm): its weight would be {:.3e} times a typical point's. A point far more \
+                 certain than the others pins the fit to itself, one far less certain is left \
+                 out without a word; check the value, or remove the point",
+                (median / s).powi(2)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// How a fit weights observations (see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Weighting {
@@ -146,6 +188,7 @@ impl Weighting {
     /// `obs` with these weights applied: the tracker model's sigmas where the observations have
     /// none, and the orientation weight.
     pub fn apply(&self, obs: &Observations) -> Result<Observations> {
+        check_sigma_spread(obs)?;
         let mut out = obs.clone();
         out.set_mm_per_deg(self.mm_per_deg)?;
         if let (Some(t), false) = (self.tracker, obs.has_sigma()) {

@@ -60,6 +60,24 @@ impl Causes<'_> {
             );
         }
         match kind {
+            CheckKind::Improvement => "the fit was pulled away from the data: a point with far \
+                 too small an uncertainty, a group of inconsistent points (another reflector, \
+                 another set-up), or a model family the data cannot support; check the points \
+                 the fit lists and the uncertainties"
+                .to_string(),
+            CheckKind::DiscardedPoints => "a large part of the data disagrees with the rest: \
+                 rows of another reflector or tool, another set-up or tracker station, joint \
+                 values with an offset on some rows; the points listed as down-weighted show \
+                 which"
+                .to_string(),
+            CheckKind::Residuals => "the model cannot explain the data to anywhere near the \
+                 measurement's uncertainty: inconsistent rows (another reflector, a joint offset \
+                 on part of the data), an error the model lacks (compliance, backlash), or an \
+                 uncertainty far smaller than the measurement's (the tracker model, `sigma_mm`)"
+                .to_string(),
+            CheckKind::WeightShare => "one point's uncertainty (`sigma_mm`) is so much smaller \
+                 than the others' that it alone decides the fit; check its value"
+                .to_string(),
             CheckKind::ParameterRanges => "the data ask more of a compliance or transmission \
                  error than a real joint can give: the family absorbs an error of another kind \
                  (a wrong payload, a geometric error the model lacks, outliers), or the poses \

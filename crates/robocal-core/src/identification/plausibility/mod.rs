@@ -20,6 +20,7 @@
 mod causes;
 pub mod diagnosis;
 mod ranges;
+pub mod statistics;
 pub mod similarity;
 
 #[cfg(test)]
@@ -98,6 +99,14 @@ pub enum CheckKind {
     /// Every identified parameter of a family acting through the joints (compliance,
     /// transmission errors) within its family's plausible range.
     ParameterRanges,
+    /// The calibrated model no worse than the model it started from.
+    Improvement,
+    /// The share of points beyond the robust loss's threshold.
+    DiscardedPoints,
+    /// The residuals against the noise model.
+    Residuals,
+    /// The largest share of the total weight on one point.
+    WeightShare,
 }
 
 impl CheckKind {
@@ -112,6 +121,10 @@ impl CheckKind {
             CheckKind::LengthMoves => "length_moves",
             CheckKind::AngleMoves => "angle_moves",
             CheckKind::ParameterRanges => "parameter_ranges",
+            CheckKind::Improvement => "improvement",
+            CheckKind::DiscardedPoints => "discarded_points",
+            CheckKind::Residuals => "residuals",
+            CheckKind::WeightShare => "weight_share",
         }
     }
 }
@@ -169,6 +182,17 @@ pub struct Fit<'a> {
     pub nominal_rms_mm: f64,
     /// Error norms of the validation points under the same model (mm), if any.
     pub validation_before: Option<&'a [f64]>,
+    /// Error norms of the validation points under the calibrated model (mm), if any.
+    pub validation_after: Option<&'a [f64]>,
+    /// Error norms of the calibration points under the model the identification started from
+    /// (mm).
+    pub calibration_before: &'a [f64],
+    /// The number of calibration points beyond the robust loss's threshold.
+    pub downweighted: usize,
+    /// The predicted mean error at new poses (mm), when available.
+    pub prediction_mean_mm: Option<f64>,
+    /// The per-axis noise of the calibrated model's residuals (mm), when available.
+    pub noise_sigma_mm: Option<f64>,
     /// The last solver run.
     pub solver: &'a SolverReport,
     /// The solver's iteration limit.
@@ -398,6 +422,10 @@ pub fn assess(fit: &Fit) -> Plausibility {
     ));
 
     checks.push(ranges::check_non_geometric(fit));
+    checks.push(statistics::improvement(fit));
+    checks.push(statistics::discarded(fit));
+    checks.push(statistics::residuals(fit));
+    checks.push(statistics::weight_share(fit));
 
     let data_suspect = checks
         .iter()

@@ -61,17 +61,67 @@ fn excess(fit: &Fit, p: crate::model::Param) -> Excess {
     }
 }
 
+/// The largest joint deflection (degrees) the calibrated model's families acting through the
+/// joints give over the calibration poses, with the joint (0-based) and the point.
+fn largest_deflection(fit: &Fit) -> Option<(f64, usize, usize)> {
+    let robot = fit.calibrated;
+    if !robot.deflects_joints() {
+        return None;
+    }
+    let obs = fit.calibration;
+    let mut buf = [0.0; crate::model::MAX_JOINTS];
+    let mut worst: Option<(f64, usize, usize)> = None;
+    for i in 0..obs.len() {
+        let q = obs.q(i);
+        let d = robot.deflected(q, &mut buf);
+        for (j, (a, b)) in d.iter().zip(q).enumerate() {
+            let deg = (a - b).abs().to_degrees();
+            if worst.map_or(true, |w| deg > w.0) {
+                worst = Some((deg, j, i));
+            }
+        }
+    }
+    worst
+}
+
 /// The `parameter_ranges` check: the worst identified parameter of a family acting through the
-/// joints, against its plausible range (measured: its move over the plausible move, above 1 also
-/// when its value lies outside the range; limit 1).
+/// joints against its plausible range (its move over the plausible move, above 1 also when its
+/// value lies outside the range), and the joint deflection those families give over the
+/// calibration poses against [`plausible::JOINT_DEFLECTION_DEG`] (limit 1 for the ratio).
 pub(super) fn check_non_geometric(fit: &Fit) -> Check {
-    let worst = fit
+    let mut worst = fit
         .identified
         .iter()
-        .filter(|p| p.family().deflects_joints(fit.start))
+        .filter(|p| {
+            p.family().deflects_joints(fit.start) && plausible::of(fit.start, **p).individual
+        })
         .map(|&p| excess(fit, p))
         .max_by(|a, b| a.ratio.total_cmp(&b.ratio));
-    match worst {
+    let any = fit
+        .identified
+        .iter()
+        .any(|p| p.family().deflects_joints(fit.start));
+    if any {
+        if let Some((deg, j, i)) = largest_deflection(fit) {
+            let ratio = deg / plausible::JOINT_DEFLECTION_DEG;
+            if worst.as_ref().map_or(true, |w| ratio > w.ratio) {
+                let obs = fit.calibration;
+                worst = Some(Excess {
+                    name: format!("the deflection of joint {}", j + 1),
+                    ratio,
+                    detail: format!(
+                        "the compliance and transmission parameters turn joint {} by {} deg at \
+                         {}; plausible: {} deg",
+                        j + 1,
+                        sig(deg),
+                        obs.describe(obs.line(i)),
+                        plausible::JOINT_DEFLECTION_DEG
+                    ),
+                });
+            }
+        }
+    }
+    match worst.filter(|_| any) {
         None => check(
             CheckKind::ParameterRanges,
             0.0,

@@ -324,6 +324,11 @@ fn parameter_move_checks_catch_lengths_and_angles_beyond_calibration() {
             registration: &c.registration,
             nominal_rms_mm: c.registration.stats.rms_mm,
             validation_before: None,
+            validation_after: None,
+            calibration_before: &c.calibration.before,
+            downweighted: c.downweighted.len(),
+            prediction_mean_mm: c.prediction.as_ref().map(|p| p.mean_mm),
+            noise_sigma_mm: c.prediction.as_ref().map(|p| p.noise_sigma_mm),
             solver: c.solver(),
             max_iterations: 1000,
         })

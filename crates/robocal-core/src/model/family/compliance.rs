@@ -133,6 +133,24 @@ fn levers_on(robot: &Robot, rigid: &RigidPose, i: usize) -> [f64; MAX_JOINTS + 1
     out
 }
 
+/// The longest lever (mm) lumped point `k` (the origin of axis frame k; `k = n`: the tool
+/// point) can have about joint `i`: the lengths of the links between them (and the tool's), at
+/// least 1 mm. A coefficient's plausible range is one degree of deflection at this lever.
+pub fn lever_bound_mm(robot: &Robot, i: usize, k: usize) -> f64 {
+    let n = robot.dof();
+    let links: f64 = robot.links()[i.min(n)..(k + 1).min(n)]
+        .iter()
+        .map(|l| l.a.abs() + l.d.abs())
+        .sum();
+    let tool = if k >= n {
+        let t = robot.target_tool0(0);
+        (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt()
+    } else {
+        0.0
+    };
+    (links + tool).max(1.0)
+}
+
 /// N·m of torque per mm of lever of the payload's weight (physical mode), else 1.
 fn tool_scale(v: &[f64]) -> f64 {
     if physical(v) {
@@ -180,27 +198,41 @@ impl ParameterFamily for Compliance {
         super::priority::NON_GEOMETRIC + 100 * p.index() as u32 + p.template() as u32
     }
 
-    /// Lumped coefficients: one degree of joint deflection at the reach, either sign (a
-    /// counterbalance or a lumped point beyond a mass can turn the lever). A physical compliance:
-    /// never negative, at most [`super::plausible::COMPLIANCE_MAX_URAD_PER_NM`] and at most one
-    /// degree of deflection under the payload at the reach.
+    /// One degree of joint deflection at the longest lever the coefficient's point can have
+    /// about its joint ([`lever_bound_mm`]): a lumped coefficient of either sign (a
+    /// counterbalance or a lumped point beyond a mass can turn the lever); a physical compliance,
+    /// never negative, also at most [`super::plausible::COMPLIANCE_MAX_URAD_PER_NM`].
     fn plausible(&self, robot: &Robot, p: Param) -> super::plausible::Plausible {
         use super::plausible::{Plausible, COMPLIANCE_MAX_URAD_PER_NM, JOINT_DEFLECTION_DEG};
+        let n = robot.dof();
+        let k = match p.template() {
+            TOOL | COMPLIANCE => n,
+            k => k,
+        };
+        let lever_mm = lever_bound_mm(robot, p.index(), k);
+        let deflection = JOINT_DEFLECTION_DEG.to_radians();
         if p.template() != COMPLIANCE {
-            return Plausible::geometric(robot, Unit::MicroradPerM);
+            return Plausible {
+                individual: false,
+                ..Plausible::moving(
+                    Unit::MicroradPerM.from_internal(deflection / lever_mm),
+                    "1 degree of joint deflection at the longest lever of its point",
+                )
+            };
         }
-        let torque_nm = payload_kg(robot).unwrap_or(0.0) * G0 * robot.reach_mm() / 1000.0;
-        let by_deflection = JOINT_DEFLECTION_DEG.to_radians() * 1e6 / torque_nm;
+        let torque_nm = payload_kg(robot).unwrap_or(0.0) * G0 * lever_mm / 1000.0;
+        let by_deflection = Unit::MicroradPerNm.from_internal(deflection / torque_nm);
         let max = COMPLIANCE_MAX_URAD_PER_NM.min(by_deflection);
         Plausible {
             max_move: max,
             min: 0.0,
             max,
             why: if max < COMPLIANCE_MAX_URAD_PER_NM {
-                "never negative, at most 1 degree of deflection under the payload at the reach"
+                "never negative, at most 1 degree of deflection under the payload"
             } else {
                 "never negative, at most 1e-3 rad per N·m"
             },
+            individual: true,
         }
     }
 

@@ -45,6 +45,12 @@ pub struct Plausible {
     pub max: f64,
     /// Why the range is where it is, in a few words, for messages.
     pub why: &'static str,
+    /// Whether the gate bounds this parameter's move on its own. The lumped gravity coefficients
+    /// of one joint trade against each other (neighbouring points' levers are nearly
+    /// proportional), so a single one may be large while their sum, the joint's deflection,
+    /// stays small: for them the gate bounds the deflection over the poses instead
+    /// ([`JOINT_DEFLECTION_DEG`]); their move still sets the identifiability limit.
+    pub individual: bool,
 }
 
 impl Plausible {
@@ -55,6 +61,7 @@ impl Plausible {
             min: f64::NEG_INFINITY,
             max: f64::INFINITY,
             why,
+            individual: true,
         }
     }
 
@@ -74,11 +81,15 @@ impl Plausible {
                 min: 0.0,
                 max: COMPLIANCE_MAX_URAD_PER_NM,
                 why: "1e-3 rad per N·m, never negative",
+                individual: true,
             },
-            Unit::MicroradPerM => Plausible::moving(
-                deflection_per_m(robot),
-                "1 degree of joint deflection at the robot's reach",
-            ),
+            Unit::MicroradPerM => Plausible {
+                individual: false,
+                ..Plausible::moving(
+                    deflection_per_m(robot),
+                    "1 degree of joint deflection at the robot's reach",
+                )
+            },
         }
     }
 
