@@ -830,8 +830,11 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
             if c.downweighted.is_empty() { "" } else { ":" }
         );
         for d in &c.downweighted {
+            let orientation = d
+                .orientation_deg
+                .map_or(String::new(), |a| format!(", orientation {a:.4} deg"));
             println!(
-                "  line {:>5}: error {:.4} mm, weight {:.4}",
+                "  line {:>5}: error {:.4} mm{orientation}, weight {:.4}",
                 d.line, d.error_mm, d.weight
             );
         }

@@ -157,8 +157,44 @@ pub struct DownWeighted {
     pub line: usize,
     /// Error norm under the calibrated model (mm).
     pub error_mm: f64,
+    /// Orientation error under the calibrated model (deg), for 6-DoF rows.
+    pub orientation_deg: Option<f64>,
     /// Its weight relative to a perfectly fitting point (1).
     pub weight: f64,
+}
+
+impl DownWeighted {
+    /// The observations whose residual as the loss sees it (position and orientation rows,
+    /// weighted; [`Problem::fit_norms`]) exceeds the robust scale `c` (mm), worst first: an
+    /// orientation row far off is listed like a position far off.
+    fn list(
+        problem: &Problem,
+        robot: &Robot,
+        errors: &SetErrors,
+        loss: &Loss,
+        c: f64,
+    ) -> Vec<DownWeighted> {
+        let norms = problem.fit_norms(robot);
+        let mut out: Vec<(f64, DownWeighted)> = norms
+            .iter()
+            .enumerate()
+            .filter(|(_, &r)| r > c)
+            .map(|(i, &r)| {
+                (
+                    r,
+                    DownWeighted {
+                        index: i,
+                        line: errors.lines[i],
+                        error_mm: errors.after[i],
+                        orientation_deg: errors.orientation_deg.as_ref().map(|(_, a)| a[i]),
+                        weight: loss.weight(r),
+                    },
+                )
+            })
+            .collect();
+        out.sort_by(|a, b| b.0.total_cmp(&a.0));
+        out.into_iter().map(|(_, d)| d).collect()
+    }
 }
 
 /// The outcome of [`calibrate`].
@@ -551,20 +587,9 @@ fn calibrate_once(
             Some(e)
         }
     };
-    let mut downweighted = Vec::new();
-    if let Some(c) = robust_scale {
-        for (i, &r) in calibration.after.iter().enumerate() {
-            if r > c {
-                downweighted.push(DownWeighted {
-                    index: i,
-                    line: cal.line(i),
-                    error_mm: r,
-                    weight: final_loss.weight(r),
-                });
-            }
-        }
-        downweighted.sort_by(|a, b| b.error_mm.total_cmp(&a.error_mm));
-    }
+    let downweighted = robust_scale.map_or_else(Vec::new, |c| {
+        DownWeighted::list(&problem, &robot, &calibration, &final_loss, c)
+    });
     observer.progress(progress::Stage::Plausibility, 0, 1);
     // The gate judges the model the identification started from (the nominal geometry with
     // the fitted tools): Table II's second line, and the validation points under it.

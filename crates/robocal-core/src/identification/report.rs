@@ -306,6 +306,7 @@ impl Calibration {
                 .map(|d| DownweightedEntry {
                     line: d.line,
                     error_mm: d.error_mm,
+                    orientation_deg: d.orientation_deg,
                     weight: d.weight,
                 })
                 .collect(),

@@ -457,6 +457,9 @@ pub struct DownweightedEntry {
     /// Its error (mm).
     #[serde(deserialize_with = "nullable::f64")]
     pub error_mm: f64,
+    /// Its orientation error (deg), for 6-DoF rows.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orientation_deg: Option<f64>,
     /// Its final weight.
     #[serde(deserialize_with = "nullable::f64")]
     pub weight: f64,

@@ -122,7 +122,14 @@ impl ExtrasLayout {
                     &set.path,
                     Some(row.line),
                     Some(SIGMA_COLUMN),
-                    format!("{s} is not a plausible uncertainty (mm, above 0)"),
+                    format!(
+                        "{} is not a plausible uncertainty (mm, above 0 and at most 1000)",
+                        if (1e-4..1e6).contains(&s.abs()) {
+                            s.to_string()
+                        } else {
+                            format!("{s:e}")
+                        }
+                    ),
                 ));
             }
             out.sigma_mm = Some(s);

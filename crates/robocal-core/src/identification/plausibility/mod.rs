@@ -20,8 +20,8 @@
 mod causes;
 pub mod diagnosis;
 mod ranges;
-pub mod statistics;
 pub mod similarity;
+pub mod statistics;
 
 #[cfg(test)]
 mod tests;

@@ -106,8 +106,7 @@ pub(super) fn residuals(fit: &Fit) -> Check {
             RESIDUAL_RATIO_LIMIT,
             "ratio",
             true,
-            "not measured: the points carry no uncertainty (no tracker model, no sigma_mm)"
-                .into(),
+            "not measured: the points carry no uncertainty (no tracker model, no sigma_mm)".into(),
         );
     };
     let typical = crate::stats::percentile(&sigmas, 0.5);
