@@ -531,6 +531,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         );
     }
     let mut res = cal.to_result();
+    res.inputs = Some(record_inputs(&s)?);
     if let Some(rs) = &mut res.settings {
         rs.robot_arg = Some(s.robot_arg.clone());
         rs.data = Some(s.data.display().to_string());
@@ -909,4 +910,20 @@ fn print_weighting(w: &robocal_core::observations::AppliedWeighting) {
             w.tracker_distance_mm
         ),
     }
+}
+
+/// The result's `inputs`: the robot file (not a preset), the data and the validation file, each
+/// with its path and SHA-256.
+fn record_inputs(s: &Settings) -> anyhow::Result<robocal_core::io::inputs::Inputs> {
+    use robocal_core::io::inputs::{InputFile, Inputs};
+    let mut inputs = Inputs::new();
+    let robot = std::path::Path::new(&s.robot_arg);
+    if robot.is_file() {
+        inputs.insert("robot".into(), InputFile::of(robot)?);
+    }
+    inputs.insert("data".into(), InputFile::of(&s.data)?);
+    if let Some(v) = &s.validate {
+        inputs.insert("validation".into(), InputFile::of(v)?);
+    }
+    Ok(inputs)
 }

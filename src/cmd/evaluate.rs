@@ -151,6 +151,9 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         nominal_limits,
         refit_frame,
     } = Settings::try_from(&a)?;
+    if let Some(inputs) = &res.inputs {
+        robocal_core::io::inputs::check_unchanged(inputs, &data, &params)?;
+    }
     // Row by row: only the error norms are kept (16 bytes per row), so files of any length fit.
     let context = || format!("--data {}", data.display());
     let mut reader = MeasurementReader::open(&data, nominal.joint_space(), Positions::Required)
@@ -194,10 +197,13 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     let n_outside = outside.count();
     // Refused before anything is written (the per-point writer is dropped).
     super::common::check_limits(outside, nominal_limits, &mut Vec::new())?;
-    if !refit_frame && ev.reference() == Reference::Model {
-        let mean = norms[1].iter().sum::<f64>() / norms[1].len().max(1) as f64;
-        if mean > robocal_core::registration::STATION_MIN_MM {
-            let set = whole().with_context(context)?;
+    let mean = norms[1].iter().sum::<f64>() / norms[1].len().max(1) as f64;
+    if mean > robocal_core::registration::STATION_MIN_MM {
+        // Far off: data of another robot or in another unit (calibrate's gate, exit 6), or
+        // from another tracker station.
+        let set = whole().with_context(context)?;
+        robocal_core::evaluation::check_data_matches(&cal, &set)?;
+        if !refit_frame && ev.reference() == Reference::Model {
             robocal_core::evaluation::check_station(&cal, &set, mean)?;
         }
     }
@@ -248,6 +254,11 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             o.insert(
                 "predicted".into(),
                 serde_json::json!({
+                    "new_poses": res.prediction.as_ref().map(|p| serde_json::json!({
+                        "mean_mm": p.mean_mm,
+                        "std_mm": p.std_mm,
+                        "rms_mm": p.rms_mm,
+                    })),
                     "calibration": res.errors.calibration.after,
                     "validation": res.errors.validation.map(|v| v.after),
                 }),
@@ -428,11 +439,24 @@ fn print_table(
                 }
                 println!();
             }
-            let (m, p) = (series[0].stats.mean_mm, cal.mean_mm);
+            // One prediction everywhere: the expected mean error at new poses spread like the
+            // calibration poses (calibrate's `prediction`); Table IV's calibration points only
+            // for a result without one, and then named as such.
+            let m = series[0].stats.mean_mm;
+            let (p, basis) = match res.prediction.as_ref().map(|p| p.mean_mm) {
+                Some(p) if p.is_finite() => (
+                    p,
+                    "predicted at new poses spread like the calibration poses (calibrate's \
+                     prediction)",
+                ),
+                _ => (
+                    cal.mean_mm,
+                    "on the calibration points (Table IV; the result has no prediction)",
+                ),
+            };
             if p > 0.0 {
                 println!(
-                    "verification mean {m:.4} mm vs {p:.4} mm predicted on the calibration points \
-                     ({:+.0}%)",
+                    "verification mean {m:.4} mm vs {p:.4} mm {basis} ({:+.0}%)",
                     100.0 * (m - p) / p
                 );
             }

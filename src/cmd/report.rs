@@ -210,9 +210,19 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         out,
     } = Settings::try_from(&a)?;
     let joints = nominal.joint_space();
+    // The files the calibration recorded must be the ones it read; every set must be of this
+    // robot (calibrate's gate: another robot's points, another unit, a mirrored frame).
+    for p in [&data_path, &val_path, &verify].into_iter().flatten() {
+        if let Some(inputs) = &result.inputs {
+            robocal_core::io::inputs::check_unchanged(inputs, p, &result_path)?;
+        }
+    }
     let data = read(&data_path, joints, "--data")?;
     let validation = read(&val_path, joints, "--validate")?;
     let verification = read(&verify, joints, "--verify")?;
+    for set in [&data, &validation, &verification].into_iter().flatten() {
+        robocal_core::evaluation::check_data_matches(&calibrated, set)?;
+    }
     let mut report = ReportData::from_run(&RunData {
         result: &result,
         nominal: &nominal,

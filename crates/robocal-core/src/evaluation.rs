@@ -278,7 +278,7 @@ pub fn check_result_nominal(
 
 mod station;
 mod stream;
-pub use station::{check_station, observations_of, station_frames};
+pub use station::{check_data_matches, check_station, observations_of, station_frames};
 pub use stream::{Evaluator, PerPointWriter};
 
 #[cfg(test)]

@@ -37,6 +37,26 @@ pub fn station_frames(
     Ok((refit_frame(nominal, &obs)?, refit_frame(calibrated, &obs)?))
 }
 
+/// Fails ([`Error::Implausible`], the exit code of `calibrate`'s gate) when the measured points of
+/// `set` cannot be of `model`'s robot: the plausibility gate's data checks (units, handedness, the
+/// error after the best rigid fit; [`crate::identification::plausibility::assess_data`]), with
+/// the likely cause. Free of any tracker frame: a set from another station passes.
+pub fn check_data_matches(model: &Robot, set: &MeasurementSet) -> Result<()> {
+    let obs = observations_of(set)?;
+    if obs.len() < 3 {
+        return Ok(());
+    }
+    let p = crate::identification::plausibility::assess_data(model, &obs);
+    if p.implausible() {
+        return Err(Error::Implausible(format!(
+            "{}: these measurements cannot be of the calibrated robot:\n{}",
+            set.path.display(),
+            p.summary()
+        )));
+    }
+    Ok(())
+}
+
 /// Fails when `set` was clearly measured from another station than the calibration's
 /// ([`crate::registration::another_station`]): the calibrated model is off by `mean_mm` on
 /// average in the calibration's frame. The message tells the refit setting by its name,

@@ -4,6 +4,7 @@ pub mod atomic;
 pub(crate) mod columns;
 pub mod export;
 pub mod input;
+pub mod inputs;
 pub mod joint_limits;
 pub mod json_keys;
 pub mod measurements;

@@ -125,6 +125,10 @@ pub struct CalibrationResult {
     /// Why the fit failed the plausibility gate (with `status` implausible).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub implausible_reason: Option<String>,
+    /// The input files (robot, data, validation) with their paths and SHA-256
+    /// ([`crate::io::inputs`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inputs: Option<crate::io::inputs::Inputs>,
     /// Why the result is partial (with `status` partial).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub partial_reason: Option<String>,
@@ -341,6 +345,7 @@ impl CalibrationResult {
             downweighted_points: None,
             identifiability: None,
             implausible_reason: None,
+            inputs: None,
             partial_reason: None,
             plausibility: None,
             points: None,

@@ -259,6 +259,101 @@ fn largest_move(fit: &Fit, unit: Unit) -> Option<(Param, f64)> {
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
+/// The measured points against a model's shape, free of any frame: the best rigid fit, the best
+/// uniform scale (units) and the best reflection (handedness).
+struct Shape {
+    /// RMS of the best rigid fit (mm; NaN when the points coincide).
+    rigid_rms: f64,
+    /// The best uniform scale (NaN when the points coincide).
+    scale: f64,
+}
+
+impl Shape {
+    /// Fits `obs`'s measured points to `robot`'s tool points, pushing the units and handedness
+    /// checks to `checks`.
+    fn of(obs: &Observations, robot: &Robot, checks: &mut Vec<Check>) -> Shape {
+        let measured = obs.measured();
+        let model = obs.model_positions(robot);
+        let rigid = fit_similarity(measured, &model, Handedness::Rotation, false);
+        let scaled = fit_similarity(measured, &model, Handedness::Rotation, true);
+        let mirrored = fit_similarity(measured, &model, Handedness::Reflection, true);
+        let baseline_rms = rigid.map_or(f64::NAN, |f| f.rms);
+        match (rigid, scaled) {
+            (Some(r), Some(s)) => {
+                let factor = s.scale.max(1.0 / s.scale);
+                let gain = r.rms / s.rms;
+                let passed = !(factor > SCALE_LIMIT && gain >= SCALE_GAIN);
+                let unit = unit_of_scale(s.scale)
+                    .filter(|(_, f)| *f != 1.0)
+                    .map_or(String::new(), |(u, _)| format!(", the scale of {u}"));
+                checks.push(check(
+                    CheckKind::Units,
+                    factor,
+                    SCALE_LIMIT,
+                    "factor",
+                    passed,
+                    format!(
+                        "the measured points fit the nominal model best at scale {}{unit} \
+                         ({:.3} mm RMS, against {:.3} mm at scale 1); limit: within a factor {} of \
+                         1 unless the scale improves the fit less than {}-fold",
+                        sig(s.scale),
+                        s.rms,
+                        r.rms,
+                        SCALE_LIMIT,
+                        SCALE_GAIN
+                    ),
+                ));
+            }
+            _ => checks.push(check(
+                CheckKind::Units,
+                f64::NAN,
+                SCALE_LIMIT,
+                "factor",
+                true,
+                "not measurable: the measured points coincide".into(),
+            )),
+        }
+        match (scaled, mirrored) {
+            (Some(s), Some(m)) => {
+                let ratio = if s.rms > 0.0 {
+                    m.rms / s.rms
+                } else {
+                    f64::INFINITY
+                };
+                checks.push(check(
+                    CheckKind::Handedness,
+                    ratio,
+                    HANDEDNESS_LIMIT,
+                    "ratio",
+                    ratio >= HANDEDNESS_LIMIT,
+                    format!(
+                        "the best reflection fits the measured points to {:.3} mm RMS, the best \
+                         rotation to {:.3} mm (ratio {}); limit: a reflection must not fit better \
+                         than {} times the rotation's RMS",
+                        m.rms,
+                        s.rms,
+                        sig(ratio),
+                        HANDEDNESS_LIMIT
+                    ),
+                ));
+            }
+            _ => checks.push(check(
+                CheckKind::Handedness,
+                f64::NAN,
+                HANDEDNESS_LIMIT,
+                "ratio",
+                true,
+                "not measurable: the measured points coincide".into(),
+            )),
+        }
+
+        Shape {
+            rigid_rms: baseline_rms,
+            scale: scaled.map_or(f64::NAN, |s| s.scale),
+        }
+    }
+}
+
 /// Runs every check on a fit and, if one fails, looks for the likely cause.
 pub fn assess(fit: &Fit) -> Plausibility {
     let reach = reach_mm(fit.start);
@@ -279,80 +374,8 @@ pub fn assess(fit: &Fit) -> Plausibility {
         ),
     ));
 
-    let measured = fit.calibration.measured();
-    let model = fit.calibration.model_positions(fit.start);
-    let rigid = fit_similarity(measured, &model, Handedness::Rotation, false);
-    let scaled = fit_similarity(measured, &model, Handedness::Rotation, true);
-    let mirrored = fit_similarity(measured, &model, Handedness::Reflection, true);
-    let baseline_rms = rigid.map_or(f64::NAN, |f| f.rms);
-    match (rigid, scaled) {
-        (Some(r), Some(s)) => {
-            let factor = s.scale.max(1.0 / s.scale);
-            let gain = r.rms / s.rms;
-            let passed = !(factor > SCALE_LIMIT && gain >= SCALE_GAIN);
-            let unit = unit_of_scale(s.scale)
-                .filter(|(_, f)| *f != 1.0)
-                .map_or(String::new(), |(u, _)| format!(", the scale of {u}"));
-            checks.push(check(
-                CheckKind::Units,
-                factor,
-                SCALE_LIMIT,
-                "factor",
-                passed,
-                format!(
-                    "the measured points fit the nominal model best at scale {}{unit} \
-                     ({:.3} mm RMS, against {:.3} mm at scale 1); limit: within a factor {} of \
-                     1 unless the scale improves the fit less than {}-fold",
-                    sig(s.scale),
-                    s.rms,
-                    r.rms,
-                    SCALE_LIMIT,
-                    SCALE_GAIN
-                ),
-            ));
-        }
-        _ => checks.push(check(
-            CheckKind::Units,
-            f64::NAN,
-            SCALE_LIMIT,
-            "factor",
-            true,
-            "not measurable: the measured points coincide".into(),
-        )),
-    }
-    match (scaled, mirrored) {
-        (Some(s), Some(m)) => {
-            let ratio = if s.rms > 0.0 {
-                m.rms / s.rms
-            } else {
-                f64::INFINITY
-            };
-            checks.push(check(
-                CheckKind::Handedness,
-                ratio,
-                HANDEDNESS_LIMIT,
-                "ratio",
-                ratio >= HANDEDNESS_LIMIT,
-                format!(
-                    "the best reflection fits the measured points to {:.3} mm RMS, the best \
-                     rotation to {:.3} mm (ratio {}); limit: a reflection must not fit better \
-                     than {} times the rotation's RMS",
-                    m.rms,
-                    s.rms,
-                    sig(ratio),
-                    HANDEDNESS_LIMIT
-                ),
-            ));
-        }
-        _ => checks.push(check(
-            CheckKind::Handedness,
-            f64::NAN,
-            HANDEDNESS_LIMIT,
-            "ratio",
-            true,
-            "not measurable: the measured points coincide".into(),
-        )),
-    }
+    let shape = Shape::of(fit.calibration, fit.start, &mut checks);
+    let (baseline_rms, scaled) = (shape.rigid_rms, shape.scale);
 
     let limit_mm = NOMINAL_ERROR_LIMIT * reach;
     let table2 = |rms: f64, what: &str| {
@@ -436,7 +459,7 @@ pub fn assess(fit: &Fit) -> Plausibility {
         Vec::new()
     };
     let radians = joints_look_like_radians(fit.nominal, fit.calibration);
-    let scale = scaled.map_or(f64::NAN, |s| s.scale);
+    let scale = scaled;
     let causes = Causes {
         explanations: &explanations,
         radians,
@@ -447,6 +470,56 @@ pub fn assess(fit: &Fit) -> Plausibility {
             .map(|c| c.kind)
             .collect(),
         max_iterations: fit.max_iterations,
+    };
+    for c in checks.iter_mut().filter(|c| !c.passed) {
+        c.cause = Some(causes.of(c.kind));
+    }
+    Plausibility {
+        reach_mm: reach,
+        checks,
+        explanations,
+    }
+}
+
+/// The gate's data checks for measurements read against an existing calibration (evaluate,
+/// compensate, report): units, handedness and the error of `robot` after the best rigid fit of
+/// the points (free of any tracker frame, so that another station passes), with the likely cause
+/// of a failure, as [`assess`] finds them for `calibrate`.
+pub fn assess_data(robot: &Robot, obs: &Observations) -> Plausibility {
+    let reach = reach_mm(robot);
+    let mut checks = Vec::new();
+    let shape = Shape::of(obs, robot, &mut checks);
+    let limit_mm = NOMINAL_ERROR_LIMIT * reach;
+    let rms = shape.rigid_rms;
+    checks.push(check(
+        CheckKind::NominalError,
+        rms,
+        limit_mm,
+        "mm",
+        !(rms > limit_mm),
+        format!(
+            "the model misses the points by {rms:.3} mm RMS after the best rigid fit, {:.2}% of \
+             the robot's reach of {reach:.0} mm; limit: {}% ({limit_mm:.1} mm)",
+            100.0 * rms / reach,
+            100.0 * NOMINAL_ERROR_LIMIT
+        ),
+    ));
+    let failed: Vec<CheckKind> = checks
+        .iter()
+        .filter(|c| !c.passed)
+        .map(|c| c.kind)
+        .collect();
+    let explanations = if !failed.is_empty() && rms.is_finite() {
+        explain(robot, obs, rms, limit_mm)
+    } else {
+        Vec::new()
+    };
+    let causes = Causes {
+        explanations: &explanations,
+        radians: joints_look_like_radians(robot, obs),
+        scale: shape.scale,
+        failed,
+        max_iterations: 0,
     };
     for c in checks.iter_mut().filter(|c| !c.passed) {
         c.cause = Some(causes.of(c.kind));
