@@ -117,6 +117,17 @@ pub const NOISE_PER_M: Range = Range {
     why: "as large as the distance itself",
 };
 
+/// Controller coupling factors (a joint's share of another axis's value): up to ±1000, far
+/// beyond the gear ratios between coupled axes (about 1, as FANUC's J2/J3 or a wrist's
+/// differential), while a mistyped exponent lands outside.
+pub const COUPLING: Range = Range {
+    min: -1e3,
+    max: 1e3,
+    unit: "times",
+    what: "a coupling factor",
+    why: "a thousand times the other axis",
+};
+
 /// Masses (links, payload): up to 1000 t, far beyond the heaviest robot payloads (a few tonnes).
 pub const MASS: Range = Range {
     min: 0.0,

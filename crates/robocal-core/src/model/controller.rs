@@ -77,11 +77,12 @@ impl Controller {
                 format!("{s} is not +1 or -1"),
             ));
         }
-        if let Some((i, o)) = offset.iter().enumerate().find(|(_, o)| !o.is_finite()) {
-            return Err(Error::invalid(
-                format!("controller.offset[{}]", i + 1),
-                format!("{o} is not a finite number"),
-            ));
+        // The range of a joint value (degrees, or mm for a prismatic joint: the smaller bound
+        // of the two, 1e5, serves both).
+        for (i, o) in offset.iter().enumerate() {
+            crate::ranges::JOINT
+                .check(*o)
+                .map_err(|m| Error::invalid(format!("controller.offset[{}]", i + 1), m))?;
         }
         let mut m = DMatrix::from_diagonal(&nalgebra::DVector::from_column_slice(&sign));
         for (r, c) in coupling.iter().enumerate() {
@@ -105,12 +106,9 @@ impl Controller {
                     ),
                 ));
             }
-            if !c.factor.is_finite() {
-                return Err(Error::invalid(
-                    field,
-                    format!("factor {} is not a finite number", c.factor),
-                ));
-            }
+            crate::ranges::COUPLING
+                .check(c.factor)
+                .map_err(|m| Error::invalid(field.clone(), format!("factor: {m}")))?;
             m[(c.joint, c.axis)] += c.factor;
         }
         let sv = m.clone().singular_values();
