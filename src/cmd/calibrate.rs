@@ -620,10 +620,11 @@ fn print_plausibility(c: &Calibration) {
     let p = &c.plausibility;
     println!();
     if p.passed() {
+        let names: Vec<&str> = p.checks.iter().map(|c| c.kind.name()).collect();
         println!(
-            "plausibility: all {} checks passed (units, handedness, nominal error, parameter \
-             moves, convergence)",
-            p.checks.len()
+            "plausibility: all {} checks passed ({})",
+            p.checks.len(),
+            names.join(", ")
         );
         return;
     }

@@ -183,7 +183,7 @@ fn real_ur5_and_wam_pass_the_gate() {
     // The calibrations cli_calibrate's real-data tests check too, made once.
     for robot in ["ur5", "wam"] {
         let fit = real_fit(&d, robot);
-        assert!(fit.stdout.contains("plausibility: all 7 checks passed"));
+        assert!(fit.stdout.contains("plausibility: all 12 checks passed"));
         let j = &fit.result;
         assert_eq!(j["status"], "calibrated");
         assert_eq!(j["plausibility"]["passed"], true);
@@ -221,7 +221,8 @@ fn good_data_pass_and_the_result_records_every_check() {
     ]);
     o.assert_ok();
     assert!(
-        o.stdout().contains("plausibility: all 7 checks passed"),
+        o.stdout()
+            .contains("checks passed (convergence, units, handedness"),
         "{}",
         o.stdout()
     );

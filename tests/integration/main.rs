@@ -40,6 +40,7 @@ mod cli_simulate;
 mod cli_stations;
 #[cfg(unix)]
 mod cli_trust_files;
+mod cli_trust_fits;
 mod cli_trust_gate;
 mod cli_trust_readers;
 mod cli_urdf;
