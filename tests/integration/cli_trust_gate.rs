@@ -245,7 +245,12 @@ fn good_data_pass_and_the_result_records_every_check() {
             "nominal_error",
             "validation_nominal_error",
             "length_moves",
-            "angle_moves"
+            "angle_moves",
+            "parameter_ranges",
+            "improvement",
+            "discarded_points",
+            "residuals",
+            "weight_share"
         ]
     );
     for c in p["checks"].as_array().unwrap() {

@@ -322,6 +322,21 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
         )));
     }
     let mut result = calibration.to_result();
+    // The files as `calibrate` records them, run in the demo's folder.
+    result.inputs = Some(
+        [
+            ("data", files::CELL, &cell_csv),
+            ("validation", files::VALIDATION, &val_csv),
+        ]
+        .into_iter()
+        .map(|(role, f, bytes)| {
+            (
+                role.to_owned(),
+                crate::io::inputs::InputFile::from_bytes(Path::new(f), bytes),
+            )
+        })
+        .collect(),
+    );
     if let Some(s) = &mut result.settings {
         s.robot_arg = Some(nominal.name().to_owned());
         s.data = Some(files::CELL.to_owned());

@@ -65,3 +65,42 @@ pub fn to_hold(start: &Robot, calibrated: &Robot, covariance: &Covariance) -> Ve
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::family::compliance;
+    use crate::model::presets::preset;
+    use crate::model::Unit;
+    use nalgebra::DMatrix;
+
+    /// A physical compliance fitted at -2 +- 1 urad/(N·m) is held at 0; at -5 +- 1 (beyond 3
+    /// standard deviations) it is not (the gate refuses it); a positive one is left alone.
+    #[test]
+    fn a_compliance_just_below_zero_is_held_at_zero() {
+        let mut start = preset("kuka-kr480-r3330").unwrap();
+        compliance::enable(&mut start, &[1, 2], Some(300.0)).unwrap();
+        let ps: Vec<Param> = start
+            .params()
+            .into_iter()
+            .filter(|p| p.name().starts_with("compliance"))
+            .collect();
+        assert_eq!(ps.len(), 2);
+        let to = |v: f64| Unit::MicroradPerNm.to_internal(v);
+        let cov = Covariance {
+            params: ps.clone(),
+            matrix: DMatrix::from_diagonal_element(2, 2, to(1.0).powi(2)),
+            sigma_mm: 0.01,
+            unavailable: None,
+        };
+        let mut cal = start.clone();
+        cal.set(ps[0], to(-2.0));
+        cal.set(ps[1], to(0.5));
+        let held = to_hold(&start, &cal, &cov);
+        assert_eq!(held.len(), 1);
+        assert_eq!(held[0].param, ps[0]);
+        assert!((held[0].value + 2.0).abs() < 1e-9 && held[0].bound == 0.0);
+        cal.set(ps[0], to(-5.0));
+        assert!(to_hold(&start, &cal, &cov).is_empty());
+    }
+}

@@ -9,12 +9,13 @@ use crate::error::{Error, Result};
 use indexmap::IndexMap;
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// One input file.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 pub struct InputFile {
-    /// Its absolute path when it was read.
+    /// Its path as it was given (relative to the directory the command ran in, as the result's
+    /// `settings` record it; the same arguments give the same result, byte for byte).
     pub path: String,
     /// The SHA-256 of its bytes, lower-case hexadecimal.
     pub sha256: String,
@@ -44,12 +45,15 @@ fn read(path: &Path) -> Result<Vec<u8>> {
 impl InputFile {
     /// The record of the file at `path` as it is now.
     pub fn of(path: &Path) -> Result<InputFile> {
-        let bytes = read(path)?;
-        let abs = std::fs::canonicalize(path).unwrap_or_else(|_| PathBuf::from(path));
-        Ok(InputFile {
-            path: abs.display().to_string(),
-            sha256: sha256_hex(&bytes),
-        })
+        Ok(InputFile::from_bytes(path, &read(path)?))
+    }
+
+    /// The record of a file at `path` whose bytes are `bytes` (a file about to be written).
+    pub fn from_bytes(path: &Path, bytes: &[u8]) -> InputFile {
+        InputFile {
+            path: path.display().to_string(),
+            sha256: sha256_hex(bytes),
+        }
     }
 }
 

@@ -153,7 +153,7 @@ fn good_data_pass_every_check() {
         let c = fit(&nominal, &cell.good(), Some(&val.good()));
         let p = &c.plausibility;
         assert!(p.passed(), "{}: {}", nominal.name(), p.summary());
-        assert_eq!(p.checks.len(), 7, "every check, validation included");
+        assert_eq!(p.checks.len(), 12, "every check, validation included");
         assert!(p.explanations.is_empty() && p.checks.iter().all(|k| k.cause.is_none()));
         for k in &p.checks {
             assert!(k.measured.is_finite(), "{}: {}", k.kind.name(), k.detail);
@@ -443,4 +443,79 @@ fn the_gate_passes_the_demo_for_seeds_1_to_30() {
             "calibrated"
         );
     }
+}
+
+/// The statistical checks on a good fit pass; a calibrated model worse than its start on the
+/// validation points, and residuals far beyond the points' uncertainty, fail with their causes.
+#[test]
+fn statistical_checks_catch_a_worse_model_and_unexplained_residuals() {
+    let cell = kuka_cell();
+    let obs = cell.good();
+    let c = fit(&kuka(), &obs, None);
+    for k in [
+        CheckKind::Improvement,
+        CheckKind::DiscardedPoints,
+        CheckKind::Residuals,
+        CheckKind::WeightShare,
+        CheckKind::ParameterRanges,
+    ] {
+        assert!(
+            check_of(&c, k).passed,
+            "{:?}: {}",
+            k,
+            check_of(&c, k).detail
+        );
+    }
+    let start = if c.tool_fit.applied {
+        c.tool_fit.apply(&c.nominal)
+    } else {
+        c.nominal.clone()
+    };
+    let before = vec![1.0; 10];
+    let after = vec![1.5; 10];
+    let weighted = {
+        let mut o = obs.clone();
+        o.set_sigmas(Some(vec![0.001; o.len()])).unwrap();
+        o
+    };
+    let p = assess(&Fit {
+        nominal: &c.nominal,
+        start: &start,
+        calibrated: &c.calibrated,
+        identified: &c.identifiability.identified,
+        calibration: &weighted,
+        registration: &c.registration,
+        nominal_rms_mm: c.registration.stats.rms_mm,
+        validation_before: Some(&before),
+        validation_after: Some(&after),
+        calibration_before: &c.calibration.before,
+        downweighted: 0,
+        prediction_mean_mm: None,
+        noise_sigma_mm: Some(0.05),
+        solver: c.solver(),
+        max_iterations: 1000,
+    });
+    let imp = p
+        .checks
+        .iter()
+        .find(|k| k.kind == CheckKind::Improvement)
+        .unwrap();
+    assert!(
+        !imp.passed && (imp.measured - 1.5).abs() < 1e-12,
+        "{}",
+        imp.detail
+    );
+    assert!(imp.cause.as_deref().unwrap().contains("pulled away"));
+    // 0.05 mm of residual noise against points claimed certain to 0.001 mm: 50 times.
+    let res = p
+        .checks
+        .iter()
+        .find(|k| k.kind == CheckKind::Residuals)
+        .unwrap();
+    assert!(
+        !res.passed && (res.measured - 50.0).abs() < 1e-9,
+        "{}",
+        res.detail
+    );
+    assert!(p.implausible());
 }

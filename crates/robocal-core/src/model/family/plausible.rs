@@ -110,3 +110,81 @@ pub fn deflection_per_m(robot: &Robot) -> f64 {
 pub fn of(robot: &Robot, p: Param) -> Plausible {
     p.family().plausible(robot, p)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::family::{compliance, transmission};
+    use crate::model::presets::preset;
+
+    fn kuka() -> Robot {
+        preset("kuka-kr480-r3330").unwrap()
+    }
+
+    /// Geometric parameters keep the gate's limits; every family gives a finite, positive move.
+    #[test]
+    fn every_parameter_of_every_family_has_a_finite_range() {
+        let mut r = kuka();
+        compliance::enable(&mut r, &[1, 2], Some(300.0)).unwrap();
+        transmission::enable(&mut r, &[0, 1, 2, 3, 4, 5], 2).unwrap();
+        for p in r.params() {
+            let g = of(&r, p);
+            assert!(
+                g.max_move.is_finite() && g.max_move > 0.0,
+                "{}: {g:?}",
+                p.name()
+            );
+        }
+        let a2 = of(&r, Param::a(1));
+        assert_eq!(a2.max_move, LENGTH_MOVE_FRACTION * r.reach_mm());
+        assert_eq!(of(&r, Param::alpha(1)).max_move, ANGLE_MOVE_DEG);
+    }
+
+    /// A physical compliance is never negative and bounded by the deflection under its payload;
+    /// lumped coefficients are bounded through the joint deflection, not one by one.
+    #[test]
+    fn compliance_ranges_follow_the_payload_and_the_lever() {
+        let mut r = kuka();
+        compliance::enable(&mut r, &[1], Some(300.0)).unwrap();
+        let c2 = r
+            .params()
+            .into_iter()
+            .find(|p| p.name() == "compliance2")
+            .unwrap();
+        let g = of(&r, c2);
+        assert_eq!(g.min, 0.0);
+        assert!(!g.contains(-1e-9) && g.contains(0.0));
+        // One degree at the lever of the tool about joint 2 under 300 kg.
+        let lever = compliance::lever_bound_mm(&r, 1, r.dof());
+        let expect =
+            JOINT_DEFLECTION_DEG.to_radians() * 1e6 / (300.0 * compliance::G0 * lever / 1000.0);
+        assert!((g.max - expect.min(COMPLIANCE_MAX_URAD_PER_NM)).abs() < 1e-9 * g.max);
+        // A payload of 0.1 g leaves only the absolute bound.
+        compliance::enable(&mut r, &[1], Some(1e-4)).unwrap();
+        assert_eq!(of(&r, c2).max, COMPLIANCE_MAX_URAD_PER_NM);
+        // Without a payload: lumped coefficients, either sign, not bounded one by one.
+        compliance::enable(&mut r, &[1], None).unwrap();
+        let lumped: Vec<Param> = r
+            .params()
+            .into_iter()
+            .filter(|p| p.name().starts_with("grav"))
+            .collect();
+        assert!(!lumped.is_empty());
+        for p in lumped {
+            let g = of(&r, p);
+            assert!(!g.individual && g.min == f64::NEG_INFINITY, "{}", p.name());
+        }
+    }
+
+    #[test]
+    fn transmission_amplitudes_are_bounded_by_a_degree() {
+        let mut r = kuka();
+        transmission::enable(&mut r, &[0], 1).unwrap();
+        let p = r
+            .params()
+            .into_iter()
+            .find(|p| p.name() == "tcos1_1")
+            .unwrap();
+        assert_eq!(of(&r, p).max_move, JOINT_DEFLECTION_DEG);
+    }
+}
