@@ -322,21 +322,6 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
         )));
     }
     let mut result = calibration.to_result();
-    // The files as `calibrate` records them, run in the demo's folder.
-    result.inputs = Some(
-        [
-            ("data", files::CELL, &cell_csv),
-            ("validation", files::VALIDATION, &val_csv),
-        ]
-        .into_iter()
-        .map(|(role, f, bytes)| {
-            (
-                role.to_owned(),
-                crate::io::inputs::InputFile::from_bytes(Path::new(f), bytes),
-            )
-        })
-        .collect(),
-    );
     if let Some(s) = &mut result.settings {
         s.robot_arg = Some(nominal.name().to_owned());
         s.data = Some(files::CELL.to_owned());
@@ -346,6 +331,34 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
         s.merge(config.result_settings.clone())
             .map_err(|e| Error::invalid("result settings", e.to_string()))?;
     }
+    // The files as `calibrate` records them, under the paths the settings give.
+    let given = |f: Option<&String>, default: &str| f.cloned().unwrap_or_else(|| default.into());
+    let settings = result.settings.as_ref();
+    result.inputs = Some(
+        [
+            (
+                "data",
+                given(settings.and_then(|s| s.data.as_ref()), files::CELL),
+                &cell_csv,
+            ),
+            (
+                "validation",
+                given(
+                    settings.and_then(|s| s.validate.as_ref()),
+                    files::VALIDATION,
+                ),
+                &val_csv,
+            ),
+        ]
+        .into_iter()
+        .map(|(role, f, bytes)| {
+            (
+                role.to_owned(),
+                crate::io::inputs::InputFile::from_bytes(Path::new(&f), bytes),
+            )
+        })
+        .collect(),
+    );
     let mut result_json = serde_json::to_string_pretty(&result)
         .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
     result_json.push('\n');
