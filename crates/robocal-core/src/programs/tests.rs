@@ -1,8 +1,10 @@
+use super::seed::{branch_joints, BranchJoints};
 use super::seed::{krl_status, rapid_conf};
 use super::*;
-use crate::compensation::PoseNewton;
+use crate::compensation::{Compensator, DampedLeastSquares, PoseNewton};
 use crate::model::presets::preset;
 use crate::model::robot_file::parse_robot_toml;
+use crate::model::Robot;
 use crate::simulation::{random_poses, GeometricErrors, PoseSampler};
 use rand::SeedableRng;
 
@@ -71,7 +73,7 @@ pub(crate) fn krl_program(nominal: &Robot) -> String {
             turn_of(nominal, &q)
         );
     }
-    s += "PTP_REL {A1 10, A2 0, A3 0, A4 0, A5 0, A6 0}\r\nEND\r\n";
+    s += "END\r\n";
     s
 }
 
@@ -106,12 +108,12 @@ pub(crate) fn rapid_program(nominal: &Robot) -> String {
         );
         if k == 1 {
             moves += &format!("    MoveAbsJ {joints}\\NoEOffs, v100, fine, tool0;\n");
-            moves += &format!("    MoveL {rob}, v100, z10, tool0\\WObj:=wobj0; ! inline\n\n");
+            moves += &format!("    MoveL {rob}, v100, z10, gun\\WObj:=wobj0; ! inline\n\n");
         } else {
             s += &format!("  CONST jointtarget j{k} := {joints};\n");
             s += &format!("  CONST robtarget p{k}:={rob};\n");
             moves += &format!(
-                "    MoveAbsJ j{k}, v100, fine, tool0;\n    MoveJ p{k}, v100, z10, tool0;\n"
+                "    MoveAbsJ j{k}, v100, fine, tool0;\n    MoveJ p{k}, v100, z10, gun;\n"
             );
         }
     }
@@ -146,12 +148,27 @@ pub(crate) fn ur_program(nominal: &Robot) -> String {
         );
         if k == 0 {
             s += &format!("  home = {list}\n  pick = {p}\n\n  movej(home, a=1.4, v=1.05)\n");
-            s += "  movel(pick, a=1.2, v=0.25)\n  movel(pose_trans(pick, offset), a=1.2, v=0.25)\n";
+            s += "  movel(pick, a=1.2, v=0.25)\n";
         } else {
             s += &format!("  movej({list}, a=1.4, v=1.05)\n  movel({p}, a=1.2, v=0.25, r=0)\n");
         }
     }
     s + "end\n"
+}
+
+/// Compensates one program file.
+pub(crate) fn run(
+    path: &Path,
+    text: &str,
+    format: Format,
+    comp: &Compensator<'_, DampedLeastSquares>,
+    s: &ProgramSettings,
+) -> CompensatedProgram {
+    let src = [Source {
+        path: path.to_owned(),
+        text: text.to_owned(),
+    }];
+    compensate_program(&src, format, None, comp, s).unwrap()
 }
 
 /// The text outside the targets' numeric fields, in order.
@@ -215,14 +232,22 @@ fn check_program(format: Format, nom: &Robot, cal: &Robot, text: &str) -> Compen
     let comp = Compensator::new(nom, cal, DampedLeastSquares::default()).unwrap();
     let s = ProgramSettings::default();
     let path = Path::new("fixture");
-    let out = compensate_program(path, text, format, &comp, &s).unwrap();
+    let out = run(path, text, format, &comp, &s);
     let (tin, tout) = (
         format.targets(path, text).unwrap(),
-        format.targets(path, &out.text).unwrap(),
+        format.targets(path, &out.texts[0]).unwrap(),
     );
     assert_eq!(tin.len(), tout.len());
     assert_eq!(out.changes.len(), tin.len());
-    assert_eq!(outside_fields(text, &tin), outside_fields(&out.text, &tout));
+    assert_eq!(
+        outside_fields(text, &tin),
+        outside_fields(&out.texts[0], &tout)
+    );
+    assert!(
+        out.unchanged_motions().next().is_none(),
+        "{:?}",
+        out.motions
+    );
     let js = nom.joint_space();
     let mut previous: Option<Vec<f64>> = None;
     for ((c, t), t0) in out.changes.iter().zip(&tout).zip(&tin) {
@@ -230,6 +255,11 @@ fn check_program(format: Format, nom: &Robot, cal: &Robot, text: &str) -> Compen
         assert_eq!(c.status, IkStatus::Converged);
         let written: Vec<f64> = t.fields.iter().map(|f| f.value).collect();
         assert_eq!(written, c.new);
+        let written: Vec<f64> = written
+            .iter()
+            .enumerate()
+            .map(|(k, v)| format.precision(t.kind, k).stored(*v))
+            .collect();
         let old: Vec<f64> = t0.fields.iter().map(|f| f.value).collect();
         let (desired, reached) = match t.kind {
             TargetKind::Joints => {
@@ -249,7 +279,14 @@ fn check_program(format: Format, nom: &Robot, cal: &Robot, text: &str) -> Compen
                 (format.pose_of(&old), q)
             }
         };
-        let (dp, dw) = pose_distance(&cal.tool_pose(&reached), &desired);
+        // RAPID: the tool `gun` (the robot description's tool) as given, on the calibrated flange.
+        let actual = match (format, t.kind) {
+            (Format::Rapid, TargetKind::Pose) => {
+                cal.tool_pose(&reached) * cal.tool_frame().inverse() * nom.tool_frame()
+            }
+            _ => cal.tool_pose(&reached),
+        };
+        let (dp, dw) = pose_distance(&actual, &desired);
         assert!(
             dp < s.verify_mm && dw < s.verify_deg,
             "{} line {}: {dp} mm {dw} deg",
@@ -279,7 +316,9 @@ fn a_rapid_program_is_compensated_target_by_target_and_kept_byte_for_byte() {
     // The confdata are kept.
     let (a, b) = (
         Format::Rapid.targets(Path::new("a"), &text).unwrap(),
-        Format::Rapid.targets(Path::new("b"), &out.text).unwrap(),
+        Format::Rapid
+            .targets(Path::new("b"), &out.texts[0])
+            .unwrap(),
     );
     assert!(a.iter().zip(&b).all(|(x, y)| x.conf == y.conf));
 }
@@ -306,8 +345,8 @@ fn targets_that_need_no_change_are_verified_and_keep_their_text() {
     ] {
         let comp = Compensator::new(robot, robot, DampedLeastSquares::default()).unwrap();
         let s = ProgramSettings::default();
-        let out = compensate_program(Path::new("same"), &text, format, &comp, &s).unwrap();
-        assert_eq!(out.text, text, "{format:?}");
+        let out = run(Path::new("same"), &text, format, &comp, &s);
+        assert_eq!(out.texts[0], text, "{format:?}");
         for c in &out.changes {
             assert!(c.applied && c.status == IkStatus::Converged, "{c:?}");
             assert!(
@@ -327,8 +366,7 @@ fn position_only_compensation_puts_the_tool_point_on_target() {
         full_pose: false,
         ..ProgramSettings::default()
     };
-    let out =
-        compensate_program(Path::new("k"), &krl_program(&nom), Format::Krl, &comp, &s).unwrap();
+    let out = run(Path::new("k"), &krl_program(&nom), Format::Krl, &comp, &s);
     assert!(out
         .changes
         .iter()
@@ -413,8 +451,8 @@ fn a_target_that_cannot_be_compensated_is_left_unchanged_and_listed() {
     let comp = Compensator::new(&nom, &cal, DampedLeastSquares::default()).unwrap();
     let text = "DEF far()\nLIN {X 9000, Y 0, Z 1000, A 0, B 90, C 0}\nEND\n";
     let s = ProgramSettings::default();
-    let out = compensate_program(Path::new("far.src"), text, Format::Krl, &comp, &s).unwrap();
-    assert_eq!(out.text, text);
+    let out = run(Path::new("far.src"), text, Format::Krl, &comp, &s);
+    assert_eq!(out.texts[0], text);
     assert_eq!(out.changes.len(), 1);
     assert!(!out.changes[0].applied);
     assert_eq!(out.changes[0].status, IkStatus::Unreachable);
