@@ -13,6 +13,7 @@
 use super::census::{target_ref, Motion};
 use super::frames::{krl_frame, FrameSpec, Frames, KrlConfig};
 use super::krl::parse_aggregate;
+use std::collections::HashMap;
 use std::path::Path;
 
 const MOTIONS: [&str; 14] = [
@@ -66,7 +67,8 @@ struct State<'a> {
     /// The block depth at which tool and base were set.
     set_at: [usize; 2],
     config: Option<&'a KrlConfig>,
-    dat: Option<&'a str>,
+    /// The `.dat`'s FDAT: upper-case name -> (TOOL_NO, BASE_NO, external TCP).
+    fdats: HashMap<String, Option<(usize, usize, bool)>>,
 }
 
 impl State<'_> {
@@ -165,7 +167,12 @@ impl State<'_> {
     /// `FDAT_ACT = name`: the tool and base numbers of the `.dat`'s `DECL FDAT name={...}`.
     fn fdat(&mut self, name: &str, depth: usize) {
         let unknown = |why: String| (FrameSpec::Unknown(why.clone()), FrameSpec::Unknown(why));
-        let (t, b) = match self.dat.and_then(|d| find_fdat(d, name)) {
+        let found = self
+            .fdats
+            .get(&name.to_ascii_uppercase())
+            .copied()
+            .flatten();
+        let (t, b) = match found {
             None => unknown(format!("FDAT_ACT = {name}: no FDAT {name} in the .dat")),
             Some((_, _, true)) => unknown(format!("FDAT {name}: an external TCP (IPO_FRAME #TCP)")),
             Some((t, b, false)) => (self.numbered(true, t), self.numbered(false, b)),
@@ -175,28 +182,37 @@ impl State<'_> {
     }
 }
 
-/// `TOOL_NO`, `BASE_NO` and whether `IPO_FRAME` is `#TCP`, of `DECL FDAT name={...}` in a `.dat`.
-fn find_fdat(dat: &str, name: &str) -> Option<(usize, usize, bool)> {
+/// The `DECL FDAT name={...}` of a `.dat`: upper-case name -> `TOOL_NO`, `BASE_NO` and whether
+/// `IPO_FRAME` is `#TCP` (`None`: not readable).
+fn fdats(dat: &str) -> HashMap<String, Option<(usize, usize, bool)>> {
+    let mut out = HashMap::new();
     for (k, l) in dat.lines().enumerate() {
         let c = code(l);
-        let u = c.to_ascii_uppercase();
         let Some(open) = c.find('{') else { continue };
-        let head: Vec<&str> = u[..open]
+        let u = c[..open].to_ascii_uppercase();
+        let head: Vec<&str> = u
             .split(|ch: char| ch.is_whitespace() || ch == '=')
             .filter(|w| !w.is_empty())
             .collect();
-        if !(head.contains(&"FDAT") && head.last() == Some(&name.to_ascii_uppercase().as_str())) {
+        if !head.contains(&"FDAT") {
             continue;
         }
-        let a = parse_aggregate(Path::new(""), c, open, k + 1).ok()?;
-        let int = |m: &str| -> Option<usize> { c[a.member(m)?.value_span()?].trim().parse().ok() };
-        let tcp = a
-            .member("IPO_FRAME")
-            .and_then(|m| m.value_span())
-            .is_some_and(|s| c[s].to_ascii_uppercase().contains("TCP"));
-        return Some((int("TOOL_NO")?, int("BASE_NO")?, tcp));
+        let Some(name) = head.last() else { continue };
+        let value = parse_aggregate(Path::new(""), c, open, k + 1)
+            .ok()
+            .and_then(|a| {
+                let int = |m: &str| -> Option<usize> {
+                    c[a.member(m)?.value_span()?].trim().parse().ok()
+                };
+                let tcp = a
+                    .member("IPO_FRAME")
+                    .and_then(|m| m.value_span())
+                    .is_some_and(|s| c[s].to_ascii_uppercase().contains("TCP"));
+                Some((int("TOOL_NO")?, int("BASE_NO")?, tcp))
+            });
+        out.insert((*name).to_owned(), value);
     }
-    None
+    out
 }
 
 /// The motions of a KRL `.src` text, with the frames in force; `dat` is its `.dat` (FDAT data),
@@ -206,7 +222,7 @@ pub fn motions(text: &str, dat: Option<&str>, config: Option<&KrlConfig>) -> Vec
         frames: Frames::default(),
         set_at: [0, 0],
         config,
-        dat,
+        fdats: dat.map(fdats).unwrap_or_default(),
     };
     let mut out = Vec::new();
     let mut depth = 0usize;

@@ -51,12 +51,13 @@ pub fn compensate_program(
         Format::Rapid => census_rapid::motions(main),
         Format::UrScript => census_ur::motions(main),
     };
+    let names = Names::new(format, &targets);
     let links: Vec<Vec<Option<usize>>> = motions
         .iter()
         .map(|m| {
             m.refs
                 .iter()
-                .map(|r| link(format, &targets, m, r))
+                .map(|r| link(&names, &targets, m, r))
                 .collect()
         })
         .collect();
@@ -122,29 +123,61 @@ fn splice(text: &str, splices: &mut [(Range<usize>, String)]) -> String {
     out
 }
 
+/// The targets by name (upper case for KRL and RAPID, whose names are case-insensitive).
+struct Names {
+    format: Format,
+    by_name: std::collections::HashMap<String, Vec<usize>>,
+}
+
+impl Names {
+    fn new(format: Format, targets: &[ProgramTarget]) -> Names {
+        let mut by_name: std::collections::HashMap<String, Vec<usize>> = Default::default();
+        let mut n = Names {
+            format,
+            by_name: Default::default(),
+        };
+        for (k, t) in targets.iter().enumerate() {
+            by_name.entry(n.key(&t.name)).or_default().push(k);
+        }
+        n.by_name = by_name;
+        n
+    }
+
+    fn key(&self, name: &str) -> String {
+        match self.format {
+            Format::UrScript => name.to_owned(),
+            _ => name.to_ascii_uppercase(),
+        }
+    }
+}
+
 /// The target a motion's reference names: inline, the target written in its statement; named,
 /// the target of that name (KRL, RAPID: any case; URScript: the last assignment before it).
-fn link(format: Format, targets: &[ProgramTarget], m: &Motion, r: &TargetRef) -> Option<usize> {
+fn link(names: &Names, targets: &[ProgramTarget], m: &Motion, r: &TargetRef) -> Option<usize> {
     match r {
-        TargetRef::Inline => targets.iter().position(|t| {
-            t.file == m.file
-                && t.fields
-                    .first()
-                    .is_some_and(|f| m.span.contains(&f.span.start))
-        }),
-        TargetRef::Named(n) => {
-            let same = |t: &ProgramTarget| match format {
-                Format::UrScript => t.name == *n,
-                _ => t.name.eq_ignore_ascii_case(n),
-            };
-            let before = targets.iter().rposition(|t| {
-                same(t)
-                    && (t.file != m.file
-                        || t.fields
-                            .first()
-                            .is_some_and(|f| f.span.start < m.span.start))
+        TargetRef::Inline => {
+            let k = targets.partition_point(|t| {
+                t.file < m.file
+                    || (t.file == m.file
+                        && t.fields.first().map_or(0, |f| f.span.start) < m.span.start)
             });
-            before.or_else(|| targets.iter().position(same))
+            let first = |t: &ProgramTarget| t.fields.first().map_or(0, |f| f.span.start);
+            targets[k..]
+                .iter()
+                .take_while(|t| t.file == m.file && first(t) < m.span.end)
+                .position(|t| m.span.contains(&first(t)) && !t.fields.is_empty())
+                .map(|i| i + k)
+        }
+        TargetRef::Named(n) => {
+            let all = names.by_name.get(&names.key(n))?;
+            let before = all.iter().rev().find(|k| {
+                let t = &targets[**k];
+                t.file != m.file
+                    || t.fields
+                        .first()
+                        .is_some_and(|f| f.span.start < m.span.start)
+            });
+            before.or(all.first()).copied()
         }
         TargetRef::Computed(_) => None,
     }
