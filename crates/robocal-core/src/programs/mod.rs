@@ -13,26 +13,31 @@
 //!   ([`crate::model::JointSpace::joints_from_axes`]; the KUKA presets: q = (-A1, A2, A3, -A4,
 //!   A5, -A6); robots without a map: the identity) to the desired model joints; the commanded
 //!   joints go back to axis values.
-//! - **Cartesian targets** (KRL POS/E6POS/FRAME, RAPID robtarget, URScript `p[...]`): the pose is
-//!   taken as the tool frame (target 1, [`crate::Robot::tool_pose`]) in the robot's base frame,
-//!   i.e. the program's base/work object and tool are those of the robot description: a `$BASE`
-//!   or `$TOOL` set in a KRL program, a RAPID wobj other than `wobj0` or a tool other than the
-//!   robot file's, a URScript `set_tcp` are not followed. The desired joints are the nominal
-//!   model's inverse kinematics on the branch the target's configuration data give
-//!   ([`seed::Branch`]: KRL `S` and `T`, RAPID confdata; a URScript pose, which has none, takes
-//!   the solution nearest the previous target's joints, as the controller takes the one nearest
-//!   its current joints). The compensated pose written is the nominal model's pose at the
-//!   commanded joints, so that the controller, which believes the nominal model, drives the
-//!   robot to the commanded joints. The configuration data are kept, and must still hold at the
-//!   commanded joints ([`IkStatus::ConfigurationChange`] otherwise), with one exception: a KRL
-//!   `T` follows an axis that compensation moves across 0 from within 1 degree of it (a target
-//!   at A4 = 0 may need A4 = -0.002).
+//! - **Cartesian targets** (KRL POS/E6POS/FRAME, RAPID robtarget, URScript `p[...]`): the pose
+//!   is in the base and for the tool in force at the motions that use it ([`frames`]: KRL
+//!   `$TOOL`/`$BASE`, `BAS`, `FDAT_ACT`, `TOOL_DATA[n]`/`BASE_DATA[n]` of a `$config.dat`; RAPID
+//!   tooldata and wobjdata; URScript `set_tcp`), mapped to the model's tool frame in its base
+//!   frame; a frame robocal cannot resolve leaves the target unchanged ("frame unknown"), never
+//!   compensated in another frame. The desired joints are the nominal model's inverse
+//!   kinematics on the branch the target's configuration data give ([`seed::Branch`]: KRL `S`
+//!   and `T`, RAPID confdata; a URScript pose, which has none, takes the solution nearest the
+//!   previous target's joints, as the controller takes the one nearest its current joints). The
+//!   compensated pose written is the nominal model's pose at the commanded joints, so that the
+//!   controller, which believes the nominal model, drives the robot to the commanded joints.
+//!   The configuration data are kept, and must still hold at the commanded joints
+//!   ([`IkStatus::ConfigurationChange`] otherwise), with one exception: a KRL `T` follows an
+//!   axis that compensation moves across 0 from within 1 degree of it (a target at A4 = 0 may
+//!   need A4 = -0.002).
 //!
-//! Numbers are written with [`ProgramSettings::decimals`] decimals in mm and deg (3 more in m and
-//! rad, 4 more for a quaternion), and every written target is verified after rounding: read back
-//! as the controller would (joints, or the nominal inverse kinematics of the written pose from
-//! the commanded joints, on the target's branch), the calibrated model's tool must be within
-//! [`ProgramSettings::verify_mm`] and [`ProgramSettings::verify_deg`] of the desired pose.
+//! Every motion statement is counted by a scan independent of the readers ([`census`]), and
+//! reported compensated or unchanged with its reason ([`CompensatedProgram::motions`]).
+//!
+//! Numbers are written as precisely as the controller stores them ([`digits`]: 32-bit floats for
+//! KRL and RAPID, 9 decimals for URScript), and every written target is verified as the
+//! controller stores it: read back as the controller would (joints, or the nominal inverse
+//! kinematics of the written pose from the commanded joints, on the target's branch), the
+//! calibrated model's tool must be within [`ProgramSettings::verify_mm`] and
+//! [`ProgramSettings::verify_deg`] of the desired pose.
 
 pub mod census;
 pub mod census_krl;

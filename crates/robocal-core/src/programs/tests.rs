@@ -480,3 +480,63 @@ fn shipped_example_programs_are_the_fixtures() {
         );
     }
 }
+
+/// A RAPID target in a declared work object for a declared tool: compensated through both
+/// (FK on the calibrated model, the tool as given, after 32-bit rounding); the same target in
+/// a work object declared elsewhere is left unchanged, "frame unknown".
+#[test]
+fn rapid_targets_are_mapped_through_their_tool_and_work_object() {
+    use crate::frame::pose;
+    let nom = robot_file("programs/irb-like.toml");
+    let cal = perturbed(&nom, 9);
+    let grip = pose(&[20.0, 0.0, 300.0, 0.0, 0.4, 0.0]);
+    let w = pose(&[800.0, -300.0, 200.0, 0.5, 0.0, 0.0]) * pose(&[0.0, 0.0, 50.0, 0.0, 0.0, 0.0]);
+    let q = nom
+        .joint_space()
+        .joints_from_axes(&[-25.0, 20.0, -10.0, 100.0, -50.0, -100.0]);
+    let flange = nom.tool_pose(&q) * nom.tool_frame().inverse();
+    let p = w.inverse() * flange * grip;
+    let v = rapid::pose_values(&p, &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]);
+    let c = rapid_conf(&nom, &q);
+    let q5 = nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, 0.5);
+    let text = format!(
+        "MODULE m\n  PERS tooldata grip := [TRUE,[[20,0,300],[{},0,{},0]],[5,[0,0,100],[1,0,0,0],0,0,0]];\n  \
+         PERS wobjdata table := [FALSE,TRUE,\"\",[[800,-300,200],[{},{},{},{}]],[[0,0,50],[1,0,0,0]]];\n  \
+         CONST robtarget pt := [[{},{},{}],[{},{},{},{}],[{},{},{},{}],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];\n  \
+         PROC main()\n    MoveL pt, v100, z10, grip\\WObj:=table;\n  ENDPROC\nENDMODULE\n",
+        (0.2f64).cos(), (0.2f64).sin(), q5.w, q5.i, q5.j, q5.k,
+        v[0], v[1], v[2], v[3], v[4], v[5], v[6], c[0], c[1], c[2], c[3]
+    );
+    let comp = Compensator::new(&nom, &cal, DampedLeastSquares::default()).unwrap();
+    let s = ProgramSettings::default();
+    let out = run(Path::new("m.mod"), &text, Format::Rapid, &comp, &s);
+    assert!(out.changes[0].applied, "{:?}", out.changes);
+    assert!(
+        out.unchanged_motions().next().is_none(),
+        "{:?}",
+        out.motions
+    );
+    let t = &Format::Rapid
+        .targets(Path::new("m.mod"), &out.texts[0])
+        .unwrap()[0];
+    let new: Vec<f64> = t.fields.iter().map(|f| f64::from(f.value as f32)).collect();
+    let x = w * rapid::pose_of(&new) * grip.inverse() * nom.tool_frame();
+    let BranchJoints::Found(qc) = branch_joints(&nom, &PoseNewton::default(), &x, &t.branch(None))
+    else {
+        panic!("not on its branch")
+    };
+    let real = cal.tool_pose(&qc) * cal.tool_frame().inverse() * grip;
+    let (dp, dw) = pose_distance(&real, &(w * p));
+    assert!(dp < 3e-4 && dw < 3e-5, "{dp} mm {dw} deg");
+    assert!(out.changes[0].correction_mm > 0.05);
+    // A work object this module does not declare.
+    let other = text.replace("\\WObj:=table", "\\WObj:=fixture");
+    let out = run(Path::new("m.mod"), &other, Format::Rapid, &comp, &s);
+    assert_eq!(out.texts[0], other);
+    let why = out.changes[0].skipped.as_deref().unwrap();
+    assert!(
+        why.contains("frame unknown") && why.contains("fixture"),
+        "{why}"
+    );
+    assert_eq!(out.unchanged_motions().count(), 1);
+}
