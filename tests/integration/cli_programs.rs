@@ -477,6 +477,17 @@ fn every_motion_is_accounted_for() {
 /// A real cell's shape: a .src whose inline forms (folds) name points of its .dat, tools and
 /// bases from the controller's $config.dat, 120 points.
 fn cell(dir: &Dir, nom: &Robot, n: usize) -> (PathBuf, PathBuf) {
+    cell_named(dir, nom, n, "cell", "$config.dat")
+}
+
+/// [`cell`] with the program's name and the config file's name.
+fn cell_named(
+    dir: &Dir,
+    nom: &Robot,
+    n: usize,
+    name: &str,
+    config_name: &str,
+) -> (PathBuf, PathBuf) {
     use robocal_core::programs::krl;
     use robocal_core::programs::seed::krl_status;
     let tool = robocal_core::frame::pose(&[10.0, -5.0, 300.0, 0.0, 0.3, 0.0]);
@@ -484,9 +495,9 @@ fn cell(dir: &Dir, nom: &Robot, n: usize) -> (PathBuf, PathBuf) {
     let config = "DEFDAT $CONFIG\nDECL FRAME TOOL_DATA[16]\nTOOL_DATA[1]={X 10.0,Y -5.0,Z 300.0,A 0.0,B 17.188733853924695,C 0.0}\n\
                   BASE_DATA[1]={X 1200.0,Y -400.0,Z 50.0,A 28.64788975654116,B 0.0,C 0.0}\nENDDAT\n";
     let js = nom.joint_space();
-    let mut src = String::from("&ACCESS RVP\r\n&REL 1\r\nDEF cell( )\r\n;FOLD INI;%{PE}\r\nBAS(#INITMOV,0)\r\n;ENDFOLD (INI)\r\n\r\n");
-    let mut dat = String::from("&ACCESS RVP\r\nDEFDAT cell\r\nDECL E6AXIS XHOME={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 45.0,A6 0.0,E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}\r\n\
-        DECL FDAT FHOME={TOOL_NO 0,BASE_NO 0,IPO_FRAME #BASE,POINT2[] \" \"}\r\nDECL PDAT PPDAT1={VEL 100.0,ACC 100.0,APO_DIST 100.0,APO_MODE #CDIS}\r\n");
+    let mut src = format!("&ACCESS RVP\r\n&REL 1\r\nDEF {name}( )\r\n;FOLD INI;%{{PE}}\r\nBAS(#INITMOV,0)\r\n;ENDFOLD (INI)\r\n\r\n");
+    let mut dat = format!("&ACCESS RVP\r\nDEFDAT {name}\r\nDECL E6AXIS XHOME={{A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 45.0,A6 0.0,E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}}\r\n\
+        DECL FDAT FHOME={{TOOL_NO 0,BASE_NO 0,IPO_FRAME #BASE,POINT2[] \" \"}}\r\nDECL PDAT PPDAT1={{VEL 100.0,ACC 100.0,APO_DIST 100.0,APO_MODE #CDIS}}\r\n");
     src += ";FOLD PTP HOME Vel=100 % DEFAULT;%{PE}\r\nFDAT_ACT=FHOME\r\nBAS(#PTP_PARAMS,100)\r\nPTP XHOME\r\n;ENDFOLD\r\n";
     for k in 0..n {
         let a = [
@@ -519,9 +530,11 @@ fn cell(dir: &Dir, nom: &Robot, n: usize) -> (PathBuf, PathBuf) {
     }
     src += "PTP XHOME\r\nEND\r\n";
     dat += "ENDDAT\r\n";
-    dir.write("cell.src", src);
-    dir.write("cell.dat", dat);
-    (dir.join("cell.src"), dir.write("$config.dat", config))
+    dir.write(&format!("{name}.dat"), dat);
+    (
+        dir.write(&format!("{name}.src"), src),
+        dir.write(config_name, config),
+    )
 }
 
 #[test]
@@ -599,4 +612,22 @@ fn five_thousand_targets_in_under_a_second() {
     // 0.35 s measured alone (README, "Robot programs"); the bound leaves room for a loaded
     // machine while catching a quadratic step (11 s before the name index).
     assert!(s < 2.0, "{s} s");
+}
+
+/// The shipped KRL cell example (`examples/programs/kr480_cell.src`, its `.dat` and
+/// `kr480-config.dat`) is [`cell_named`] with 8 points; `ROBOCAL_WRITE_EXAMPLE=1` rewrites it.
+#[test]
+fn the_shipped_cell_example_is_the_generator() {
+    let dir = Dir::new();
+    let nom = preset(KUKA).unwrap();
+    cell_named(&dir, &nom, 8, "kr480_cell", "kr480-config.dat");
+    for f in ["kr480_cell.src", "kr480_cell.dat", "kr480-config.dat"] {
+        let made = std::fs::read_to_string(dir.join(f)).unwrap();
+        if std::env::var_os("ROBOCAL_WRITE_EXAMPLE").is_some() {
+            std::fs::write(shipped(f), &made).unwrap();
+            continue;
+        }
+        let have = std::fs::read_to_string(shipped(f)).unwrap();
+        assert_eq!(have, made, "{f}: regenerate with ROBOCAL_WRITE_EXAMPLE=1");
+    }
 }
