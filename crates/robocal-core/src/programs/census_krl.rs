@@ -333,5 +333,7 @@ mod tests {
         assert!(matches!(m[4].refs[0], TargetRef::Computed(_)));
         assert!(matches!(m[5].frames.tool, FrameSpec::Known(_)));
         assert!(matches!(m[5].frames.base, FrameSpec::Known(_)));
+        crate::programs::tests::edits_never_panic(crate::programs::Format::Krl, src);
+        crate::programs::tests::edits_never_panic(crate::programs::Format::Krl, dat);
     }
 }

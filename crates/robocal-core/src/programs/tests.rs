@@ -214,6 +214,12 @@ pub(crate) fn edits_never_panic(format: Format, fixture: &str) {
             }
         }
         let text = String::from_utf8_lossy(&b);
+        // The motion census reads any text.
+        match format {
+            Format::Krl => drop(census_krl::motions(&text, Some(&text), None)),
+            Format::Rapid => drop(census_rapid::motions(&text)),
+            Format::UrScript => drop(census_ur::motions(&text)),
+        }
         if let Ok(ts) = format.targets(Path::new("f"), &text) {
             for t in ts {
                 for f in &t.fields {
