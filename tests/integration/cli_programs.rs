@@ -530,9 +530,9 @@ fn cell_named(
     }
     src += "PTP XHOME\r\nEND\r\n";
     dat += "ENDDAT\r\n";
-    dir.write(&format!("{name}.dat"), dat);
+    dir.write(format!("{name}.dat"), dat);
     (
-        dir.write(&format!("{name}.src"), src),
+        dir.write(format!("{name}.src"), src),
         dir.write(config_name, config),
     )
 }
