@@ -8,11 +8,11 @@ MODULE demo
 
   PROC main()
     MoveAbsJ j0, v100, fine, tool0;
-    MoveJ p0, v100, z10, tool0;
+    MoveJ p0, v100, z10, gun;
     MoveAbsJ [[-25,20,-10,100,-50,-200],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]]\NoEOffs, v100, fine, tool0;
-    MoveL [[2334.922,-1538.286, 1816.608],[0.03976264,0.23911941,-0.75108722,0.61409187],[-1,1,-3,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]], v100, z10, tool0\WObj:=wobj0; ! inline
+    MoveL [[2334.922,-1538.286, 1816.608],[0.03976264,0.23911941,-0.75108722,0.61409187],[-1,1,-3,1],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]], v100, z10, gun\WObj:=wobj0; ! inline
 
     MoveAbsJ j2, v100, fine, tool0;
-    MoveJ p2, v100, z10, tool0;
+    MoveJ p2, v100, z10, gun;
   ENDPROC
 ENDMODULE

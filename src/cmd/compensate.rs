@@ -64,6 +64,11 @@ pub struct CompensateArgs {
     /// (exit 5, nothing written).
     #[arg(long, requires = "program")]
     keep_going: bool,
+    /// With a KRL `--program`: the controller's `$config.dat`, whose `TOOL_DATA[n]` and
+    /// `BASE_DATA[n]` resolve the program's tools and bases (without it, Cartesian targets in a
+    /// numbered tool or base other than 0 are left unchanged, "frame unknown").
+    #[arg(long, value_name = "$config.dat", requires = "program")]
+    config: Option<PathBuf>,
     /// Output: with `--program`, the compensated program. Otherwise: commanded joints q1..qn (degrees, mm for a prismatic joint) and, when the robot
     /// has a controller map, the controller's axis1..axisN, with status, residual and the
     /// desired values. `-`: standard output (written when complete; the summary then goes to
@@ -114,6 +119,7 @@ struct Settings {
     program: Option<(PathBuf, robocal_core::programs::Format)>,
     changes: Option<PathBuf>,
     keep_going: bool,
+    config: Option<PathBuf>,
 }
 
 impl TryFrom<&CompensateArgs> for Settings {
@@ -182,6 +188,15 @@ impl TryFrom<&CompensateArgs> for Settings {
         if let Some(c) = &a.changes {
             plan.output_or_stdout("--changes", c);
         }
+        plan.input_opt("--config", a.config.as_deref());
+        if let Some(dat) = a.program.as_deref().and_then(program::dat_beside) {
+            plan.input("--program", &dat);
+            plan.output(
+                "--out",
+                &program::dat_path(&a.out),
+                "a KRL program with a .dat",
+            );
+        }
         let outputs = plan.check()?;
         let (nominal, mut calibrated, res) = calibrated_model(a.robot.as_deref(), &a.params)?;
         super::common::apply_payload(&mut calibrated, a.payload_kg)?;
@@ -224,6 +239,7 @@ impl TryFrom<&CompensateArgs> for Settings {
             program,
             changes: a.changes.clone(),
             keep_going: a.keep_going,
+            config: a.config.clone(),
         })
     }
 }
@@ -244,6 +260,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         program: program_file,
         changes,
         keep_going,
+        config,
     } = Settings::try_from(&a)?;
     let dof = nominal.dof();
     let joints = nominal.joint_space();
@@ -260,6 +277,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
             keep_going,
             full_pose: !position_only,
             params: &params,
+            config: config.as_deref(),
         };
         return program::run(&run, &comp, &mut outputs);
     }

@@ -4,8 +4,10 @@
 
 use crate::exit;
 use robocal_core::io::atomic::{commit_all, AtomicFile};
+use robocal_core::programs::census::{MotionOutcome, MotionReport};
+use robocal_core::programs::frames::KrlConfig;
 use robocal_core::programs::{
-    compensate_program, Change, CompensatedProgram, Format, ProgramSettings, TargetKind,
+    compensate_program, Change, CompensatedProgram, Format, ProgramSettings, Source, TargetKind,
 };
 use robocal_core::{Compensator, DampedLeastSquares};
 use std::io::Write;
@@ -20,11 +22,41 @@ pub(super) struct ProgramRun<'a> {
     pub keep_going: bool,
     pub full_pose: bool,
     pub params: &'a Path,
+    pub config: Option<&'a Path>,
+}
+
+/// The `.dat` beside a KRL `.src` (same stem; `.dat` or `.DAT`), when it exists.
+pub(super) fn dat_beside(program: &Path) -> Option<std::path::PathBuf> {
+    let ext = program.extension()?.to_str()?;
+    if !ext.eq_ignore_ascii_case("src") {
+        return None;
+    }
+    ["dat", "DAT"]
+        .iter()
+        .map(|e| program.with_extension(e))
+        .find(|p| p.is_file())
+}
+
+/// The `.dat` written beside an output `.src`.
+pub(super) fn dat_path(out: &Path) -> std::path::PathBuf {
+    out.with_extension("dat")
+}
+
+fn read_text(flag: &str, path: &Path) -> anyhow::Result<String> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| anyhow::anyhow!(e).context(format!("{flag} {}", path.display())))?;
+    String::from_utf8(bytes).map_err(|e| {
+        exit::input(format!(
+            "{flag} {}: not UTF-8 text (byte {}); save it as UTF-8 (or ASCII)",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        ))
+    })
 }
 
 /// The header of the `--changes` CSV (README, "Robot programs").
 pub(super) const CHANGES_HEADER: &str = "name,line,kind,status,applied,correction_mm,\
-    correction_deg,verified_mm,verified_deg,old,new";
+    correction_deg,verified_mm,verified_deg,old,new,reason";
 
 /// Targets listed one by one before the rest are counted.
 const LISTED: usize = 50;
@@ -34,42 +66,69 @@ pub(super) fn run(
     comp: &Compensator<'_, DampedLeastSquares>,
     outputs: &mut super::super::io_plan::Outputs,
 ) -> anyhow::Result<()> {
-    let bytes = std::fs::read(r.program)
-        .map_err(|e| anyhow::anyhow!(e).context(format!("--program {}", r.program.display())))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        exit::input(format!(
-            "--program {}: not UTF-8 text (byte {}); save the program as UTF-8 (or ASCII)",
-            r.program.display(),
-            e.utf8_error().valid_up_to()
-        ))
-    })?;
+    if r.config.is_some() && r.format != Format::Krl {
+        return Err(exit::usage(
+            "--config (a KUKA $config.dat) applies to a KRL program (.src)".to_owned(),
+        ));
+    }
+    let mut sources = vec![Source {
+        path: r.program.to_owned(),
+        text: read_text("--program", r.program)?,
+    }];
+    if let Some(dat) = dat_beside(r.program) {
+        let text = read_text("--program", &dat)?;
+        sources.push(Source { path: dat, text });
+    }
+    let config = match r.config {
+        Some(p) => Some(KrlConfig::parse(p, &read_text("--config", p)?)?),
+        None => None,
+    };
     let settings = ProgramSettings {
         full_pose: r.full_pose,
         ..ProgramSettings::default()
     };
     let pb = crate::progress::spinner("compensating the program's targets");
-    let res = compensate_program(r.program, &text, r.format, comp, &settings);
+    let res = compensate_program(&sources, r.format, config.as_ref(), comp, &settings);
     pb.finish_and_clear();
     let res = res?;
     let failed: Vec<&Change> = res.changes.iter().filter(|c| !c.applied).collect();
-    if !failed.is_empty() && !r.keep_going {
-        let lines: Vec<String> = failed.iter().map(|c| describe(c)).collect();
+    let motions: Vec<&MotionReport> = res.unchanged_motions().collect();
+    if (!failed.is_empty() || !motions.is_empty()) && !r.keep_going {
+        let mut lines: Vec<String> = failed.iter().map(|c| describe(c)).collect();
+        lines.extend(motions.iter().map(|m| describe_motion(m)));
         return Err(exit::numerical(format!(
-            "{} of {} target(s) of {} cannot be compensated; nothing written (give \
-             --keep-going to leave them unchanged and write the rest):\n  {}",
+            "{} of {} target(s) and {} of {} motion(s) of {} cannot be compensated; nothing \
+             written (give --keep-going to leave them unchanged and write the rest):\n  {}",
             failed.len(),
             res.changes.len(),
+            motions.len(),
+            res.motions.len(),
             r.program.display(),
             lines.join("\n  ")
         )));
     }
-    let mut files = vec![write(outputs, r.out, res.text.as_bytes())?];
+    let mut files = vec![write(outputs, r.out, res.texts[0].as_bytes())?];
+    if let Some(dat) = res.texts.get(1) {
+        files.push(write(outputs, &dat_path(r.out), dat.as_bytes())?);
+    }
     if let Some(p) = r.changes {
         files.push(write(outputs, p, changes_csv(&res).as_bytes())?);
     }
     commit_all(files)?;
     print_listing(r, &res, &settings);
     Ok(())
+}
+
+/// One line of a motion left unchanged.
+fn describe_motion(m: &MotionReport) -> String {
+    let why = match &m.outcome {
+        MotionOutcome::Unchanged(w) => w.as_str(),
+        MotionOutcome::Compensated => "compensated",
+    };
+    format!(
+        "motion {} (line {}): {why}",
+        m.motion.statement, m.motion.line
+    )
 }
 
 fn write(
@@ -90,6 +149,7 @@ fn describe(c: &Change) -> String {
             "the written value misses the target by {:.4} mm, {:.4} deg after rounding",
             c.verified_mm, c.verified_deg
         ),
+        _ if c.skipped.is_some() => c.skipped.clone().unwrap_or_default(),
         s => s.to_string(),
     };
     format!("{} (line {}): {why}", c.name, c.line)
@@ -135,17 +195,34 @@ pub(super) fn changes_csv(res: &CompensatedProgram) -> String {
         } else {
             (String::new(), String::new())
         };
+        let status = if c.skipped.is_some() {
+            "frame_unknown".to_owned()
+        } else {
+            c.status.to_string()
+        };
         s += &format!(
-            "{},{},{},{},{},{cm},{cd},{},{},{},{}\n",
+            "{},{},{},{status},{},{cm},{cd},{},{},{},{},{}\n",
             field(&c.name),
             c.line,
             kind(c.kind),
-            c.status,
             c.applied,
             num(c.verified_mm),
             num(c.verified_deg),
             values(&c.old),
-            values(&c.new)
+            values(&c.new),
+            field(c.skipped.as_deref().unwrap_or(""))
+        );
+    }
+    for m in res.unchanged_motions() {
+        let why = match &m.outcome {
+            MotionOutcome::Unchanged(w) => w.as_str(),
+            MotionOutcome::Compensated => "",
+        };
+        s += &format!(
+            "{},{},motion,unchanged,false,,,,,,,{}\n",
+            field(&m.motion.statement),
+            m.motion.line,
+            field(why)
         );
     }
     s
@@ -205,6 +282,12 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
             .fold(0.0, f64::max)
     };
     println!(
+        "  motions: {} in the program, {} compensated, {} left unchanged",
+        res.motions.len(),
+        res.motions.len() - res.unchanged_motions().count(),
+        res.unchanged_motions().count()
+    );
+    println!(
         "  {applied} compensated, {} left unchanged; largest correction {:.4} mm, {:.4} deg; \
          checked by forward kinematics on the calibrated model after rounding: within {:.4} mm, \
          {:.4} deg (limit {} mm, {} deg)",
@@ -223,9 +306,18 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
             describe(c)
         );
     }
-    let shown = super::super::io_plan::shown;
-    match r.changes {
-        Some(p) => println!("wrote {} and {}", shown(r.out), shown(p)),
-        None => println!("wrote {}", shown(r.out)),
+    for m in res.unchanged_motions() {
+        println!("  unchanged: {}", describe_motion(m));
+        eprintln!(
+            "warning: {}: {}; left unchanged (--keep-going)",
+            r.program.display(),
+            describe_motion(m)
+        );
     }
+    let shown = super::super::io_plan::shown;
+    let dat = (res.texts.len() > 1).then(|| dat_path(r.out));
+    let mut wrote = vec![shown(r.out)];
+    wrote.extend(dat.as_deref().map(shown));
+    wrote.extend(r.changes.map(shown));
+    println!("wrote {}", wrote.join(" and "));
 }

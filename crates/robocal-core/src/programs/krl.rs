@@ -1,54 +1,225 @@
 //! KUKA KRL targets (`.src` and `.dat`): the aggregates `{...}` that hold a complete joint target
-//! (AXIS/E6AXIS: `A1..A6` in degrees, external axes `E1..` kept) or a complete Cartesian target
+//! (AXIS/E6AXIS: `A1..A6` in degrees, external axes `E1..E6` kept) or a complete Cartesian target
 //! (POS/E6POS/FRAME: `X, Y, Z` mm and `A, B, C` deg; `S` and `T` kept).
 //!
 //! What is read: every `{...}` outside comments (`;` to the end of the line) and strings, with an
-//! optional type prefix (`{E6POS: X 1, ...}`), whose fields are `NAME number` pairs separated by
-//! commas. It is a target when it has all of `A1..A6` (joints) or all of `X, Y, Z, A, B, C`
-//! (Cartesian). Not targets, and left alone: aggregates assigned to a system variable (`$BASE =
-//! {...}`, `$TOOL = {...}`: frames, not motions), the arguments of relative motions (`PTP_REL`,
-//! `LIN_REL`), and incomplete aggregates (`{A1 10}`: "the other axes unchanged"). A hand-written
-//! parser: KRL has no maintained Rust parser, and this is all robocal needs of it.
+//! optional type prefix (`{E6POS: X 1, ...}`), members `NAME value` separated by commas, values
+//! numbers, words or nested aggregates (`LOAD_DATA[1]={M 5,CM {X 0,...},J {...}}`). An aggregate
+//! is a target when it is declared or prefixed as one of the target types, or has a member of one
+//! (`A1..A6`, `X, Y, Z, A, B, C`), and holds all six of its kind. Such an aggregate is checked
+//! whole, and an error names its line and member: not closed on its line, a nested aggregate, a
+//! member given twice or unknown to its type (`A7` on a six-axis robot), a value that is not a
+//! number or out of range ([`crate::ranges`]: `A1..A6` joint values, `X, Y, Z` and `E1..E6`
+//! lengths, `A, B, C` angles), a status `S` outside 0..7 or a turn `T` outside 0..63. Not
+//! targets, and left alone: aggregates assigned to a system variable (`$BASE = {...}`, `$TOOL =
+//! {...}`: frames, not motions; checked like a Cartesian target), the arguments of relative
+//! motions (`PTP_REL`, `LIN_REL`), and incomplete aggregates (`{A1 10}`: "the other axes
+//! unchanged"). A hand-written parser: KRL has no maintained Rust parser, and this is all robocal
+//! needs of it.
 
 use super::lex::{line_end, past_string};
 use super::{Field, ProgramTarget, TargetKind};
 use crate::error::{Error, Result};
 use crate::frame::{frame_vector, pose, Frame};
+use crate::ranges;
 use std::ops::Range;
 use std::path::Path;
 
 const JOINT_FIELDS: [&str; 6] = ["A1", "A2", "A3", "A4", "A5", "A6"];
 const POSE_FIELDS: [&str; 6] = ["X", "Y", "Z", "A", "B", "C"];
+const EXTERNAL: [&str; 6] = ["E1", "E2", "E3", "E4", "E5", "E6"];
+/// The KRL types of targets and what they hold.
+const TYPES: [(&str, TargetKind); 5] = [
+    ("E6POS", TargetKind::Pose),
+    ("POS", TargetKind::Pose),
+    ("FRAME", TargetKind::Pose),
+    ("E6AXIS", TargetKind::Joints),
+    ("AXIS", TargetKind::Joints),
+];
+/// Deepest nesting of aggregates read.
+const MAX_DEPTH: usize = 8;
 
-/// Finds the targets of a KRL file's text, in file order. An aggregate that names every field of
-/// a target but holds something else than a number in one of them (or in `S` or `T`) is an error
-/// naming its line and field.
+/// A member's value.
+#[derive(Debug, Clone)]
+pub(crate) enum Value {
+    /// A number, word or string: its trimmed span.
+    Scalar(Range<usize>),
+    /// A nested aggregate.
+    Nested,
+}
+
+/// One member `NAME value` of an aggregate.
+#[derive(Debug, Clone)]
+pub(crate) struct Member {
+    /// Its name, upper case.
+    pub name: String,
+    /// Its value.
+    pub value: Value,
+}
+
+impl Member {
+    /// The span of a scalar value.
+    pub fn value_span(&self) -> Option<Range<usize>> {
+        match &self.value {
+            Value::Scalar(r) => Some(r.clone()),
+            Value::Nested => None,
+        }
+    }
+}
+
+/// A KRL aggregate `{[TYPE:] NAME value, ...}`.
+#[derive(Debug, Clone)]
+pub(crate) struct Aggregate {
+    /// The byte of its `}`.
+    pub close: usize,
+    /// Its type prefix, upper case.
+    pub prefix: Option<String>,
+    /// Its members, in order.
+    pub members: Vec<Member>,
+}
+
+impl Aggregate {
+    /// The member named `name` (upper case).
+    pub fn member(&self, name: &str) -> Option<&Member> {
+        self.members.iter().find(|m| m.name == name)
+    }
+}
+
+fn skip_blank(b: &[u8], mut i: usize) -> usize {
+    while i < b.len() && (b[i] == b' ' || b[i] == b'\t') {
+        i += 1;
+    }
+    i
+}
+
+fn is_word(c: u8) -> bool {
+    c.is_ascii_alphanumeric() || c == b'_' || c == b'$'
+}
+
+/// Reads the aggregate whose `{` is at `open` (on `line`). An aggregate not closed on its line,
+/// or a member without a name or value, is an error.
+pub(crate) fn parse_aggregate(
+    path: &Path,
+    text: &str,
+    open: usize,
+    line: usize,
+) -> Result<Aggregate> {
+    nested(path, text, open, line, 0)
+}
+
+fn nested(path: &Path, text: &str, open: usize, line: usize, depth: usize) -> Result<Aggregate> {
+    let b = text.as_bytes();
+    let err = |field: Option<&str>, msg: &str| Error::parse(path, Some(line), field, msg);
+    let unclosed = || {
+        err(
+            None,
+            "an aggregate `{` that is not closed by `}` on its line",
+        )
+    };
+    if depth > MAX_DEPTH {
+        return Err(err(None, "aggregates nested too deep"));
+    }
+    let mut i = skip_blank(b, open + 1);
+    let mut prefix = None;
+    // An optional type prefix `E6POS:`.
+    let w = (i..b.len()).find(|&k| !is_word(b[k])).unwrap_or(b.len());
+    let after = skip_blank(b, w);
+    if w > i && b.get(after) == Some(&b':') {
+        prefix = Some(text[i..w].to_ascii_uppercase());
+        i = skip_blank(b, after + 1);
+    }
+    let mut members = Vec::new();
+    if b.get(i) == Some(&b'}') {
+        return Ok(Aggregate {
+            close: i,
+            prefix,
+            members,
+        });
+    }
+    loop {
+        i = skip_blank(b, i);
+        let s = i;
+        while i < b.len()
+            && !matches!(
+                b[i],
+                b' ' | b'\t' | b',' | b'}' | b'{' | b'\n' | b'\r' | b';'
+            )
+        {
+            i += 1;
+        }
+        if i == s {
+            return Err(match b.get(i) {
+                None | Some(b'\n' | b'\r' | b';') => unclosed(),
+                _ => err(None, "an aggregate member without a name"),
+            });
+        }
+        let name = text[s..i].to_ascii_uppercase();
+        i = skip_blank(b, i);
+        let value = match b.get(i) {
+            Some(b'{') => {
+                let n = nested(path, text, i, line, depth + 1)?;
+                i = n.close + 1;
+                Value::Nested
+            }
+            _ => {
+                let vs = i;
+                while i < b.len() && !matches!(b[i], b',' | b'}' | b'{' | b'\n' | b';') {
+                    if b[i] == b'"' {
+                        i = past_string(b, i).min(b.len());
+                        continue;
+                    }
+                    i += 1;
+                }
+                let mut ve = i.min(b.len());
+                while ve > vs && b[ve - 1].is_ascii_whitespace() {
+                    ve -= 1;
+                }
+                if ve == vs {
+                    if matches!(b.get(i), None | Some(b'\n' | b';')) {
+                        return Err(unclosed());
+                    }
+                    return Err(err(Some(&name), "a member without a value"));
+                }
+                Value::Scalar(vs..ve)
+            }
+        };
+        members.push(Member { name, value });
+        i = skip_blank(b, i);
+        match b.get(i) {
+            Some(b',') => i += 1,
+            Some(b'}') => {
+                return Ok(Aggregate {
+                    close: i,
+                    prefix,
+                    members,
+                })
+            }
+            Some(b'{') => return Err(err(None, "a nested aggregate `{` where a member belongs")),
+            _ => return Err(unclosed()),
+        }
+    }
+}
+
+/// Finds the targets of a KRL file's text, in file order. A target (see the module
+/// documentation) that is malformed is an error naming its line and member.
 pub fn targets(path: &Path, text: &str) -> Result<Vec<ProgramTarget>> {
     let b = text.as_bytes();
     let mut out = Vec::new();
     let mut i = 0;
+    let mut line = 1;
+    let mut counted = 0;
     while i < b.len() {
         match b[i] {
             b';' => i = line_end(b, i),
             b'"' => i = past_string(b, i),
             b'{' => {
-                // The aggregate ends at `}`; a `;`, `{` or the end of the text first: not one.
-                let Some(end) = b[i + 1..]
-                    .iter()
-                    .position(|&c| c == b'}' || c == b';' || c == b'{')
-                    .map(|k| k + 1)
-                else {
-                    break;
-                };
-                if b[i + end] != b'}' {
-                    i += end;
-                    continue;
-                }
-                let body = i + 1..i + end;
-                if let Some(t) = aggregate(path, text, i, body)? {
+                line += text[counted..i].matches('\n').count();
+                counted = i;
+                let agg = parse_aggregate(path, text, i, line)?;
+                if let Some(t) = classify(path, text, i, &agg, line)? {
                     out.push(t);
                 }
-                i += end + 1;
+                i = agg.close + 1;
             }
             _ => i += 1,
         }
@@ -57,114 +228,185 @@ pub fn targets(path: &Path, text: &str) -> Result<Vec<ProgramTarget>> {
 }
 
 /// The statement text before the aggregate at `open`, on its line.
-fn statement_before(text: &str, open: usize) -> &str {
+pub(crate) fn statement_before(text: &str, open: usize) -> &str {
     let start = text[..open].rfind('\n').map_or(0, |k| k + 1);
     &text[start..open]
 }
 
-fn aggregate(
+/// Whether the statement before an aggregate assigns it to a system variable (`$TOOL =`,
+/// `WITH $BASE =`) or a numbered frame (`TOOL_DATA[1]=`).
+pub(crate) fn assigns_frame(before: &str) -> bool {
+    let Some(eq) = before.rfind('=') else {
+        return false;
+    };
+    let lhs = before[..eq].trim_end();
+    let word = lhs
+        .rsplit(|c: char| c.is_whitespace() || c == ',')
+        .next()
+        .unwrap_or("")
+        .to_ascii_uppercase();
+    word.starts_with('$') || word.starts_with("TOOL_DATA[") || word.starts_with("BASE_DATA[")
+}
+
+/// The declared type of `DECL [GLOBAL] TYPE NAME=`, upper case.
+fn declared_type(before: &str) -> Option<String> {
+    let u = before.to_ascii_uppercase();
+    let mut w = u.split_whitespace();
+    if w.next()? != "DECL" {
+        return None;
+    }
+    let t = w.next()?;
+    if t == "GLOBAL" || t == "CONST" {
+        return w.next().map(str::to_owned);
+    }
+    Some(t.to_owned())
+}
+
+fn kind_of_type(t: &str) -> Option<TargetKind> {
+    TYPES.iter().find(|(n, _)| *n == t).map(|(_, k)| *k)
+}
+
+/// A target, a checked frame (`None`) or nothing, from an aggregate.
+fn classify(
     path: &Path,
     text: &str,
     open: usize,
-    body: Range<usize>,
+    agg: &Aggregate,
+    line: usize,
 ) -> Result<Option<ProgramTarget>> {
-    let before = statement_before(text, open).trim();
-    let upper = before.to_ascii_uppercase();
-    if upper.starts_with('$') || upper.contains("_REL") {
+    let before = statement_before(text, open);
+    let first = before
+        .split_whitespace()
+        .next()
+        .unwrap_or("")
+        .to_ascii_uppercase();
+    if first.ends_with("_REL") {
         return Ok(None);
     }
-    let line = text[..open].matches('\n').count() + 1;
-    let bad = |field: &str, value: &str| {
-        Error::parse(
-            path,
-            Some(line),
-            Some(field),
-            format!("`{value}` is not a number"),
-        )
+    let typed = agg
+        .prefix
+        .as_deref()
+        .or(declared_type(before).as_deref())
+        .and_then(kind_of_type);
+    let has = |names: &[&str]| agg.members.iter().any(|m| names.contains(&m.name.as_str()));
+    let frame = assigns_frame(before);
+    let kind = match typed {
+        Some(k) => k,
+        None if frame && has(&POSE_FIELDS) => TargetKind::Pose,
+        None if has(&JOINT_FIELDS) || agg.members.iter().any(|m| is_axis(&m.name)) => {
+            TargetKind::Joints
+        }
+        None if has(&POSE_FIELDS) => TargetKind::Pose,
+        None => return Ok(None),
     };
-    let mut inner = &text[body.clone()];
-    let mut offset = body.start;
-    // An optional type prefix `E6POS:`.
-    if let Some(colon) = inner.find(':') {
-        let head = inner[..colon].trim();
-        if head.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
-            offset += colon + 1;
-            inner = &inner[colon + 1..];
-        }
-    }
-    let mut fields = Vec::new();
-    let mut pos = offset;
-    for part in inner.split(',') {
-        let part_start = pos;
-        pos += part.len() + 1;
-        let trimmed = part.trim_start();
-        let lead = part.len() - trimmed.len();
-        let name_len = trimmed
-            .find(|c: char| c.is_whitespace())
-            .unwrap_or(trimmed.len());
-        let name = &trimmed[..name_len];
-        let rest = &trimmed[name_len..];
-        let value = rest.trim();
-        if name.is_empty() || value.is_empty() {
-            return Ok(None);
-        }
-        let vstart = part_start + lead + name_len + (rest.len() - rest.trim_start().len());
-        let span = vstart..vstart + value.len();
-        let v = value.parse::<f64>().ok();
-        fields.push((name.to_ascii_uppercase(), v, span, value.to_owned()));
-    }
-    let has = |names: &[&str]| names.iter().all(|n| fields.iter().any(|f| f.0 == *n));
-    let kind = if has(&JOINT_FIELDS) {
-        TargetKind::Joints
-    } else if has(&POSE_FIELDS) {
-        TargetKind::Pose
-    } else {
+    let checked = check(path, text, agg, kind, line)?;
+    if frame {
         return Ok(None);
-    };
-    let wanted: &[&str] = match kind {
-        TargetKind::Joints => &JOINT_FIELDS,
-        TargetKind::Pose => &POSE_FIELDS,
-    };
-    let mut picked = Vec::with_capacity(6);
-    for n in wanted {
-        let Some(f) = fields.iter().find(|f| f.0 == *n) else {
-            return Ok(None);
-        };
-        let value = f.1.filter(|v| v.is_finite()).ok_or_else(|| bad(n, &f.3))?;
-        picked.push(Field {
-            name: (*n).to_owned(),
-            value,
-            span: f.2.clone(),
-        });
     }
-    let int = |name: &str| -> Result<Option<(u32, Range<usize>)>> {
-        match fields.iter().find(|f| f.0 == name) {
-            None => Ok(None),
-            Some(f) => parse_krl_int(&f.3)
-                .map(|v| Some((v, f.2.clone())))
-                .ok_or_else(|| bad(name, &f.3)),
-        }
-    };
-    let t = if kind == TargetKind::Pose {
-        int("T")?
-    } else {
-        None
-    };
-    let status = if kind == TargetKind::Pose {
-        int("S")?.map(|s| s.0)
-    } else {
-        None
+    let Some((fields, turn, status)) = checked else {
+        return Ok(None);
     };
     Ok(Some(ProgramTarget {
         name: target_name(before),
         line,
         kind,
-        fields: picked,
-        turn: t.as_ref().map(|t| t.0),
-        turn_span: t.map(|t| t.1),
+        fields,
+        turn: turn.as_ref().map(|t| t.0),
+        turn_span: turn.map(|t| t.1),
         status,
         conf: None,
+        file: 0,
     }))
+}
+
+/// `A7`, `A12`: a robot axis name.
+fn is_axis(name: &str) -> bool {
+    name.len() > 1 && name.starts_with('A') && name[1..].bytes().all(|c| c.is_ascii_digit())
+}
+
+type Checked = (Vec<Field>, Option<(u32, Range<usize>)>, Option<u32>);
+
+/// Checks every member of a target aggregate of `kind`; its fields when it is complete.
+fn check(
+    path: &Path,
+    text: &str,
+    agg: &Aggregate,
+    kind: TargetKind,
+    line: usize,
+) -> Result<Option<Checked>> {
+    let err = |field: &str, msg: String| Error::parse(path, Some(line), Some(field), msg);
+    let (main, what): (&[&str; 6], &str) = match kind {
+        TargetKind::Joints => (&JOINT_FIELDS, "a joint target (A1..A6, E1..E6)"),
+        TargetKind::Pose => (
+            &POSE_FIELDS,
+            "a Cartesian target (X, Y, Z, A, B, C, S, T, E1..E6)",
+        ),
+    };
+    let mut seen: Vec<&str> = Vec::new();
+    let mut turn = None;
+    let mut status = None;
+    let mut values: Vec<Option<Field>> = vec![None; 6];
+    for m in &agg.members {
+        let n = m.name.as_str();
+        if seen.contains(&n) {
+            return Err(err(n, format!("member `{n}` given twice")));
+        }
+        seen.push(n);
+        let Some(span) = m.value_span() else {
+            return Err(err(n, "a nested aggregate where a number belongs".into()));
+        };
+        let raw = &text[span.clone()];
+        let pos = main.iter().position(|x| *x == n);
+        let ext = EXTERNAL.contains(&n);
+        let int_field = kind == TargetKind::Pose && (n == "S" || n == "T");
+        if pos.is_none() && !ext && !int_field {
+            if kind == TargetKind::Joints && is_axis(n) {
+                return Err(err(
+                    n,
+                    format!("axis `{n}`: the robot has 6 axes (A1..A6; external axes E1..E6)"),
+                ));
+            }
+            return Err(err(n, format!("`{n}` is not a member of {what}")));
+        }
+        if int_field {
+            let (max, desc) = if n == "T" {
+                (63, "turn `T` (one bit per axis: 0..63)")
+            } else {
+                (7, "status `S` (3 bits: 0..7)")
+            };
+            let v = parse_krl_int(raw)
+                .ok_or_else(|| err(n, format!("`{raw}` is not an integer ({desc})")))?;
+            if !(0..=max).contains(&v) {
+                return Err(err(n, format!("{desc}: {v} is outside 0..{max}")));
+            }
+            if n == "T" {
+                turn = Some((v as u32, span));
+            } else {
+                status = Some(v as u32);
+            }
+            continue;
+        }
+        let v: f64 = raw
+            .parse()
+            .map_err(|_| err(n, format!("`{raw}` is not a number")))?;
+        let range = match (kind, pos) {
+            (TargetKind::Joints, Some(_)) => &ranges::JOINT,
+            (TargetKind::Pose, Some(k)) if k >= 3 => &ranges::ANGLE,
+            _ => &ranges::LENGTH,
+        };
+        range.check(v).map_err(|m| err(n, m))?;
+        if let Some(k) = pos {
+            values[k] = Some(Field {
+                name: n.to_owned(),
+                value: v,
+                span,
+            });
+        }
+    }
+    if values.iter().any(Option::is_none) {
+        return Ok(None);
+    }
+    Ok(Some((values.into_iter().flatten().collect(), turn, status)))
 }
 
 /// The tool frame of a KRL pose `X, Y, Z` (mm), `A, B, C` (deg).
@@ -192,20 +434,20 @@ pub fn pose_values(f: &Frame) -> Vec<f64> {
     ]
 }
 
-/// A KRL integer: decimal or a binary literal `'B010'`.
-fn parse_krl_int(s: &str) -> Option<u32> {
+/// A KRL integer: decimal (also written `35.0`) or a binary literal `'B010'`.
+fn parse_krl_int(s: &str) -> Option<i64> {
     let s = s.trim();
     if let Some(bits) = s
         .strip_prefix("'B")
         .or_else(|| s.strip_prefix("'b"))
         .and_then(|r| r.strip_suffix('\''))
     {
-        return u32::from_str_radix(bits, 2).ok();
+        return i64::from_str_radix(bits, 2).ok();
     }
     s.parse::<f64>()
         .ok()
-        .filter(|v| *v >= 0.0 && v.fract() == 0.0)
-        .map(|v| v as u32)
+        .filter(|v| v.fract() == 0.0 && v.abs() < 1e15)
+        .map(|v| v as i64)
 }
 
 /// `DECL E6POS XP1=` gives `XP1`; `PTP` gives `PTP`; an empty statement gives `{...}`.
@@ -234,19 +476,6 @@ pub fn format_turn(t: u32, old: &str) -> String {
     }
 }
 
-/// A number written in KRL with `decimals` decimals (`-0.0000` written as `0.0000`).
-pub fn format_number(v: f64, decimals: usize) -> String {
-    let s = format!("{v:.decimals$}");
-    if s.trim_start_matches('-')
-        .bytes()
-        .all(|c| c == b'0' || c == b'.')
-    {
-        s.trim_start_matches('-').to_owned()
-    } else {
-        s
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -256,6 +485,8 @@ mod tests {
         DECL E6AXIS XHOME={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 45.0,A6 0.0,E1 0.0}\n\
         DECL E6POS XP1={X 2500.0,Y -100.5,Z 1500,A 10,B 80.5,C -170,S 'B010',T 35,E1 0.0}\n\
         DECL FRAME F1={X 1,Y 2,Z 3}\n\
+        DECL FDAT FP1={TOOL_NO 1,BASE_NO 2,IPO_FRAME #BASE,POINT2[] \" \",TQ_STATE FALSE}\n\
+        DECL LOAD L1={M 5,CM {X 0,Y 0,Z 100,A 0,B 0,C 0},J {X 0,Y 0,Z 0}}\n\
         ENDDAT\n";
 
     #[test]
@@ -289,17 +520,84 @@ mod tests {
         assert_eq!(t[1].status, None);
     }
 
+    /// The malformed aggregates of issue 26, each exit 3 naming its line and member.
     #[test]
     fn a_malformed_target_is_an_error_naming_its_line_and_field() {
-        let src = "DEF m()\n\nPTP {A1 1, A2 -90, A3 9O, A4 0, A5 30, A6 0}\nEND\n";
-        let e = targets(Path::new("m.src"), src).unwrap_err().to_string();
-        assert!(
-            e.contains("m.src:3") && e.contains("A3") && e.contains("9O"),
-            "{e}"
-        );
-        let src = "DEF m()\nLIN {X 1, Y 2, Z 3, A 0, B 90, C 0, S 'B2', T 0}\nEND\n";
-        let e = targets(Path::new("m.src"), src).unwrap_err().to_string();
-        assert!(e.contains("m.src:2") && e.contains("`S`"), "{e}");
+        let cases = [
+            (
+                "\n\nPTP {A1 1, A2 -90, A3 9O, A4 0, A5 30, A6 0}\n",
+                "m.src:3",
+                "`A3`",
+                "9O",
+            ),
+            (
+                "LIN {X 1, Y 2, Z 3, A 0, B 90, C 0, S 'B2', T 0}\n",
+                "m.src:1",
+                "`S`",
+                "'B2'",
+            ),
+            (
+                "PTP {A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0\n",
+                "m.src:1",
+                "not closed",
+                "",
+            ),
+            (
+                "PTP {A1 0, A2 {A1 1}, A3 90, A4 0, A5 30, A6 0}\n",
+                "m.src:1",
+                "`A2`",
+                "nested",
+            ),
+            (
+                "PTP {A1 0, A2 -90, A3 90, A3 91, A4 0, A5 30, A6 0}\n",
+                "m.src:1",
+                "`A3`",
+                "twice",
+            ),
+            (
+                "PTP {A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0, A7 5}\n",
+                "m.src:1",
+                "`A7`",
+                "6 axes",
+            ),
+            (
+                "PTP {A1 0, A2 -9e99, A3 90, A4 0, A5 30, A6 0}\n",
+                "m.src:1",
+                "`A2`",
+                "out of range",
+            ),
+            (
+                "LIN {X 9e15, Y 2, Z 3, A 0, B 90, C 0}\n",
+                "m.src:1",
+                "`X`",
+                "out of range",
+            ),
+            (
+                "LIN {X 1, Y 2, Z 3, A 0, B 90, C 0, T -5}\n",
+                "m.src:1",
+                "turn `T`",
+                "0..63",
+            ),
+            (
+                "LIN {X 1, Y 2, Z 3, A 0, B 90, C 0, T 64}\n",
+                "m.src:1",
+                "turn `T`",
+                "0..63",
+            ),
+            (
+                "DECL E6POS P={X 1, Y 2, Z 3, A 0, B 90, Q 0}\n",
+                "m.src:1",
+                "`Q`",
+                "not a member",
+            ),
+        ];
+        for (src, at, field, what) in cases {
+            let e = targets(Path::new("m.src"), src).unwrap_err().to_string();
+            assert!(
+                e.contains(at) && e.contains(field) && e.contains(what),
+                "{src}: {e}"
+            );
+        }
     }
 
     #[test]
@@ -314,12 +612,5 @@ mod tests {
     #[test]
     fn random_byte_edits_never_panic() {
         crate::programs::tests::edits_never_panic(super::super::Format::Krl, DAT);
-    }
-
-    #[test]
-    fn numbers_are_written_with_fixed_decimals() {
-        assert_eq!(format_number(1.23456789, 4), "1.2346");
-        assert_eq!(format_number(-0.00001, 4), "0.0000");
-        assert_eq!(format_number(-90.0, 4), "-90.0000");
     }
 }

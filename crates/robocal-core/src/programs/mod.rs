@@ -13,40 +13,55 @@
 //!   ([`crate::model::JointSpace::joints_from_axes`]; the KUKA presets: q = (-A1, A2, A3, -A4,
 //!   A5, -A6); robots without a map: the identity) to the desired model joints; the commanded
 //!   joints go back to axis values.
-//! - **Cartesian targets** (KRL POS/E6POS/FRAME, RAPID robtarget, URScript `p[...]`): the pose is
-//!   taken as the tool frame (target 1, [`crate::Robot::tool_pose`]) in the robot's base frame,
-//!   i.e. the program's base/work object and tool are those of the robot description: a `$BASE`
-//!   or `$TOOL` set in a KRL program, a RAPID wobj other than `wobj0` or a tool other than the
-//!   robot file's, a URScript `set_tcp` are not followed. The desired joints are the nominal
-//!   model's inverse kinematics on the branch the target's configuration data give
-//!   ([`seed::Branch`]: KRL `S` and `T`, RAPID confdata; a URScript pose, which has none, takes
-//!   the solution nearest the previous target's joints, as the controller takes the one nearest
-//!   its current joints). The compensated pose written is the nominal model's pose at the
-//!   commanded joints, so that the controller, which believes the nominal model, drives the
-//!   robot to the commanded joints. The configuration data are kept, and must still hold at the
-//!   commanded joints ([`IkStatus::ConfigurationChange`] otherwise), with one exception: a KRL
-//!   `T` follows an axis that compensation moves across 0 from within 1 degree of it (a target
-//!   at A4 = 0 may need A4 = -0.002).
+//! - **Cartesian targets** (KRL POS/E6POS/FRAME, RAPID robtarget, URScript `p[...]`): the pose
+//!   is in the base and for the tool in force at the motions that use it ([`frames`]: KRL
+//!   `$TOOL`/`$BASE`, `BAS`, `FDAT_ACT`, `TOOL_DATA[n]`/`BASE_DATA[n]` of a `$config.dat`; RAPID
+//!   tooldata and wobjdata; URScript `set_tcp`), mapped to the model's tool frame in its base
+//!   frame; a frame robocal cannot resolve leaves the target unchanged ("frame unknown"), never
+//!   compensated in another frame. The desired joints are the nominal model's inverse
+//!   kinematics on the branch the target's configuration data give ([`seed::Branch`]: KRL `S`
+//!   and `T`, RAPID confdata; a URScript pose, which has none, takes the solution nearest the
+//!   previous target's joints, as the controller takes the one nearest its current joints). The
+//!   compensated pose written is the nominal model's pose at the commanded joints, so that the
+//!   controller, which believes the nominal model, drives the robot to the commanded joints.
+//!   The configuration data are kept, and must still hold at the commanded joints
+//!   ([`IkStatus::ConfigurationChange`] otherwise), with one exception: a KRL `T` follows an
+//!   axis that compensation moves across 0 from within 1 degree of it (a target at A4 = 0 may
+//!   need A4 = -0.002).
 //!
-//! Numbers are written with [`ProgramSettings::decimals`] decimals in mm and deg (3 more in m and
-//! rad, 4 more for a quaternion), and every written target is verified after rounding: read back
-//! as the controller would (joints, or the nominal inverse kinematics of the written pose from
-//! the commanded joints, on the target's branch), the calibrated model's tool must be within
-//! [`ProgramSettings::verify_mm`] and [`ProgramSettings::verify_deg`] of the desired pose.
+//! Every motion statement is counted by a scan independent of the readers ([`census`]), and
+//! reported compensated or unchanged with its reason ([`CompensatedProgram::motions`]).
+//!
+//! Numbers are written as precisely as the controller stores them ([`digits`]: 32-bit floats for
+//! KRL and RAPID, 9 decimals for URScript), and every written target is verified as the
+//! controller stores it: read back as the controller would (joints, or the nominal inverse
+//! kinematics of the written pose from the commanded joints, on the target's branch), the
+//! calibrated model's tool must be within [`ProgramSettings::verify_mm`] and
+//! [`ProgramSettings::verify_deg`] of the desired pose.
 
+pub mod census;
+pub mod census_krl;
+pub mod census_rapid;
+pub mod census_ur;
+mod compensate;
+pub mod digits;
+pub mod frames;
 pub mod krl;
 mod lex;
 pub mod rapid;
 pub mod seed;
 pub mod urscript;
 
-use crate::compensation::{Compensator, DampedLeastSquares, IkStatus};
+use crate::compensation::IkStatus;
 use crate::error::{Error, Result};
 use crate::frame::Frame;
-use crate::model::Robot;
-use seed::{branch_joints, matches, Branch, BranchJoints};
+use census::{MotionOutcome, MotionReport};
+use digits::Precision;
+use seed::Branch;
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
+
+pub use compensate::compensate_program;
 
 pub use seed::turn_of;
 
@@ -89,6 +104,8 @@ pub struct ProgramTarget {
     pub status: Option<u32>,
     /// RAPID's confdata `[cf1, cf4, cf6, cfx]`, for a robtarget.
     pub conf: Option<[i64; 4]>,
+    /// Index of the file it is in ([`Source`]; 0: the program, 1: a KRL `.dat`).
+    pub file: usize,
 }
 
 impl ProgramTarget {
@@ -188,12 +205,64 @@ impl Format {
         }
     }
 
-    /// Decimals of field `i` of a target of `kind`, for `base` decimals in mm and deg.
-    pub fn decimals(self, kind: TargetKind, i: usize, base: usize) -> usize {
-        match (self, kind) {
-            (Format::UrScript, _) => base + 3,
-            (Format::Rapid, TargetKind::Pose) if i >= 3 => base + 4,
-            _ => base,
+    /// How field `i` of a target of `kind` is stored and written ([`digits`]).
+    pub fn precision(self, _kind: TargetKind, _i: usize) -> Precision {
+        match self {
+            Format::UrScript => Precision::Decimals(9),
+            _ => Precision::F32,
+        }
+    }
+
+    /// Refuses a program whose content is another dialect than its extension says (a RAPID
+    /// module saved as `.src`, KRL saved as `.mod`): its first statement decides.
+    pub fn check_dialect(self, path: &Path, text: &str) -> Result<()> {
+        let first = text
+            .lines()
+            .map(str::trim)
+            .find(|l| {
+                !l.is_empty()
+                    && !l.starts_with(';')
+                    && !l.starts_with('&')
+                    && !l.starts_with('!')
+                    && !l.starts_with('%')
+                    && !l.starts_with('#')
+            })
+            .unwrap_or("");
+        let word = first
+            .split(|c: char| !c.is_ascii_alphanumeric() && c != '_')
+            .next()
+            .unwrap_or("")
+            .to_ascii_uppercase();
+        let is = match word.as_str() {
+            "MODULE" => Some(Format::Rapid),
+            "DEF" | "DEFDAT" | "DEFFCT" | "GLOBAL" => Some(Format::Krl),
+            _ => None,
+        };
+        match is {
+            Some(f) if f != self && !(self == Format::UrScript && word == "DEF") => {
+                Err(Error::parse(
+                    path,
+                    None,
+                    None,
+                    format!(
+                        "the extension says {}, but the text is {} (it starts with `{}`): save \
+                         it with that format's extension",
+                        self.name(),
+                        f.name(),
+                        first.split_whitespace().next().unwrap_or("")
+                    ),
+                ))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// The format's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Krl => "KUKA KRL",
+            Format::Rapid => "ABB RAPID",
+            Format::UrScript => "URScript",
         }
     }
 }
@@ -203,9 +272,6 @@ impl Format {
 pub struct ProgramSettings {
     /// Whole pose (default) or position only.
     pub full_pose: bool,
-    /// Decimals of the numbers written in mm and deg (m and rad: 3 more; quaternions: 4 more).
-    /// Default 4.
-    pub decimals: usize,
     /// Largest position error (mm) of a written target after rounding. Default 0.01: a joint
     /// rounded to 5e-5 deg moves the tool of a 3.6 m arm by up to 3e-3 mm.
     pub verify_mm: f64,
@@ -217,7 +283,6 @@ impl Default for ProgramSettings {
     fn default() -> Self {
         ProgramSettings {
             full_pose: true,
-            decimals: 4,
             verify_mm: 0.01,
             verify_deg: 0.001,
         }
@@ -231,6 +296,8 @@ pub struct Change {
     pub name: String,
     /// 1-based line.
     pub line: usize,
+    /// Index of the file it is in ([`Source`]; 0: the program, 1: a KRL `.dat`).
+    pub file: usize,
     /// Joints or pose.
     pub kind: TargetKind,
     /// The values as written in the input (controller units).
@@ -254,76 +321,38 @@ pub struct Change {
     /// Whether the output holds the new values (false for a target that could not be
     /// compensated: left unchanged).
     pub applied: bool,
+    /// Why the target was not tried (a frame robocal cannot resolve), when it was not.
+    pub skipped: Option<String>,
+}
+
+/// One file of a program.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Source {
+    /// Its path (in messages).
+    pub path: PathBuf,
+    /// Its text.
+    pub text: String,
 }
 
 /// A compensated program.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CompensatedProgram {
-    /// The output text: the input with the applied targets' fields replaced.
-    pub text: String,
-    /// Every target, in file order.
+    /// The output texts, one per [`Source`]: the input with the applied targets' fields
+    /// replaced.
+    pub texts: Vec<String>,
+    /// Every target, in file order (the program's, then its `.dat`'s).
     pub changes: Vec<Change>,
+    /// Every motion statement of the program, in order, with what became of it.
+    pub motions: Vec<MotionReport>,
 }
 
-/// Compensates every target of `text` (a program in `format`, named `path` in errors) with
-/// `comp` (nominal = what the controller believes, calibrated = the real robot). Targets that
-/// cannot be compensated (status other than converged, or failing the check after rounding) are
-/// left unchanged and listed with `applied = false`; the caller decides whether that stops the
-/// run. A malformed target is an error naming its line.
-pub fn compensate_program(
-    path: &Path,
-    text: &str,
-    format: Format,
-    comp: &Compensator<'_, DampedLeastSquares>,
-    settings: &ProgramSettings,
-) -> Result<CompensatedProgram> {
-    let nominal = comp.nominal();
-    let targets = format.targets(path, text)?;
-    if !targets.is_empty() && nominal.dof() != 6 {
-        return Err(Error::invalid(
-            "program",
-            format!(
-                "its targets have 6 axes; the robot has {} joints",
-                nominal.dof()
-            ),
-        ));
+impl CompensatedProgram {
+    /// The motions left unchanged.
+    pub fn unchanged_motions(&self) -> impl Iterator<Item = &MotionReport> {
+        self.motions
+            .iter()
+            .filter(|m| m.outcome != MotionOutcome::Compensated)
     }
-    let mut changes = Vec::with_capacity(targets.len());
-    let mut splices: Vec<(Range<usize>, String)> = Vec::new();
-    // The joints of the previous target (desired, model values): where a controller without
-    // configuration data starts a Cartesian target's inverse kinematics.
-    let mut previous: Option<Vec<f64>> = None;
-    for t in &targets {
-        let (c, desired) = compensate_target(t, format, comp, settings, previous.as_deref());
-        if desired.is_some() {
-            previous = desired;
-        }
-        if c.applied {
-            // A number the compensation leaves as it was (after rounding) keeps its text.
-            for (k, (f, v)) in t.fields.iter().zip(&c.new).enumerate() {
-                if *v != f.value {
-                    let d = format.decimals(t.kind, k, settings.decimals);
-                    splices.push((f.span.clone(), krl::format_number(*v, d)));
-                }
-            }
-            if let (Some(span), Some(old), Some(new)) = (&t.turn_span, t.turn, c.new_turn) {
-                if old != new {
-                    splices.push((span.clone(), krl::format_turn(new, &text[span.clone()])));
-                }
-            }
-        }
-        changes.push(c);
-    }
-    splices.sort_by_key(|(r, _)| r.start);
-    let mut out = String::with_capacity(text.len() + 16 * splices.len());
-    let mut at = 0;
-    for (span, s) in &splices {
-        out.push_str(&text[at..span.start]);
-        out.push_str(s);
-        at = span.end;
-    }
-    out.push_str(&text[at..]);
-    Ok(CompensatedProgram { text: out, changes })
 }
 
 /// Position (mm) and angle (deg) between two frames.
@@ -334,167 +363,6 @@ pub fn pose_distance(a: &Frame, b: &Frame) -> (f64, f64) {
         (a.translation.vector - b.translation.vector).norm(),
         w.to_degrees(),
     )
-}
-
-fn round(v: f64, decimals: usize) -> f64 {
-    krl::format_number(v, decimals).parse().unwrap_or(v)
-}
-
-/// Axes of the desired joints within this of 0 (deg) may change sign by compensation: the KRL
-/// turn written follows the commanded joints there.
-const TURN_ADJUST_DEG: f64 = 1.0;
-
-/// Compensates one target; also returns its desired joints (model values), when known.
-fn compensate_target(
-    t: &ProgramTarget,
-    format: Format,
-    comp: &Compensator<'_, DampedLeastSquares>,
-    s: &ProgramSettings,
-    previous: Option<&[f64]>,
-) -> (Change, Option<Vec<f64>>) {
-    let nominal = comp.nominal();
-    let cal = comp.calibrated();
-    let js = nominal.joint_space();
-    let old: Vec<f64> = t.fields.iter().map(|f| f.value).collect();
-    let mut change = Change {
-        name: t.name.clone(),
-        line: t.line,
-        kind: t.kind,
-        old: old.clone(),
-        new: old.clone(),
-        correction_mm: 0.0,
-        correction_deg: 0.0,
-        status: IkStatus::NotConverged,
-        verified_mm: f64::INFINITY,
-        verified_deg: f64::INFINITY,
-        new_turn: t.turn,
-        applied: false,
-    };
-    let mut q = vec![0.0; nominal.dof()];
-    let branch = t.branch(previous);
-    // Desired joints (model values) and the desired tool pose.
-    let (desired, mut branch_ok) = match t.kind {
-        TargetKind::Joints => (js.joints_from_axes(&format.axes_of(&old)), true),
-        TargetKind::Pose => {
-            match branch_joints(nominal, &comp.pose_solver, &format.pose_of(&old), &branch) {
-                BranchJoints::Found(d) => (d, true),
-                BranchJoints::Other(d) => (d, false),
-                BranchJoints::Unreachable => {
-                    change.status = IkStatus::Unreachable;
-                    return (change, None);
-                }
-            }
-        }
-    };
-    let desired_pose = match t.kind {
-        TargetKind::Joints => nominal.tool_pose(&desired),
-        TargetKind::Pose => format.pose_of(&old),
-    };
-    let rep = if s.full_pose {
-        comp.compensate_pose(&desired, &mut q).1
-    } else {
-        comp.compensate(&desired, &mut q).1
-    };
-    change.status = rep.status;
-    if rep.status.is_converged() && t.kind == TargetKind::Pose {
-        branch_ok &= commanded_branch_ok(t, nominal, &desired, &q, &branch, &mut change);
-    }
-    if rep.status.is_converged() && !branch_ok {
-        change.status = IkStatus::ConfigurationChange;
-    }
-    if !change.status.is_converged() {
-        return (change, Some(desired));
-    }
-    // The values to write, rounded as written, and their check on the calibrated model.
-    let new: Vec<f64> = match t.kind {
-        TargetKind::Joints => format.joint_values(&js.axes_from_joints(&q)),
-        TargetKind::Pose => format.pose_values(&nominal.tool_pose(&q), &old),
-    }
-    .iter()
-    .enumerate()
-    .map(|(k, v)| round(*v, format.decimals(t.kind, k, s.decimals)))
-    .collect();
-    let reached = match t.kind {
-        TargetKind::Joints => Some(js.joints_from_axes(&format.axes_of(&new))),
-        TargetKind::Pose => {
-            // The controller's inverse kinematics of the written pose, on the commanded branch.
-            let mut qw = vec![0.0; nominal.dof()];
-            let r = comp
-                .pose_solver
-                .solve(nominal, &format.pose_of(&new), 0, &q, &mut qw);
-            r.status.is_converged().then_some(qw)
-        }
-    };
-    let Some(qw) = reached else {
-        change.status = IkStatus::NotConverged;
-        return (change, Some(desired));
-    };
-    let actual = cal.tool_pose(&qw);
-    let (vm, vd) = if s.full_pose {
-        pose_distance(&actual, &desired_pose)
-    } else {
-        (
-            (actual.translation.vector - desired_pose.translation.vector).norm(),
-            0.0,
-        )
-    };
-    change.verified_mm = vm;
-    change.verified_deg = vd;
-    if vm > s.verify_mm || vd > s.verify_deg {
-        change.status = IkStatus::NotConverged;
-        return (change, Some(desired));
-    }
-    let after = match t.kind {
-        TargetKind::Joints => nominal.tool_pose(&qw),
-        TargetKind::Pose => format.pose_of(&new),
-    };
-    let (cm, cd) = pose_distance(&desired_pose, &after);
-    change.correction_mm = cm;
-    change.correction_deg = cd;
-    change.new = new;
-    change.applied = true;
-    (change, Some(desired))
-}
-
-/// Whether the commanded joints `q` of a Cartesian target keep its configuration data (see the
-/// module documentation); sets the KRL turn to write.
-fn commanded_branch_ok(
-    t: &ProgramTarget,
-    nominal: &Robot,
-    desired: &[f64],
-    q: &[f64],
-    branch: &Branch,
-    change: &mut Change,
-) -> bool {
-    let js = nominal.joint_space();
-    match (branch, t.turn) {
-        (Branch::Krl { status, .. }, Some(tt)) => {
-            // The turn follows the commanded joints where an axis of the desired joints lies
-            // within TURN_ADJUST_DEG of 0 (compensation may move it across); elsewhere a
-            // different sign is another branch.
-            // A bit changes only where the commanded axis has the other sign beyond
-            // seed::ZERO_DEG (a target written at 0 comes back as +-1e-4).
-            let axes = js.axes_from_joints(desired);
-            let mut new_turn = tt;
-            for (i, a) in js.axes_from_joints(q).iter().enumerate() {
-                if a.abs() >= seed::ZERO_DEG {
-                    new_turn = (new_turn & !(1 << i)) | (u32::from(*a < 0.0) << i);
-                }
-            }
-            let fixed = axes
-                .iter()
-                .enumerate()
-                .filter(|(_, a)| a.abs() >= TURN_ADJUST_DEG)
-                .all(|(i, _)| (new_turn ^ tt) & (1 << i) == 0);
-            change.new_turn = Some(new_turn);
-            let s_branch = Branch::Krl {
-                status: *status,
-                turn: None,
-            };
-            fixed && matches(nominal, q, &s_branch)
-        }
-        _ => matches(nominal, q, branch),
-    }
 }
 
 #[cfg(test)]

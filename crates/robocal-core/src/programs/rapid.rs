@@ -31,13 +31,13 @@ const MAX_DEPTH: usize = 8;
 
 /// A bracket aggregate: nested lists of scalar tokens with their byte spans.
 #[derive(Debug)]
-enum Node {
+pub(crate) enum Node {
     List(Vec<Node>),
     Scalar(Range<usize>),
 }
 
 /// Reads the aggregate whose `[` is at `open`; returns it and the index after its `]`.
-fn aggregate(b: &[u8], open: usize, depth: usize) -> Option<(Node, usize)> {
+pub(crate) fn aggregate(b: &[u8], open: usize, depth: usize) -> Option<(Node, usize)> {
     if depth > MAX_DEPTH {
         return None;
     }
@@ -284,6 +284,16 @@ fn target(
                     format!("{name}: `{s}` is not a number"),
                 )
             })?;
+        let range = match field.as_str() {
+            "x" | "y" | "z" => Some(&crate::ranges::LENGTH),
+            f if f.starts_with("rax_") => Some(&crate::ranges::JOINT),
+            _ => None,
+        };
+        if let Some(r) = range {
+            r.check(value).map_err(|m| {
+                Error::parse(path, Some(line), Some(&field), format!("{name}: {m}"))
+            })?;
+        }
         Ok(Field {
             name: field,
             value,
@@ -321,12 +331,26 @@ fn target(
                 .enumerate()
             {
                 let v = number(n, f.to_owned())?.value;
-                if v.fract() != 0.0 || v.abs() > 1e6 {
+                if v.fract() != 0.0 {
                     return Err(Error::parse(
                         path,
                         Some(line),
                         Some(f),
                         format!("{name}: `{v}` is not an integer"),
+                    ));
+                }
+                // cf1, cf4, cf6: quadrants of axes within the joint range (1e5 deg); cfx: 3 bits.
+                let (lo, hi, what) = if f == "cfx" {
+                    (0.0, 7.0, "cfx (3 bits: 0..7)")
+                } else {
+                    (-1112.0, 1111.0, "a quadrant (joint values within ±1e5 deg)")
+                };
+                if !(lo..=hi).contains(&v) {
+                    return Err(Error::parse(
+                        path,
+                        Some(line),
+                        Some(f),
+                        format!("{name}: {what}: {v} is outside {lo}..{hi}"),
                     ));
                 }
                 c[k] = v as i64;
@@ -343,6 +367,7 @@ fn target(
         turn_span: None,
         status: None,
         conf,
+        file: 0,
     })
 }
 

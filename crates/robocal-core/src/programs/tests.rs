@@ -1,8 +1,10 @@
+use super::seed::{branch_joints, BranchJoints};
 use super::seed::{krl_status, rapid_conf};
 use super::*;
-use crate::compensation::PoseNewton;
+use crate::compensation::{Compensator, DampedLeastSquares, PoseNewton};
 use crate::model::presets::preset;
 use crate::model::robot_file::parse_robot_toml;
+use crate::model::Robot;
 use crate::simulation::{random_poses, GeometricErrors, PoseSampler};
 use rand::SeedableRng;
 
@@ -71,7 +73,7 @@ pub(crate) fn krl_program(nominal: &Robot) -> String {
             turn_of(nominal, &q)
         );
     }
-    s += "PTP_REL {A1 10, A2 0, A3 0, A4 0, A5 0, A6 0}\r\nEND\r\n";
+    s += "END\r\n";
     s
 }
 
@@ -106,12 +108,12 @@ pub(crate) fn rapid_program(nominal: &Robot) -> String {
         );
         if k == 1 {
             moves += &format!("    MoveAbsJ {joints}\\NoEOffs, v100, fine, tool0;\n");
-            moves += &format!("    MoveL {rob}, v100, z10, tool0\\WObj:=wobj0; ! inline\n\n");
+            moves += &format!("    MoveL {rob}, v100, z10, gun\\WObj:=wobj0; ! inline\n\n");
         } else {
             s += &format!("  CONST jointtarget j{k} := {joints};\n");
             s += &format!("  CONST robtarget p{k}:={rob};\n");
             moves += &format!(
-                "    MoveAbsJ j{k}, v100, fine, tool0;\n    MoveJ p{k}, v100, z10, tool0;\n"
+                "    MoveAbsJ j{k}, v100, fine, tool0;\n    MoveJ p{k}, v100, z10, gun;\n"
             );
         }
     }
@@ -146,12 +148,27 @@ pub(crate) fn ur_program(nominal: &Robot) -> String {
         );
         if k == 0 {
             s += &format!("  home = {list}\n  pick = {p}\n\n  movej(home, a=1.4, v=1.05)\n");
-            s += "  movel(pick, a=1.2, v=0.25)\n  movel(pose_trans(pick, offset), a=1.2, v=0.25)\n";
+            s += "  movel(pick, a=1.2, v=0.25)\n";
         } else {
             s += &format!("  movej({list}, a=1.4, v=1.05)\n  movel({p}, a=1.2, v=0.25, r=0)\n");
         }
     }
     s + "end\n"
+}
+
+/// Compensates one program file.
+pub(crate) fn run(
+    path: &Path,
+    text: &str,
+    format: Format,
+    comp: &Compensator<'_, DampedLeastSquares>,
+    s: &ProgramSettings,
+) -> CompensatedProgram {
+    let src = [Source {
+        path: path.to_owned(),
+        text: text.to_owned(),
+    }];
+    compensate_program(&src, format, None, comp, s).unwrap()
 }
 
 /// The text outside the targets' numeric fields, in order.
@@ -197,6 +214,12 @@ pub(crate) fn edits_never_panic(format: Format, fixture: &str) {
             }
         }
         let text = String::from_utf8_lossy(&b);
+        // The motion census reads any text.
+        match format {
+            Format::Krl => drop(census_krl::motions(&text, Some(&text), None)),
+            Format::Rapid => drop(census_rapid::motions(&text)),
+            Format::UrScript => drop(census_ur::motions(&text)),
+        }
         if let Ok(ts) = format.targets(Path::new("f"), &text) {
             for t in ts {
                 for f in &t.fields {
@@ -215,14 +238,22 @@ fn check_program(format: Format, nom: &Robot, cal: &Robot, text: &str) -> Compen
     let comp = Compensator::new(nom, cal, DampedLeastSquares::default()).unwrap();
     let s = ProgramSettings::default();
     let path = Path::new("fixture");
-    let out = compensate_program(path, text, format, &comp, &s).unwrap();
+    let out = run(path, text, format, &comp, &s);
     let (tin, tout) = (
         format.targets(path, text).unwrap(),
-        format.targets(path, &out.text).unwrap(),
+        format.targets(path, &out.texts[0]).unwrap(),
     );
     assert_eq!(tin.len(), tout.len());
     assert_eq!(out.changes.len(), tin.len());
-    assert_eq!(outside_fields(text, &tin), outside_fields(&out.text, &tout));
+    assert_eq!(
+        outside_fields(text, &tin),
+        outside_fields(&out.texts[0], &tout)
+    );
+    assert!(
+        out.unchanged_motions().next().is_none(),
+        "{:?}",
+        out.motions
+    );
     let js = nom.joint_space();
     let mut previous: Option<Vec<f64>> = None;
     for ((c, t), t0) in out.changes.iter().zip(&tout).zip(&tin) {
@@ -230,6 +261,11 @@ fn check_program(format: Format, nom: &Robot, cal: &Robot, text: &str) -> Compen
         assert_eq!(c.status, IkStatus::Converged);
         let written: Vec<f64> = t.fields.iter().map(|f| f.value).collect();
         assert_eq!(written, c.new);
+        let written: Vec<f64> = written
+            .iter()
+            .enumerate()
+            .map(|(k, v)| format.precision(t.kind, k).stored(*v))
+            .collect();
         let old: Vec<f64> = t0.fields.iter().map(|f| f.value).collect();
         let (desired, reached) = match t.kind {
             TargetKind::Joints => {
@@ -249,7 +285,14 @@ fn check_program(format: Format, nom: &Robot, cal: &Robot, text: &str) -> Compen
                 (format.pose_of(&old), q)
             }
         };
-        let (dp, dw) = pose_distance(&cal.tool_pose(&reached), &desired);
+        // RAPID: the tool `gun` (the robot description's tool) as given, on the calibrated flange.
+        let actual = match (format, t.kind) {
+            (Format::Rapid, TargetKind::Pose) => {
+                cal.tool_pose(&reached) * cal.tool_frame().inverse() * nom.tool_frame()
+            }
+            _ => cal.tool_pose(&reached),
+        };
+        let (dp, dw) = pose_distance(&actual, &desired);
         assert!(
             dp < s.verify_mm && dw < s.verify_deg,
             "{} line {}: {dp} mm {dw} deg",
@@ -279,7 +322,9 @@ fn a_rapid_program_is_compensated_target_by_target_and_kept_byte_for_byte() {
     // The confdata are kept.
     let (a, b) = (
         Format::Rapid.targets(Path::new("a"), &text).unwrap(),
-        Format::Rapid.targets(Path::new("b"), &out.text).unwrap(),
+        Format::Rapid
+            .targets(Path::new("b"), &out.texts[0])
+            .unwrap(),
     );
     assert!(a.iter().zip(&b).all(|(x, y)| x.conf == y.conf));
 }
@@ -306,8 +351,8 @@ fn targets_that_need_no_change_are_verified_and_keep_their_text() {
     ] {
         let comp = Compensator::new(robot, robot, DampedLeastSquares::default()).unwrap();
         let s = ProgramSettings::default();
-        let out = compensate_program(Path::new("same"), &text, format, &comp, &s).unwrap();
-        assert_eq!(out.text, text, "{format:?}");
+        let out = run(Path::new("same"), &text, format, &comp, &s);
+        assert_eq!(out.texts[0], text, "{format:?}");
         for c in &out.changes {
             assert!(c.applied && c.status == IkStatus::Converged, "{c:?}");
             assert!(
@@ -327,8 +372,7 @@ fn position_only_compensation_puts_the_tool_point_on_target() {
         full_pose: false,
         ..ProgramSettings::default()
     };
-    let out =
-        compensate_program(Path::new("k"), &krl_program(&nom), Format::Krl, &comp, &s).unwrap();
+    let out = run(Path::new("k"), &krl_program(&nom), Format::Krl, &comp, &s);
     assert!(out
         .changes
         .iter()
@@ -413,8 +457,8 @@ fn a_target_that_cannot_be_compensated_is_left_unchanged_and_listed() {
     let comp = Compensator::new(&nom, &cal, DampedLeastSquares::default()).unwrap();
     let text = "DEF far()\nLIN {X 9000, Y 0, Z 1000, A 0, B 90, C 0}\nEND\n";
     let s = ProgramSettings::default();
-    let out = compensate_program(Path::new("far.src"), text, Format::Krl, &comp, &s).unwrap();
-    assert_eq!(out.text, text);
+    let out = run(Path::new("far.src"), text, Format::Krl, &comp, &s);
+    assert_eq!(out.texts[0], text);
     assert_eq!(out.changes.len(), 1);
     assert!(!out.changes[0].applied);
     assert_eq!(out.changes[0].status, IkStatus::Unreachable);
@@ -441,4 +485,64 @@ fn shipped_example_programs_are_the_fixtures() {
             "{name}: regenerate with ROBOCAL_WRITE_EXAMPLE=1"
         );
     }
+}
+
+/// A RAPID target in a declared work object for a declared tool: compensated through both
+/// (FK on the calibrated model, the tool as given, after 32-bit rounding); the same target in
+/// a work object declared elsewhere is left unchanged, "frame unknown".
+#[test]
+fn rapid_targets_are_mapped_through_their_tool_and_work_object() {
+    use crate::frame::pose;
+    let nom = robot_file("programs/irb-like.toml");
+    let cal = perturbed(&nom, 9);
+    let grip = pose(&[20.0, 0.0, 300.0, 0.0, 0.4, 0.0]);
+    let w = pose(&[800.0, -300.0, 200.0, 0.5, 0.0, 0.0]) * pose(&[0.0, 0.0, 50.0, 0.0, 0.0, 0.0]);
+    let q = nom
+        .joint_space()
+        .joints_from_axes(&[-25.0, 20.0, -10.0, 100.0, -50.0, -100.0]);
+    let flange = nom.tool_pose(&q) * nom.tool_frame().inverse();
+    let p = w.inverse() * flange * grip;
+    let v = rapid::pose_values(&p, &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]);
+    let c = rapid_conf(&nom, &q);
+    let q5 = nalgebra::UnitQuaternion::from_euler_angles(0.0, 0.0, 0.5);
+    let text = format!(
+        "MODULE m\n  PERS tooldata grip := [TRUE,[[20,0,300],[{},0,{},0]],[5,[0,0,100],[1,0,0,0],0,0,0]];\n  \
+         PERS wobjdata table := [FALSE,TRUE,\"\",[[800,-300,200],[{},{},{},{}]],[[0,0,50],[1,0,0,0]]];\n  \
+         CONST robtarget pt := [[{},{},{}],[{},{},{},{}],[{},{},{},{}],[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]];\n  \
+         PROC main()\n    MoveL pt, v100, z10, grip\\WObj:=table;\n  ENDPROC\nENDMODULE\n",
+        (0.2f64).cos(), (0.2f64).sin(), q5.w, q5.i, q5.j, q5.k,
+        v[0], v[1], v[2], v[3], v[4], v[5], v[6], c[0], c[1], c[2], c[3]
+    );
+    let comp = Compensator::new(&nom, &cal, DampedLeastSquares::default()).unwrap();
+    let s = ProgramSettings::default();
+    let out = run(Path::new("m.mod"), &text, Format::Rapid, &comp, &s);
+    assert!(out.changes[0].applied, "{:?}", out.changes);
+    assert!(
+        out.unchanged_motions().next().is_none(),
+        "{:?}",
+        out.motions
+    );
+    let t = &Format::Rapid
+        .targets(Path::new("m.mod"), &out.texts[0])
+        .unwrap()[0];
+    let new: Vec<f64> = t.fields.iter().map(|f| f64::from(f.value as f32)).collect();
+    let x = w * rapid::pose_of(&new) * grip.inverse() * nom.tool_frame();
+    let BranchJoints::Found(qc) = branch_joints(&nom, &PoseNewton::default(), &x, &t.branch(None))
+    else {
+        panic!("not on its branch")
+    };
+    let real = cal.tool_pose(&qc) * cal.tool_frame().inverse() * grip;
+    let (dp, dw) = pose_distance(&real, &(w * p));
+    assert!(dp < 3e-4 && dw < 3e-5, "{dp} mm {dw} deg");
+    assert!(out.changes[0].correction_mm > 0.05);
+    // A work object this module does not declare.
+    let other = text.replace("\\WObj:=table", "\\WObj:=fixture");
+    let out = run(Path::new("m.mod"), &other, Format::Rapid, &comp, &s);
+    assert_eq!(out.texts[0], other);
+    let why = out.changes[0].skipped.as_deref().unwrap();
+    assert!(
+        why.contains("frame unknown") && why.contains("fixture"),
+        "{why}"
+    );
+    assert_eq!(out.unchanged_motions().count(), 1);
 }

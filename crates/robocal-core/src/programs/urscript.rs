@@ -21,7 +21,7 @@ use nalgebra::{Rotation3, Translation3, Vector3};
 use std::ops::Range;
 use std::path::Path;
 
-const MOTIONS: [&str; 5] = ["movej", "movel", "movep", "movec", "servoj"];
+const MOTIONS: [&str; 6] = ["movej", "movel", "movep", "movec", "servoj", "servoc"];
 
 /// A list `[...]` or pose `p[...]` found in the text.
 struct List {
@@ -174,7 +174,17 @@ fn motion_args(
 ) -> usize {
     let mut i = open + 1;
     loop {
-        let k = skip_ws(b, i);
+        let mut k = skip_ws(b, i);
+        // A named argument `q=[...]`, `pose=p[...]`: its value.
+        let e = (k..b.len()).find(|j| !is_ident(b[*j])).unwrap_or(b.len());
+        let after = skip_ws(b, e);
+        if e > k && b.get(after) == Some(&b'=') && b.get(after + 1) != Some(&b'=') {
+            k = skip_ws(b, after + 1);
+        }
+        // `get_inverse_kin(p[...], ...)`: the pose it is given.
+        if b[k.min(b.len())..].starts_with(b"get_inverse_kin(") {
+            k = skip_ws(b, k + "get_inverse_kin(".len());
+        }
         if let Some((end, l)) = value_list(b, k, line_of) {
             direct.push((word.to_owned(), k, l));
             i = end;
@@ -266,6 +276,7 @@ fn target(
         turn_span: None,
         status: None,
         conf: None,
+        file: 0,
     })
 }
 

@@ -1,0 +1,477 @@
+//! Compensation of a whole program: its targets through the frames in force, its motions
+//! accounted for, the new numbers spliced into exactly the spans of the old ones.
+
+use super::census::{Motion, MotionOutcome, MotionReport, TargetRef};
+use super::frames::{Frames, KrlConfig};
+use super::seed::{self, branch_joints, matches, Branch, BranchJoints};
+use super::{
+    census_krl, census_rapid, census_ur, pose_distance, Change, CompensatedProgram, Format,
+    ProgramSettings, ProgramTarget, Source, TargetKind,
+};
+use crate::compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
+use crate::error::{Error, Result};
+use crate::frame::Frame;
+use crate::model::Robot;
+use std::ops::Range;
+
+/// Compensates every target of a program: `sources[0]` the program, and for KRL its `.dat` as
+/// `sources[1]` when there is one; `config` the KUKA controller's numbered frames. Targets that
+/// cannot be compensated (a status other than converged, a check after rounding that fails, a
+/// frame robocal cannot resolve) are left unchanged and listed with `applied = false`; every
+/// motion statement is listed with its outcome. The caller decides whether anything left
+/// unchanged stops the run. A malformed target is an error naming its file, line and field.
+pub fn compensate_program(
+    sources: &[Source],
+    format: Format,
+    config: Option<&KrlConfig>,
+    comp: &Compensator<'_, DampedLeastSquares>,
+    settings: &ProgramSettings,
+) -> Result<CompensatedProgram> {
+    let nominal = comp.nominal();
+    let mut targets: Vec<ProgramTarget> = Vec::new();
+    for (k, s) in sources.iter().enumerate() {
+        format.check_dialect(&s.path, &s.text)?;
+        for mut t in format.targets(&s.path, &s.text)? {
+            t.file = k;
+            targets.push(t);
+        }
+    }
+    if !targets.is_empty() && nominal.dof() != 6 {
+        return Err(Error::invalid(
+            "program",
+            format!(
+                "its targets have 6 axes; the robot has {} joints",
+                nominal.dof()
+            ),
+        ));
+    }
+    let main = sources.first().map_or("", |s| s.text.as_str());
+    let motions = match format {
+        Format::Krl => census_krl::motions(main, sources.get(1).map(|s| s.text.as_str()), config),
+        Format::Rapid => census_rapid::motions(main),
+        Format::UrScript => census_ur::motions(main),
+    };
+    let names = Names::new(format, &targets);
+    let links: Vec<Vec<Option<usize>>> = motions
+        .iter()
+        .map(|m| {
+            m.refs
+                .iter()
+                .map(|r| link(&names, &targets, m, r))
+                .collect()
+        })
+        .collect();
+    let frames = target_frames(&targets, &motions, &links);
+    let mut changes = Vec::with_capacity(targets.len());
+    let mut splices: Vec<Vec<(Range<usize>, String)>> = vec![Vec::new(); sources.len()];
+    // The joints of the previous target (desired, model values): where a controller without
+    // configuration data starts a Cartesian target's inverse kinematics.
+    let mut previous: Option<Vec<f64>> = None;
+    for (t, f) in targets.iter().zip(&frames) {
+        let (c, desired) = match f {
+            Ok(f) => compensate_target(t, format, f, comp, settings, previous.as_deref()),
+            Err(why) => (skipped(t, why.clone()), None),
+        };
+        if desired.is_some() {
+            previous = desired;
+        }
+        if c.applied {
+            let text = &sources[t.file].text;
+            for (k, (fd, v)) in t.fields.iter().zip(&c.new).enumerate() {
+                if *v != fd.value {
+                    splices[t.file].push((fd.span.clone(), format.precision(t.kind, k).write(*v)));
+                }
+            }
+            if let (Some(span), Some(old), Some(new)) = (&t.turn_span, t.turn, c.new_turn) {
+                if old != new {
+                    splices[t.file].push((
+                        span.clone(),
+                        super::krl::format_turn(new, &text[span.clone()]),
+                    ));
+                }
+            }
+        }
+        changes.push(c);
+    }
+    let texts = sources
+        .iter()
+        .zip(splices.iter_mut())
+        .map(|(s, sp)| splice(&s.text, sp))
+        .collect();
+    let motions = motions
+        .into_iter()
+        .zip(links)
+        .map(|(m, l)| outcome(format, m, &l, &changes))
+        .collect();
+    Ok(CompensatedProgram {
+        texts,
+        changes,
+        motions,
+    })
+}
+
+fn splice(text: &str, splices: &mut [(Range<usize>, String)]) -> String {
+    splices.sort_by_key(|(r, _)| r.start);
+    let mut out = String::with_capacity(text.len() + 16 * splices.len());
+    let mut at = 0;
+    for (span, s) in splices.iter() {
+        out.push_str(&text[at..span.start]);
+        out.push_str(s);
+        at = span.end;
+    }
+    out.push_str(&text[at..]);
+    out
+}
+
+/// The targets by name (upper case for KRL and RAPID, whose names are case-insensitive).
+struct Names {
+    format: Format,
+    by_name: std::collections::HashMap<String, Vec<usize>>,
+}
+
+impl Names {
+    fn new(format: Format, targets: &[ProgramTarget]) -> Names {
+        let mut by_name: std::collections::HashMap<String, Vec<usize>> = Default::default();
+        let mut n = Names {
+            format,
+            by_name: Default::default(),
+        };
+        for (k, t) in targets.iter().enumerate() {
+            by_name.entry(n.key(&t.name)).or_default().push(k);
+        }
+        n.by_name = by_name;
+        n
+    }
+
+    fn key(&self, name: &str) -> String {
+        match self.format {
+            Format::UrScript => name.to_owned(),
+            _ => name.to_ascii_uppercase(),
+        }
+    }
+}
+
+/// The target a motion's reference names: inline, the target written in its statement; named,
+/// the target of that name (KRL, RAPID: any case; URScript: the last assignment before it).
+fn link(names: &Names, targets: &[ProgramTarget], m: &Motion, r: &TargetRef) -> Option<usize> {
+    match r {
+        TargetRef::Inline => {
+            let k = targets.partition_point(|t| {
+                t.file < m.file
+                    || (t.file == m.file
+                        && t.fields.first().map_or(0, |f| f.span.start) < m.span.start)
+            });
+            let first = |t: &ProgramTarget| t.fields.first().map_or(0, |f| f.span.start);
+            targets[k..]
+                .iter()
+                .take_while(|t| t.file == m.file && first(t) < m.span.end)
+                .position(|t| m.span.contains(&first(t)) && !t.fields.is_empty())
+                .map(|i| i + k)
+        }
+        TargetRef::Named(n) => {
+            let all = names.by_name.get(&names.key(n))?;
+            let before = all.iter().rev().find(|k| {
+                let t = &targets[**k];
+                t.file != m.file
+                    || t.fields
+                        .first()
+                        .is_some_and(|f| f.span.start < m.span.start)
+            });
+            before.or(all.first()).copied()
+        }
+        TargetRef::Computed(_) => None,
+    }
+}
+
+/// The frames of each Cartesian target: those of the motions that use it (all the same), the
+/// robot description's for a target no motion uses in a program that sets no frame.
+fn target_frames(
+    targets: &[ProgramTarget],
+    motions: &[Motion],
+    links: &[Vec<Option<usize>>],
+) -> Vec<std::result::Result<Frames, String>> {
+    let mut out: Vec<Option<std::result::Result<(Frames, usize), String>>> =
+        vec![None; targets.len()];
+    for (m, l) in motions.iter().zip(links) {
+        for k in l.iter().flatten() {
+            if targets[*k].kind == TargetKind::Joints {
+                continue;
+            }
+            out[*k] = match out[*k].take() {
+                None => Some(Ok((m.frames.clone(), m.line))),
+                Some(Ok((f, line))) if f != m.frames => Some(Err(format!(
+                    "frame unknown: used with different tools or bases (lines {line} and {})",
+                    m.line
+                ))),
+                other => other,
+            };
+        }
+    }
+    let sets_frames = motions.iter().any(|m| m.frames != Frames::default());
+    out.into_iter()
+        .zip(targets)
+        .map(|(f, t)| match f {
+            Some(Ok((f, _))) => match f.unknown() {
+                Some(why) => Err(format!("frame unknown: {why}")),
+                None => Ok(f),
+            },
+            Some(Err(e)) => Err(e),
+            None if t.kind == TargetKind::Joints || !sets_frames => Ok(Frames::default()),
+            None => Err("frame unknown: no motion of the program uses it".to_owned()),
+        })
+        .collect()
+}
+
+/// What became of a motion, from what became of its targets.
+fn outcome(format: Format, m: Motion, links: &[Option<usize>], changes: &[Change]) -> MotionReport {
+    let mut why = None;
+    if m.relative {
+        why = Some("a relative motion: its target is an offset from where the robot is".to_owned());
+    } else if let Some(n) = &m.no_target {
+        why = Some(n.clone());
+    }
+    for (r, l) in m.refs.iter().zip(links) {
+        if why.is_some() {
+            break;
+        }
+        why = match (r, l) {
+            (_, Some(k)) if changes[*k].applied => None,
+            (_, Some(k)) => {
+                let c = &changes[*k];
+                let s = c.skipped.clone().unwrap_or_else(|| c.status.to_string());
+                Some(format!(
+                    "target {} (line {}) not compensated: {s}",
+                    c.name, c.line
+                ))
+            }
+            (TargetRef::Computed(e), None) => Some(format!("target `{e}` computed at run time")),
+            (TargetRef::Named(n), None) => Some(format!(
+                "`{n}`: no target of that name in the program{}",
+                if format == Format::Krl {
+                    " or its .dat"
+                } else {
+                    ""
+                }
+            )),
+            (TargetRef::Inline, None) => Some(
+                "not a complete target (a partial aggregate takes the other values at run time)"
+                    .to_owned(),
+            ),
+        };
+    }
+    if m.refs.is_empty() && why.is_none() {
+        why = Some("no target found in the statement".to_owned());
+    }
+    let targets = links.iter().flatten().copied().collect();
+    MotionReport {
+        motion: m,
+        outcome: why.map_or(MotionOutcome::Compensated, MotionOutcome::Unchanged),
+        targets,
+    }
+}
+
+fn base_change(t: &ProgramTarget) -> Change {
+    let old: Vec<f64> = t.fields.iter().map(|f| f.value).collect();
+    Change {
+        name: t.name.clone(),
+        line: t.line,
+        file: t.file,
+        kind: t.kind,
+        old: old.clone(),
+        new: old,
+        correction_mm: 0.0,
+        correction_deg: 0.0,
+        status: IkStatus::NotConverged,
+        verified_mm: f64::INFINITY,
+        verified_deg: f64::INFINITY,
+        new_turn: t.turn,
+        applied: false,
+        skipped: None,
+    }
+}
+
+fn skipped(t: &ProgramTarget, why: String) -> Change {
+    Change {
+        skipped: Some(why),
+        ..base_change(t)
+    }
+}
+
+/// Axes of the desired joints within this of 0 (deg) may change sign by compensation: the KRL
+/// turn written follows the commanded joints there.
+const TURN_ADJUST_DEG: f64 = 1.0;
+
+/// Compensates one target in frames `fr`; also returns its desired joints (model values).
+fn compensate_target(
+    t: &ProgramTarget,
+    format: Format,
+    fr: &Frames,
+    comp: &Compensator<'_, DampedLeastSquares>,
+    s: &ProgramSettings,
+    previous: Option<&[f64]>,
+) -> (Change, Option<Vec<f64>>) {
+    let nominal = comp.nominal();
+    let cal = comp.calibrated();
+    let (tm_nom, tm_cal) = (nominal.tool_frame(), cal.tool_frame());
+    let js = nominal.joint_space();
+    let mut change = base_change(t);
+    let old = change.old.clone();
+    let prec = |k: usize| format.precision(t.kind, k);
+    let stored = |v: &[f64]| -> Vec<f64> {
+        v.iter()
+            .enumerate()
+            .map(|(k, x)| prec(k).stored(*x))
+            .collect()
+    };
+    let old_stored = stored(&old);
+    let mut q = vec![0.0; nominal.dof()];
+    let branch = t.branch(previous);
+    let program = match t.kind {
+        TargetKind::Pose => format.pose_of(&old_stored),
+        TargetKind::Joints => Frame::identity(),
+    };
+    // The desired joints (the controller's reading, nominal model) and the calibrated model's
+    // tool frame to reach.
+    let (desired, target, mut branch_ok) = match t.kind {
+        TargetKind::Joints => {
+            let d = js.joints_from_axes(&format.axes_of(&old_stored));
+            let p = nominal.tool_pose(&d);
+            (d, p, true)
+        }
+        TargetKind::Pose => {
+            let xc = fr.to_model(&program, tm_nom);
+            let (d, ok) = match branch_joints(nominal, &comp.pose_solver, &xc, &branch) {
+                BranchJoints::Found(d) => (d, true),
+                BranchJoints::Other(d) => (d, false),
+                BranchJoints::Unreachable => {
+                    change.status = IkStatus::Unreachable;
+                    return (change, None);
+                }
+            };
+            (d, fr.to_model(&program, tm_cal), ok)
+        }
+    };
+    let rep = match (t.kind, s.full_pose) {
+        (TargetKind::Joints, true) => comp.compensate_pose(&desired, &mut q).1,
+        (TargetKind::Joints, false) => comp.compensate(&desired, &mut q).1,
+        (TargetKind::Pose, true) => {
+            let r = comp.pose_solver.solve(cal, &target, 0, &desired, &mut q);
+            comp.check_configuration(nominal, &desired, &q, r)
+        }
+        (TargetKind::Pose, false) => {
+            comp.solver
+                .solve(cal, &target.translation.vector, &desired, &mut q)
+        }
+    };
+    change.status = rep.status;
+    if rep.status.is_converged() && t.kind == TargetKind::Pose {
+        branch_ok &= commanded_branch_ok(t, nominal, &desired, &q, &branch, &mut change);
+    }
+    if rep.status.is_converged() && !branch_ok {
+        change.status = IkStatus::ConfigurationChange;
+    }
+    if !change.status.is_converged() {
+        return (change, Some(desired));
+    }
+    // The values to write, as the controller stores their text, and their check on the
+    // calibrated model.
+    let exact: Vec<f64> = match t.kind {
+        TargetKind::Joints => format.joint_values(&js.axes_from_joints(&q)),
+        TargetKind::Pose => {
+            format.pose_values(&fr.from_model(&nominal.tool_pose(&q), tm_nom), &old)
+        }
+    };
+    // A number that stays the same once stored keeps its text.
+    let new: Vec<f64> = exact
+        .iter()
+        .enumerate()
+        .map(|(k, v)| {
+            let p = prec(k);
+            if p.written(*v) == old_stored[k] {
+                old[k]
+            } else {
+                p.write(*v).parse().unwrap_or(*v)
+            }
+        })
+        .collect();
+    let new_stored = stored(&new);
+    let reached = match t.kind {
+        TargetKind::Joints => Some(js.joints_from_axes(&format.axes_of(&new_stored))),
+        TargetKind::Pose => {
+            // The controller's inverse kinematics of the written pose, on the commanded branch.
+            let mut qw = vec![0.0; nominal.dof()];
+            let x = fr.to_model(&format.pose_of(&new_stored), tm_nom);
+            let r = comp.pose_solver.solve(nominal, &x, 0, &q, &mut qw);
+            r.status.is_converged().then_some(qw)
+        }
+    };
+    let Some(qw) = reached else {
+        change.status = IkStatus::NotConverged;
+        return (change, Some(desired));
+    };
+    let actual: Frame = cal.tool_pose(&qw);
+    let (vm, vd) = if s.full_pose {
+        pose_distance(&actual, &target)
+    } else {
+        (
+            (actual.translation.vector - target.translation.vector).norm(),
+            0.0,
+        )
+    };
+    change.verified_mm = vm;
+    change.verified_deg = vd;
+    if vm > s.verify_mm || vd > s.verify_deg {
+        change.status = IkStatus::NotConverged;
+        return (change, Some(desired));
+    }
+    let (before, after) = match t.kind {
+        TargetKind::Joints => (target, nominal.tool_pose(&qw)),
+        TargetKind::Pose => (program, format.pose_of(&new_stored)),
+    };
+    let (cm, cd) = pose_distance(&before, &after);
+    change.correction_mm = cm;
+    change.correction_deg = cd;
+    change.new = new;
+    change.applied = true;
+    (change, Some(desired))
+}
+
+/// Whether the commanded joints `q` of a Cartesian target keep its configuration data (see the
+/// module documentation); sets the KRL turn to write.
+fn commanded_branch_ok(
+    t: &ProgramTarget,
+    nominal: &Robot,
+    desired: &[f64],
+    q: &[f64],
+    branch: &Branch,
+    change: &mut Change,
+) -> bool {
+    let js = nominal.joint_space();
+    match (branch, t.turn) {
+        (Branch::Krl { status, .. }, Some(tt)) => {
+            // The turn follows the commanded joints where an axis of the desired joints lies
+            // within TURN_ADJUST_DEG of 0 (compensation may move it across); elsewhere a
+            // different sign is another branch. A bit changes only where the commanded axis has
+            // the other sign beyond seed::ZERO_DEG (a target written at 0 comes back as +-1e-4).
+            let axes = js.axes_from_joints(desired);
+            let mut new_turn = tt;
+            for (i, a) in js.axes_from_joints(q).iter().enumerate() {
+                if a.abs() >= seed::ZERO_DEG {
+                    new_turn = (new_turn & !(1 << i)) | (u32::from(*a < 0.0) << i);
+                }
+            }
+            let fixed = axes
+                .iter()
+                .enumerate()
+                .filter(|(_, a)| a.abs() >= TURN_ADJUST_DEG)
+                .all(|(i, _)| (new_turn ^ tt) & (1 << i) == 0);
+            change.new_turn = Some(new_turn);
+            let s_branch = Branch::Krl {
+                status: *status,
+                turn: None,
+            };
+            fixed && matches(nominal, q, &s_branch)
+        }
+        _ => matches(nominal, q, branch),
+    }
+}
