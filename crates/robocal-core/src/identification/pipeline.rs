@@ -178,7 +178,7 @@ pub struct Calibration {
     pub frame: crate::frame::TrackerFrame,
     /// Which parameters were identified, which fixed and why.
     pub identifiability: Identifiability,
-    /// The solver runs, in order (robust objectives start from a sum-of-norms fit).
+    /// The solver runs, in order (robust and adaptive objectives start from a least-squares fit).
     pub stages: Vec<Stage>,
     /// Uncertainty of the identified parameters.
     pub covariance: Covariance,
@@ -216,6 +216,11 @@ impl Calibration {
     /// The last solver run.
     pub fn solver(&self) -> &SolverReport {
         &self.stages.last().expect("at least one stage").report
+    }
+
+    /// The whole solve, every stage together (see [`whole_solve`]).
+    pub fn whole_solve(&self) -> SolverReport {
+        whole_solve(&self.stages)
     }
 
     /// Every parameter with its values and verdicts (see [`ParamVector`]).
@@ -405,7 +410,13 @@ pub fn calibrate(
     let mut stages = Vec::new();
     let run = |robot: &mut Robot, loss: Loss, stages: &mut Vec<Stage>| -> Result<()> {
         let name = loss.name();
-        let report = solve(&problem, robot, &loss, &settings.solver, observer);
+        // The iteration limit is the whole solve's: each stage gets what the earlier left.
+        let used: usize = stages.iter().map(|s| s.report.iterations).sum();
+        let opts = SolverOptions {
+            max_iterations: settings.solver.max_iterations.saturating_sub(used),
+            ..settings.solver
+        };
+        let report = solve(&problem, robot, &loss, &opts, observer);
         if let Termination::Failed(m) = &report.termination {
             return Err(Error::Numerical(format!(
                 "identification ({name}) failed after {} iterations: {m}",
@@ -429,14 +440,17 @@ pub fn calibrate(
             son
         }
         Objective::Robust(_) | Objective::Adaptive => 'staged: {
-            run(&mut robot, son, &mut stages)?;
+            // Least squares gives the start: Gauss-Newton reaches its minimum in a few
+            // iterations, and the scale below comes from the median residual, which gross
+            // outliers do not move.
+            run(&mut robot, Loss::Squared, &mut stages)?;
             // A stage stopped by the iteration limit ends the identification: the result is
             // partial, and the later stages would only restart from a point that is not a
             // minimum.
             let converged =
                 |st: &[Stage]| st.last().is_some_and(|s| s.report.termination.converged());
             if !converged(&stages) {
-                break 'staged son;
+                break 'staged Loss::Squared;
             }
             let make = |c: f64| match settings.objective {
                 Objective::Robust(RobustLoss::Cauchy) => Loss::Cauchy { c },
@@ -535,7 +549,7 @@ pub fn calibrate(
         calibration: cal,
         registration: &registration,
         validation_before: validation.as_ref().map(|v| v.before.as_slice()),
-        solver: &stages.last().expect("at least one stage").report,
+        solver: &whole_solve(&stages),
         max_iterations: settings.solver.max_iterations,
     });
     Ok(Calibration {
@@ -557,6 +571,20 @@ pub fn calibrate(
         settings: settings.clone(),
         weighting,
     })
+}
+
+/// The stages of a solve as one report: the last stage's termination (a stage that does not
+/// converge ends the solve), the iterations and evaluations of all stages, the first stage's
+/// initial objective and the last one's final values.
+pub fn whole_solve(stages: &[Stage]) -> SolverReport {
+    let last = &stages.last().expect("at least one stage").report;
+    SolverReport {
+        termination: last.termination.clone(),
+        iterations: stages.iter().map(|s| s.report.iterations).sum(),
+        evaluations: stages.iter().map(|s| s.report.evaluations).sum(),
+        initial_objective: stages[0].report.initial_objective,
+        ..last.clone()
+    }
 }
 
 pub use crate::registration::{STATION_FACTOR, STATION_MIN_MM};
