@@ -23,6 +23,7 @@ use crate::identification::param_vector::ParamVector;
 use crate::identification::plausibility::{self, Plausibility};
 use crate::identification::precision;
 use crate::identification::prediction::{predict, Prediction};
+use crate::identification::selection::{self, AutoFamilies, ModelChoice, ModelSelection};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
@@ -54,6 +55,9 @@ pub struct CalibrationSettings {
     /// The validation points were measured from another tracker station: fit them a frame of
     /// their own (the errors then show the model's shape, not where the tracker stood).
     pub validation_refit_frame: bool,
+    /// Which model to fit: the robot as given, or the families the data support
+    /// ([`selection`]).
+    pub model: ModelChoice,
 }
 
 /// The measured points of a calibration.
@@ -204,6 +208,8 @@ pub struct Calibration {
     pub settings: CalibrationSettings,
     /// The weighting the fit used (with an automatic tracker model, which).
     pub weighting: AppliedWeighting,
+    /// The automatic model choice, when the settings asked for it.
+    pub model_selection: Option<ModelSelection>,
 }
 
 impl Calibration {
@@ -243,6 +249,9 @@ pub fn calibrate(
     settings: &CalibrationSettings,
     observer: &dyn Observer,
 ) -> Result<Calibration> {
+    if let ModelChoice::Auto(auto) = settings.model {
+        return calibrate_auto(nominal, data, settings, auto, observer);
+    }
     let cal = data.calibration;
     for obs in [Some(cal), data.plane, data.validation]
         .into_iter()
@@ -570,7 +579,29 @@ pub fn calibrate(
         plausibility,
         settings: settings.clone(),
         weighting,
+        model_selection: None,
     })
+}
+
+/// The calibration of the model the data support: the selection step ([`selection::select`]),
+/// then the chosen model's calibration.
+fn calibrate_auto(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    auto: AutoFamilies,
+    observer: &dyn Observer,
+) -> Result<Calibration> {
+    observer.progress(progress::Stage::ModelSelection, 0, 1);
+    let chosen = selection::select(nominal, data, settings, auto)?;
+    let given = CalibrationSettings {
+        model: ModelChoice::Given,
+        ..settings.clone()
+    };
+    let mut cal = calibrate(&chosen.robot, data, &given, observer)?;
+    cal.settings.model = settings.model;
+    cal.model_selection = Some(chosen);
+    Ok(cal)
 }
 
 /// The stages of a solve as one report: the last stage's termination (a stage that does not
