@@ -641,7 +641,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
 }
 
 /// Prints the automatic model choice: every candidate with its cross-validated error.
-fn print_selection(sel: &robocal_core::identification::ModelSelection) {
+pub(crate) fn print_selection(sel: &robocal_core::identification::ModelSelection) {
     println!();
     println!(
         "model: {} (--model auto: cross-validation over the calibration data, {} folds by pose; \

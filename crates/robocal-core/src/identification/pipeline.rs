@@ -182,7 +182,8 @@ pub struct Calibration {
     pub frame: crate::frame::TrackerFrame,
     /// Which parameters were identified, which fixed and why.
     pub identifiability: Identifiability,
-    /// The solver runs, in order (robust and adaptive objectives start from a least-squares fit).
+    /// The solver runs, in order (robust and adaptive objectives start from a least-squares fit, or
+    /// a sum-of-norms fit where the nominal geometry misses the data).
     pub stages: Vec<Stage>,
     /// Uncertainty of the identified parameters.
     pub covariance: Covariance,
@@ -451,15 +452,18 @@ pub fn calibrate(
         Objective::Robust(_) | Objective::Adaptive => 'staged: {
             // Least squares gives the start: Gauss-Newton reaches its minimum in a few
             // iterations, and the scale below comes from the median residual, which gross
-            // outliers do not move.
-            run(&mut robot, Loss::Squared, &mut stages)?;
+            // outliers do not move. Where the nominal geometry misses the data (the tool fit not
+            // applied: another robot, wrong units) the sum of norms, which huge residuals do not
+            // dominate, finds the way.
+            let start_loss = if tool_fit.applied { Loss::Squared } else { son };
+            run(&mut robot, start_loss, &mut stages)?;
             // A stage stopped by the iteration limit ends the identification: the result is
             // partial, and the later stages would only restart from a point that is not a
             // minimum.
             let converged =
                 |st: &[Stage]| st.last().is_some_and(|s| s.report.termination.converged());
             if !converged(&stages) {
-                break 'staged Loss::Squared;
+                break 'staged start_loss;
             }
             let make = |c: f64| match settings.objective {
                 Objective::Robust(RobustLoss::Cauchy) => Loss::Cauchy { c },

@@ -12,7 +12,9 @@
 //!
 //! The choice (the one-standard-error rule): among the candidates whose full fit converged and
 //! passed the plausibility gate, the one with the fewest identified parameters whose error is
-//! within one standard error of the lowest. A family therefore stays only when it lowers the
+//! within one standard error of the lowest. The robot as given (the first candidate) is part of
+//! every other: when its fit fails, does not converge or fails the gate, it is the choice, and
+//! its calibration reports why. A family therefore stays only when it lowers the
 //! cross-validated error by more than the best candidate's standard error, and the simpler model
 //! wins a tie.
 
@@ -178,7 +180,7 @@ pub fn select(
         ..data
     };
     let mut candidates = Vec::with_capacity(robots.len());
-    for robot in &robots {
+    for (i, robot) in robots.iter().enumerate() {
         let mut cand = Candidate {
             families: families(robot),
             identified: 0,
@@ -188,6 +190,8 @@ pub fn select(
             chosen: false,
         };
         match calibrate(robot, data, &fit_settings, &()) {
+            // The robot as given is part of every candidate: its error is the calibration's.
+            Err(e) if i == 0 => return Err(e),
             Err(e) => cand.rejected = Some(format!("the fit failed: {e}")),
             Ok(cal) => {
                 cand.identified = cal.identifiability.identified.len();
@@ -245,6 +249,11 @@ pub fn select(
 /// simplest whose error is within one standard error of the lowest. The first candidate (the
 /// robot as given) when none is selectable.
 fn choose(c: &[Candidate]) -> usize {
+    // The families refine the robot as given: on top of a fit that failed, did not converge or
+    // is implausible they are not chosen, and its calibration says why.
+    if c.first().map_or(true, |x| x.rejected.is_some()) {
+        return 0;
+    }
     let ok = |x: &Candidate| x.rejected.is_none() && x.cv_mean_mm.is_some();
     let Some(best) = c
         .iter()
@@ -289,6 +298,9 @@ mod tests {
         assert_eq!(choose(&c), 0);
         // Nothing selectable: the robot as given.
         let c = [cand(26, 0.100, 0.002, true), cand(36, 0.010, 0.001, true)];
+        assert_eq!(choose(&c), 0);
+        // The robot as given rejected: no family on top of it.
+        let c = [cand(26, 0.100, 0.002, true), cand(36, 0.010, 0.001, false)];
         assert_eq!(choose(&c), 0);
     }
 }

@@ -186,8 +186,12 @@ pub fn solve(
         // other losses): near the minimum it converges in a few iterations where a damped step
         // only creeps along the weakly determined directions. Its predicted gain is the most
         // the model can gain, so a small one means convergence.
+        // Only where the damped steps have found the model trustworthy (lambda back at or below
+        // its initial value): far from the minimum the undamped step would mostly be rejected.
         let newton_model = acc.h.as_ref().unwrap_or(&acc.a);
-        if damped_solve(newton_model, &d, 0.0, &acc.b, &mut m, &mut delta) {
+        if lambda <= opts.initial_lambda
+            && damped_solve(newton_model, &d, 0.0, &acc.b, &mut m, &mut delta)
+        {
             let pred = acc.b.dot(&delta) - 0.5 * delta.dot(&(newton_model * &delta));
             let tol = opts.objective_tolerance * acc.objective.abs();
             if pred <= tol {
