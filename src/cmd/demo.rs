@@ -416,9 +416,9 @@ fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) {
         format!("--robot {PAPER_NOMINAL}"),
         format!("--data {}", sh(&dir.join(files::CELL))),
         format!("--validate {}", sh(&dir.join(files::VALIDATION))),
-        "--model geometric".to_owned(),
         "--compliance auto".to_owned(),
         format!("--payload-kg {payload}"),
+        "--model geometric".to_owned(),
         format!("--out {}", sh(&dir.join("result-elasto.json"))),
     ]);
     println!();
