@@ -8,9 +8,9 @@ use crate::tables::{layout, num};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
 use robocal_core::identification::{
-    calibrate, split_measurements, Calibration, CalibrationData, CalibrationSettings, CheckKind,
-    IdentifiabilityOptions, Objective, Observations, RobustLoss, SolverOptions,
-    DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
+    calibrate, split_measurements, AutoFamilies, Calibration, CalibrationData, CalibrationSettings,
+    CheckKind, IdentifiabilityOptions, ModelChoice, Objective, Observations, RobustLoss,
+    SolverOptions, DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
 };
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::result_sections::RowsOutside;
@@ -58,6 +58,14 @@ pub struct CalibrateArgs {
     /// keeps d3 and fixes d2). An error if one cannot be identified at all.
     #[arg(long, value_delimiter = ',', value_name = "NAMES")]
     free: Vec<String>,
+    /// Which model to fit. `auto` (default): the families the data support, chosen by
+    /// cross-validation over the calibration data (5 folds by pose) among the geometric model and
+    /// the geometric model plus transmission harmonics (1, 2), joint compliance and their
+    /// combinations; a family stays only when it lowers the cross-validated error by more than
+    /// its standard error. `geometric`: the paper's model. An explicit --compliance or
+    /// --harmonics fixes that family and skips its selection.
+    #[arg(long, value_enum, default_value_t = ModelArg::Auto)]
+    model: ModelArg,
     /// Hayati tilt parameters: `parallel` (every joint whose axis is parallel to the previous
     /// one), a list of joint numbers (e.g. `3`), or `none`.
     #[arg(long, default_value = "none", value_name = "parallel|none|J,..")]
@@ -66,17 +74,18 @@ pub struct CalibrateArgs {
     /// torque about its axis, from lumped coefficients of the chain's geometry): `auto` (every
     /// revolute joint whose axis is not always parallel to the robot's `gravity`), a list of
     /// joint numbers (e.g. `2,3`), or `none`.
-    #[arg(long, default_value = "none", value_name = "auto|none|J,..")]
-    compliance: String,
+    /// [default: none, or chosen by --model auto]
+    #[arg(long, value_name = "auto|none|J,..")]
+    compliance: Option<String>,
     /// The payload (kg) the data were measured with: the compliances' payload part becomes a
     /// physical compliance (`compliance{j}`, µrad/(N·m)), so `evaluate` and `compensate` can
     /// predict another payload. Needs --compliance.
     #[arg(long, value_name = "KG")]
     payload_kg: Option<f64>,
     /// Joint transmission errors: the first N harmonics of every revolute joint's angle error
-    /// (0 to 8).
-    #[arg(long, default_value_t = 0, value_name = "N")]
-    harmonics: usize,
+    /// (0 to 8) [default: 0, or chosen by --model auto].
+    #[arg(long, value_name = "N")]
+    harmonics: Option<usize>,
     /// Also fit the paper's 12-parameter affine Tr (eq. 8-11) and report it (the tracker frame
     /// stays rigid).
     #[arg(long)]
@@ -132,6 +141,14 @@ enum ObjectiveArg {
     LeastSquares,
     /// Robust loss (see --robust-loss).
     Robust,
+}
+
+#[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
+enum ModelArg {
+    /// The families the data support, by cross-validation (default).
+    Auto,
+    /// The robot's geometry (and the families given explicitly) only.
+    Geometric,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, ValueEnum)]
@@ -251,7 +268,7 @@ fn apply_beta(robot: &mut Robot, arg: &str) -> anyhow::Result<Vec<usize>> {
 /// (0-based).
 fn apply_joint_families(robot: &mut Robot, a: &CalibrateArgs) -> anyhow::Result<Vec<usize>> {
     use robocal_core::model::family::{compliance, transmission};
-    let joints = match a.compliance.trim() {
+    let joints = match a.compliance.as_deref().unwrap_or("none").trim() {
         "none" | "" => Vec::new(),
         "auto" => compliance::auto_joints(robot),
         list => {
@@ -286,15 +303,15 @@ fn apply_joint_families(robot: &mut Robot, a: &CalibrateArgs) -> anyhow::Result<
         compliance::enable(robot, &joints, a.payload_kg)
             .map_err(|e| exit::usage(super::flags::cli_text(&e)))?;
     }
-    if a.harmonics > transmission::MAX_HARMONICS {
+    let harmonics = a.harmonics.unwrap_or(0);
+    if harmonics > transmission::MAX_HARMONICS {
         return Err(exit::usage(format!(
-            "--harmonics {}: at most {} harmonics per joint",
-            a.harmonics,
+            "--harmonics {harmonics}: at most {} harmonics per joint",
             transmission::MAX_HARMONICS
         )));
     }
     let all: Vec<usize> = (0..robot.dof()).collect();
-    transmission::enable(robot, &all, a.harmonics)
+    transmission::enable(robot, &all, harmonics)
         .map_err(|e| exit::usage(super::flags::cli_text(&e)))?;
     Ok(joints)
 }
@@ -358,7 +375,7 @@ impl TryFrom<&CalibrateArgs> for Settings {
         let mut robot = common::robot(&a.robot)?;
         let betas = apply_beta(&mut robot, &a.beta)?;
         let compliant = apply_joint_families(&mut robot, a)?;
-        if compliant.is_empty() && a.compliance.trim() == "auto" {
+        if compliant.is_empty() && a.compliance.as_deref().map(str::trim) == Some("auto") {
             eprintln!(
                 "note: --compliance auto: no joint of robot `{}` turns under gravity (every axis                  is parallel to its `gravity`); no compliance added",
                 robot.name()
@@ -443,6 +460,13 @@ impl TryFrom<&CalibrateArgs> for Settings {
             },
             weighting: weighting(a.tracker_sigma.as_deref(), a.orientation_weight)?,
             validation_refit_frame: a.validate_refit_frame,
+            model: match a.model {
+                ModelArg::Geometric => ModelChoice::Given,
+                ModelArg::Auto => ModelChoice::Auto(AutoFamilies {
+                    harmonics: a.harmonics.is_none(),
+                    compliance: a.compliance.is_none(),
+                }),
+            },
         };
         Ok(Settings {
             robot_arg: a.robot.clone(),
@@ -522,6 +546,9 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let cal = result.with_context(|| format!("calibrating from {}", s.data.display()))?;
     let converged = cal.solver().termination.converged();
     let implausible = cal.plausibility.implausible();
+    if let Some(sel) = &cal.model_selection {
+        print_selection(sel);
+    }
     print_report(&cal, converged, implausible);
     print_plausibility(&cal);
     if let Some(why) = &cal.covariance.unavailable {
@@ -611,6 +638,35 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
              write the partial result, marked as such){failed_gate}",
             s.out.display()
         )))
+    }
+}
+
+/// Prints the automatic model choice: every candidate with its cross-validated error.
+pub(crate) fn print_selection(sel: &robocal_core::identification::ModelSelection) {
+    println!();
+    println!(
+        "model: {} (--model auto: cross-validation over the calibration data, {} folds by pose; \
+         a family stays only when it lowers the error by more than the standard error)",
+        sel.chosen().name(),
+        sel.folds
+    );
+    println!(
+        "  {:<40} {:>10} {:>16} {:>10}",
+        "candidate", "parameters", "CV mean (mm)", "std. err."
+    );
+    for c in &sel.candidates {
+        let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
+        println!(
+            "{} {:<40} {:>10} {:>16} {:>10}{}",
+            if c.chosen { "*" } else { " " },
+            c.name(),
+            c.identified,
+            f(c.cv_mean_mm),
+            f(c.cv_std_error_mm),
+            c.rejected
+                .as_ref()
+                .map_or(String::new(), |r| format!("  not selectable: {r}"))
+        );
     }
 }
 

@@ -120,6 +120,7 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     bar.finish();
 
     print_run(&exp);
+    print_model_choice(&exp)?;
     if let Some(e) = &elasto {
         print_elasto(&exp, e, dir);
     }
@@ -344,6 +345,32 @@ fn elasto_config(cfg: &ExperimentConfig) -> anyhow::Result<Option<ExperimentConf
     Ok(Some(c))
 }
 
+/// The model `robocal calibrate` would choose on the same calibration points by default
+/// (`--model auto`, with its default objective), beside the paper's geometric model.
+fn print_model_choice(exp: &Experiment) -> anyhow::Result<()> {
+    use robocal_core::identification::{
+        selection, split_measurements, AutoFamilies, CalibrationData, CalibrationSettings,
+    };
+    let split = split_measurements(&exp.data)?;
+    let sel = selection::select(
+        &exp.config.nominal,
+        CalibrationData {
+            calibration: &split.calibration,
+            plane: Some(&split.plane),
+            validation: None,
+        },
+        &CalibrationSettings::default(),
+        AutoFamilies::default(),
+    )?;
+    para(
+        "The paper's model is geometric. The model `robocal calibrate` chooses by default on the \
+         same calibration points (--model auto, default objective):",
+    );
+    super::calibrate::print_selection(&sel);
+    println!();
+    Ok(())
+}
+
 /// The geometric calibration beside the elasto-geometric one, and the verification of both.
 fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) {
     let payload = geo
@@ -391,6 +418,7 @@ fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) {
         format!("--validate {}", sh(&dir.join(files::VALIDATION))),
         "--compliance auto".to_owned(),
         format!("--payload-kg {payload}"),
+        "--model geometric".to_owned(),
         format!("--out {}", sh(&dir.join("result-elasto.json"))),
     ]);
     println!();
@@ -466,7 +494,9 @@ fn print_files(exp: &Experiment, dir: &Path) {
     command(&[
         "robocal calibrate".to_owned(),
         robot.clone(),
-        // The paper's objective (eq. 4); calibrate's default is the adaptive one.
+        // The paper's model and objective (eq. 4); calibrate's defaults are the model the
+        // data support and the adaptive objective.
+        "--model geometric".to_owned(),
         "--objective sum-of-norms".to_owned(),
         format!("--data {}", p(files::CELL)),
         format!("--validate {}", p(files::VALIDATION)),

@@ -75,7 +75,7 @@ fn the_payload_known_compliance_transfers_to_another_payload() {
         let o = ok(&args);
         (o.stdout(), read_json(&d.join(out)))
     };
-    let (_, geo) = cal("geo.json", &[]);
+    let (_, geo) = cal("geo.json", &["--model", "geometric"]);
     let (stdout, el) = cal("el.json", &["--compliance", "auto", "--payload-kg", "300"]);
     assert!(stdout.contains("compliance (urad/Nm)"), "{stdout}");
     let c2 = &el["parameters"]["compliance2"];

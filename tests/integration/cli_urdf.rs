@@ -5,6 +5,7 @@
 
 use crate::util::*;
 use serde_json::Value;
+use std::path::Path;
 
 /// The tool position `fk --json` prints.
 fn fk(args: &[&str], joints: &str) -> [f64; 3] {
@@ -156,21 +157,27 @@ fn exports_of_a_simulated_calibration_reproduce_its_kinematics() {
 #[test]
 fn ur5_urdf_calibrates_the_real_data_like_the_dh_file() {
     let Some(d) = real_data() else { return };
-    let dh = &fixtures::real_fit(&d, "ur5").result;
+    // The geometric model of each (the URDF export holds geometry only).
     let dir = Dir::new();
+    let fit = |robot: &str, out: &Path| {
+        ok(&[
+            "calibrate",
+            "--robot",
+            &example(robot),
+            "--model",
+            "geometric",
+            "--data",
+            p(&d.join("jacobi_ur5_grid.csv")),
+            "--validate",
+            p(&d.join("jacobi_ur5_random.csv")),
+            "--out",
+            p(out),
+        ]);
+        read_json(out)
+    };
     let out = dir.join("ur5_urdf.json");
-    ok(&[
-        "calibrate",
-        "--robot",
-        &example("ur5.urdf"),
-        "--data",
-        p(&d.join("jacobi_ur5_grid.csv")),
-        "--validate",
-        p(&d.join("jacobi_ur5_random.csv")),
-        "--out",
-        p(&out),
-    ]);
-    let urdf = read_json(&out);
+    let urdf = fit("ur5.urdf", &out);
+    let dh = &fit("ur5.toml", &dir.join("ur5_dh.json"));
     let mean = |j: &Value, set: &str| j["errors"][set]["after"]["mean_mm"].as_f64().unwrap();
     let (a, b) = (mean(&urdf, "validation"), mean(dh, "validation"));
     let (ca, cb) = (mean(&urdf, "calibration"), mean(dh, "calibration"));

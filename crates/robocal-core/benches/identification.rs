@@ -4,7 +4,9 @@
 //! And the elasto-geometric calibration (joint compliance under gravity, `auto` joints, the
 //! payload known) of 1000 simulated UR5 poses sagging under gravity: target (issue 13) under
 //! 50 ms. And several reflectors (issue 12): 1000 KR 480 poses each measured through three
-//! reflectors (3000 points), target under 50 ms.
+//! reflectors (3000 points), target under 50 ms. And the model choice by cross-validation
+//! (issue 25): 75 poses under 10 ms (the geometric model alone under 5 ms), 1000 UR5 poses under
+//! 150 ms.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use rand::SeedableRng;
@@ -43,7 +45,17 @@ fn bench_calibrate(
     model: &Robot,
     obs: &Observations,
 ) {
-    let settings = CalibrationSettings::default();
+    bench_with(g, name, model, obs, CalibrationSettings::default());
+}
+
+/// Times the whole calibration of `obs` with `model` and `settings` as benchmark `name`.
+fn bench_with(
+    g: &mut criterion::BenchmarkGroup<'_, criterion::measurement::WallTime>,
+    name: &str,
+    model: &Robot,
+    obs: &Observations,
+    settings: CalibrationSettings,
+) {
     g.bench_function(name, |b| {
         b.iter(|| {
             let cal = calibrate(
@@ -62,10 +74,36 @@ fn bench_calibrate(
     });
 }
 
+/// The model chosen by cross-validation (`--model auto`: six candidates, 5 folds each) against
+/// the geometric model alone: 75 KR 480 poses (targets 10 ms and 5 ms, issue 25) and 1000 UR5
+/// poses sagging under gravity (target 150 ms).
+fn selection(c: &mut Criterion) {
+    use robocal_core::identification::{AutoFamilies, ModelChoice};
+    let auto = CalibrationSettings {
+        model: ModelChoice::Auto(AutoFamilies::default()),
+        ..Default::default()
+    };
+    let truth = preset("kuka-kr480-r3330-table3").unwrap();
+    let nominal = preset("kuka-kr480-r3330").unwrap();
+    let obs = data(&truth, 75, 7);
+    let (ur5, ur5_obs) = ur5_sagging();
+    let mut g = c.benchmark_group("selection");
+    g.sample_size(10);
+    bench_with(
+        &mut g,
+        "kr480 geometric 75 poses",
+        &nominal,
+        &obs,
+        Default::default(),
+    );
+    bench_with(&mut g, "kr480 auto 75 poses", &nominal, &obs, auto.clone());
+    bench_with(&mut g, "ur5 auto 1000 poses", &ur5, &ur5_obs, auto);
+    g.finish();
+}
+
 /// 1000 poses of the UR5 example sagging under gravity (about the UR5's masses, harmonic-drive
-/// compliances), and the nominal model with compliance on its `auto` joints at the 2 kg payload.
-fn ur5_elasto(c: &mut Criterion) {
-    use robocal_core::model::family::compliance;
+/// compliances), and the nominal UR5.
+fn ur5_sagging() -> (Robot, Observations) {
     use robocal_core::simulation::GravityModel;
     let file = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/ur5.toml");
     let nominal = robocal_core::load_robot_file(std::path::Path::new(file)).unwrap();
@@ -87,6 +125,14 @@ fn ur5_elasto(c: &mut Criterion) {
         let p = nominal.tool_position(&g.deflected(&nominal, q));
         obs.push(q, tracker.measure(&p, &mut rng), i + 2).unwrap();
     }
+    (nominal, obs)
+}
+
+/// The UR5 data of [`ur5_sagging`] with the nominal model and with compliance on its `auto`
+/// joints at the 2 kg payload.
+fn ur5_elasto(c: &mut Criterion) {
+    use robocal_core::model::family::compliance;
+    let (nominal, obs) = ur5_sagging();
     let mut model = nominal.clone();
     let joints = compliance::auto_joints(&model);
     compliance::enable(&mut model, &joints, Some(2.0)).unwrap();
@@ -157,5 +203,5 @@ fn reflectors(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench, ur5_elasto, reflectors);
+criterion_group!(benches, bench, ur5_elasto, reflectors, selection);
 criterion_main!(benches);

@@ -24,6 +24,8 @@ pub enum Stage {
     Uncertainty,
     /// The plausibility gate.
     Plausibility,
+    /// Choosing the model the data support (cross-validation of the candidates).
+    ModelSelection,
     /// A whole calibration, as one step of an experiment.
     Calibration,
     /// Inverse kinematics of many rows (eq. 12-14).
@@ -46,6 +48,7 @@ impl Stage {
             Stage::Identification(objective) => objective,
             Stage::Uncertainty => "uncertainty",
             Stage::Plausibility => "plausibility",
+            Stage::ModelSelection => "choosing the model",
             Stage::Calibration => "calibrating",
             Stage::Compensation => "compensating",
             Stage::Verification => "verifying",

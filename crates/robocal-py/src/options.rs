@@ -5,8 +5,8 @@ use crate::errors::{input, usage, IntoPy};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use robocal_core::identification::{
-    CalibrationSettings, IdentifiabilityOptions, Objective, RobustLoss, SolverOptions,
-    DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
+    AutoFamilies, CalibrationSettings, IdentifiabilityOptions, ModelChoice, Objective, RobustLoss,
+    SolverOptions, DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
 };
 use robocal_core::model::family::{compliance, transmission};
 use robocal_core::observations::{TrackerSigma, Weighting};
@@ -43,6 +43,7 @@ const KNOWN: &[&str] = &[
     "compliance",
     "payload_kg",
     "harmonics",
+    "model",
     "affine",
     "rank_tol",
     "max_iterations",
@@ -350,6 +351,23 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
         weighting.mm_per_deg = m;
     }
     let flag = |k: &str| -> PyResult<bool> { Ok(opt::<bool>(d, k, "a bool")?.unwrap_or(false)) };
+    // `model`: "auto" (default, as the CLI) chooses the families not given explicitly.
+    let given = |k: &str| -> PyResult<bool> { Ok(d.get_item(k)?.is_some_and(|v| !v.is_none())) };
+    let model = match opt::<String>(d, "model", "a str")?
+        .as_deref()
+        .unwrap_or("auto")
+    {
+        "auto" => ModelChoice::Auto(AutoFamilies {
+            harmonics: !given("harmonics")?,
+            compliance: !given("compliance")?,
+        }),
+        "geometric" => ModelChoice::Given,
+        other => {
+            return Err(usage(format!(
+                "model: {other:?}: expected \"auto\" or \"geometric\""
+            )))
+        }
+    };
     let settings = CalibrationSettings {
         objective,
         robust_scale_mm: robust_scale,
@@ -366,6 +384,7 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
         },
         weighting,
         validation_refit_frame: flag("validate_refit_frame")?,
+        model,
     };
     Ok(Options {
         settings,

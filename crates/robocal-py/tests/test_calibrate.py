@@ -126,7 +126,8 @@ def demo(cli, tmp_path_factory):
     run = d / "run"
     out = d / "cli.json"
     # The calibration the demo prints to reproduce its result by hand.
-    cli("calibrate", "--robot", "kuka-kr480-r3330", "--objective", "sum-of-norms", "--data", str(run / "cell.csv"),
+    cli("calibrate", "--robot", "kuka-kr480-r3330", "--model", "geometric", "--objective", "sum-of-norms",
+        "--data", str(run / "cell.csv"),
         "--validate", str(run / "validation.csv"), "--out", str(out))
     return run, read_json(out)
 
@@ -140,7 +141,7 @@ def test_demo_data_arrays_are_the_cli(demo):
     cal = ~plane & (sets != "validation")
     assert plane.sum() == 3
     res = robocal.calibrate(kr, q[cal], xyz[cal], plane=(q[plane], xyz[plane]), validate=(vq, vxyz),
-                            objective="sum-of-norms")
+                            objective="sum-of-norms", model="geometric")
     compare(res.data, cli_res)
     print(f"\ndemo data, Python vs CLI result: max abs difference {identity_figure(res.data, cli_res):.1e}")
     # And the demo's own result (the library's experiment) says the same.
@@ -152,7 +153,8 @@ def test_demo_data_arrays_are_the_cli(demo):
 def test_demo_data_files_are_the_cli(demo):
     run, cli_res = demo
     kr = robocal.Robot.preset("kuka-kr480-r3330")
-    res = robocal.calibrate_files(kr, run / "cell.csv", run / "validation.csv", objective="sum-of-norms")
+    res = robocal.calibrate_files(kr, run / "cell.csv", run / "validation.csv", objective="sum-of-norms",
+                                  model="geometric")
     compare(res.data, cli_res)
     assert res.data["points"] == cli_res["points"]
 

@@ -14,7 +14,8 @@ def fit(ur5, real_data):
     from conftest import load_csv
 
     q, xyz, _ = load_csv(real_data / "jacobi_ur5_grid.csv")
-    return robocal.calibrate(ur5, q, xyz)
+    # The geometric model: the result's robots are the given robot's parameters.
+    return robocal.calibrate(ur5, q, xyz, model="geometric")
 
 
 def test_json_round_trip(fit, tmp_path):

@@ -12,6 +12,8 @@
 //! - [`param_vector`]: every parameter with its name, unit, family, values and verdicts;
 //! - [`covariance`]: standard deviations and correlations of the estimates;
 //! - [`prediction`]: the expected error at new poses (noise plus parameter uncertainty);
+//! - [`selection`], [`cross_validation`]: the model the data support, chosen by
+//!   cross-validation by pose;
 //! - [`pipeline`]: registration + all of the above ([`calibrate`]);
 //! - [`plausibility`]: the gate run after every fit (units, handedness, nominal error, parameter
 //!   moves and ranges, convergence) and the likely cause of a failure;
@@ -21,6 +23,7 @@
 
 pub mod bounds;
 pub mod covariance;
+pub mod cross_validation;
 pub(crate) mod householder;
 pub mod identifiability;
 pub mod objective;
@@ -30,6 +33,7 @@ pub mod plausibility;
 pub mod precision;
 pub mod prediction;
 pub mod report;
+pub mod selection;
 pub(crate) mod simd;
 pub mod solver;
 pub mod split;
@@ -37,6 +41,8 @@ pub mod system;
 
 #[cfg(test)]
 mod conditioning_tests;
+#[cfg(test)]
+mod selection_tests;
 #[cfg(test)]
 mod targets_tests;
 #[cfg(test)]
@@ -55,6 +61,7 @@ pub use pipeline::{
 };
 pub use plausibility::{Check, CheckKind, Plausibility};
 pub use prediction::{MapPoint, Prediction};
+pub use selection::{AutoFamilies, Candidate, ModelChoice, ModelSelection};
 pub use solver::{solve, SolverOptions, SolverReport, Termination};
 pub use split::{split_measurements, SplitData};
 pub use system::Problem;

@@ -23,7 +23,7 @@ pub enum Objective {
     Robust(RobustLoss),
     /// Least squares with outliers down-weighted beyond a data-scaled threshold
     /// ([`Loss::Adaptive`] with `k = ADAPTIVE_THRESHOLD_SIGMAS * sigma`, sigma re-estimated from the
-    /// median residual after every reweighting; a sum-of-norms fit gives the robust start).
+    /// median residual after every reweighting, starting from a least-squares fit).
     /// Default: as efficient as least squares on clean data, as robust as the Cauchy loss.
     #[default]
     Adaptive,
@@ -42,7 +42,7 @@ impl Objective {
     }
 }
 
-/// The robust losses. Their scale `c` is set from the residuals of a sum-of-norms fit: with
+/// The robust losses. Their scale `c` is set from the residuals of a least-squares fit: with
 /// `sigma = median(|e_i|) / 1.5382` (the per-axis standard deviation for isotropic Gaussian
 /// errors, whose norms have median 1.5382 sigma), `c = ROBUST_SCALE_SIGMAS * sigma`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

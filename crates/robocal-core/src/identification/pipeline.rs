@@ -24,6 +24,7 @@ use crate::identification::param_vector::ParamVector;
 use crate::identification::plausibility::{self, Plausibility};
 use crate::identification::precision;
 use crate::identification::prediction::{predict, Prediction};
+use crate::identification::selection::{self, AutoFamilies, ModelChoice, ModelSelection};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
@@ -55,6 +56,9 @@ pub struct CalibrationSettings {
     /// The validation points were measured from another tracker station: fit them a frame of
     /// their own (the errors then show the model's shape, not where the tracker stood).
     pub validation_refit_frame: bool,
+    /// Which model to fit: the robot as given, or the families the data support
+    /// ([`selection`]).
+    pub model: ModelChoice,
 }
 
 /// The measured points of a calibration.
@@ -215,7 +219,8 @@ pub struct Calibration {
     pub frame: crate::frame::TrackerFrame,
     /// Which parameters were identified, which fixed and why.
     pub identifiability: Identifiability,
-    /// The solver runs, in order (robust objectives start from a sum-of-norms fit).
+    /// The solver runs, in order (robust and adaptive objectives start from a least-squares fit, or
+    /// a sum-of-norms fit where the nominal geometry misses the data).
     pub stages: Vec<Stage>,
     /// Uncertainty of the identified parameters.
     pub covariance: Covariance,
@@ -241,6 +246,8 @@ pub struct Calibration {
     pub settings: CalibrationSettings,
     /// The weighting the fit used (with an automatic tracker model, which).
     pub weighting: AppliedWeighting,
+    /// The automatic model choice, when the settings asked for it.
+    pub model_selection: Option<ModelSelection>,
 }
 
 impl Calibration {
@@ -253,6 +260,11 @@ impl Calibration {
     /// The last solver run.
     pub fn solver(&self) -> &SolverReport {
         &self.stages.last().expect("at least one stage").report
+    }
+
+    /// The whole solve, every stage together (see [`whole_solve`]).
+    pub fn whole_solve(&self) -> SolverReport {
+        whole_solve(&self.stages)
     }
 
     /// Every parameter with its values and verdicts (see [`ParamVector`]).
@@ -278,6 +290,9 @@ pub fn calibrate(
     settings: &CalibrationSettings,
     observer: &dyn Observer,
 ) -> Result<Calibration> {
+    if let ModelChoice::Auto(auto) = settings.model {
+        return calibrate_auto(nominal, data, settings, auto, observer);
+    }
     let first = calibrate_once(nominal, data, settings, observer)?;
     let start = if first.tool_fit.applied {
         first.tool_fit.apply(nominal)
@@ -480,7 +495,13 @@ fn calibrate_once(
     let mut stages = Vec::new();
     let run = |robot: &mut Robot, loss: Loss, stages: &mut Vec<Stage>| -> Result<()> {
         let name = loss.name();
-        let report = solve(&problem, robot, &loss, &settings.solver, observer);
+        // The iteration limit is the whole solve's: each stage gets what the earlier left.
+        let used: usize = stages.iter().map(|s| s.report.iterations).sum();
+        let opts = SolverOptions {
+            max_iterations: settings.solver.max_iterations.saturating_sub(used),
+            ..settings.solver
+        };
+        let report = solve(&problem, robot, &loss, &opts, observer);
         if let Termination::Failed(m) = &report.termination {
             return Err(Error::Numerical(format!(
                 "identification ({name}) failed after {} iterations: {m}",
@@ -504,14 +525,20 @@ fn calibrate_once(
             son
         }
         Objective::Robust(_) | Objective::Adaptive => 'staged: {
-            run(&mut robot, son, &mut stages)?;
+            // Least squares gives the start: Gauss-Newton reaches its minimum in a few
+            // iterations, and the scale below comes from the median residual, which gross
+            // outliers do not move. Where the nominal geometry misses the data (the tool fit not
+            // applied: another robot, wrong units) the sum of norms, which huge residuals do not
+            // dominate, finds the way.
+            let start_loss = if tool_fit.applied { Loss::Squared } else { son };
+            run(&mut robot, start_loss, &mut stages)?;
             // A stage stopped by the iteration limit ends the identification: the result is
             // partial, and the later stages would only restart from a point that is not a
             // minimum.
             let converged =
                 |st: &[Stage]| st.last().is_some_and(|s| s.report.termination.converged());
             if !converged(&stages) {
-                break 'staged son;
+                break 'staged start_loss;
             }
             let make = |c: f64| match settings.objective {
                 Objective::Robust(RobustLoss::Cauchy) => Loss::Cauchy { c },
@@ -622,7 +649,7 @@ fn calibrate_once(
         downweighted: downweighted.len(),
         prediction_mean_mm: prediction.as_ref().map(|p| p.mean_mm),
         noise_sigma_mm: prediction.as_ref().map(|p| p.noise_sigma_mm),
-        solver: &stages.last().expect("at least one stage").report,
+        solver: &whole_solve(&stages),
         max_iterations: settings.solver.max_iterations,
     });
     Ok(Calibration {
@@ -643,7 +670,43 @@ fn calibrate_once(
         plausibility,
         settings: settings.clone(),
         weighting,
+        model_selection: None,
     })
+}
+
+/// The calibration of the model the data support: the selection step ([`selection::select`]),
+/// then the chosen model's calibration.
+fn calibrate_auto(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    auto: AutoFamilies,
+    observer: &dyn Observer,
+) -> Result<Calibration> {
+    observer.progress(progress::Stage::ModelSelection, 0, 1);
+    let chosen = selection::select(nominal, data, settings, auto)?;
+    let given = CalibrationSettings {
+        model: ModelChoice::Given,
+        ..settings.clone()
+    };
+    let mut cal = calibrate(&chosen.robot, data, &given, observer)?;
+    cal.settings.model = settings.model;
+    cal.model_selection = Some(chosen);
+    Ok(cal)
+}
+
+/// The stages of a solve as one report: the last stage's termination (a stage that does not
+/// converge ends the solve), the iterations and evaluations of all stages, the first stage's
+/// initial objective and the last one's final values.
+pub fn whole_solve(stages: &[Stage]) -> SolverReport {
+    let last = &stages.last().expect("at least one stage").report;
+    SolverReport {
+        termination: last.termination.clone(),
+        iterations: stages.iter().map(|s| s.report.iterations).sum(),
+        evaluations: stages.iter().map(|s| s.report.evaluations).sum(),
+        initial_objective: stages[0].report.initial_objective,
+        ..last.clone()
+    }
 }
 
 pub use crate::registration::{STATION_FACTOR, STATION_MIN_MM};

@@ -275,6 +275,10 @@ impl Calibration {
         result.partial_reason = partial_reason;
         result.implausible_reason = implausible_reason;
         result.settings = Some(settings);
+        result.model_selection = self
+            .model_selection
+            .as_ref()
+            .map(crate::io::result_selection::ModelSelectionSection::of);
         result.registration = Some(registration);
         result.identifiability = Some(Identifiability {
             rank_tolerance: id.rank_tolerance,

@@ -111,6 +111,13 @@ pub struct SolverReport {
     pub last_step_mm: f64,
 }
 
+/// Smallest gain ratio (actual over predicted decrease) at which the undamped step is taken;
+/// below it the iteration falls back to the damped steps.
+const UNDAMPED_MIN_GAIN: f64 = 0.25;
+
+/// Smallest damping the undamped steps' successes lower `lambda` to.
+const MIN_LAMBDA: f64 = 1e-12;
+
 /// Minimizes `sum l(|e_i|)` over the problem's parameters, starting from (and updating) `robot`.
 /// `observer` hears `(Stage::Identification(name), iteration, max_iterations)` once per
 /// iteration, `name` naming the loss ([`Loss::name`]).
@@ -174,6 +181,54 @@ pub fn solve(
         }
         for j in 0..k {
             d[j] = d[j].max(acc.a[(j, j)]).max(f64::MIN_POSITIVE);
+        }
+        // The undamped step first (Gauss-Newton for least squares, Newton's model for the
+        // other losses): near the minimum it converges in a few iterations where a damped step
+        // only creeps along the weakly determined directions. Its predicted gain is the most
+        // the model can gain, so a small one means convergence.
+        // Only where the damped steps have found the model trustworthy (lambda back at or below
+        // its initial value): far from the minimum the undamped step would mostly be rejected.
+        let newton_model = acc.h.as_ref().unwrap_or(&acc.a);
+        if lambda <= opts.initial_lambda
+            && damped_solve(newton_model, &d, 0.0, &acc.b, &mut m, &mut delta)
+        {
+            let pred = acc.b.dot(&delta) - 0.5 * delta.dot(&(newton_model * &delta));
+            let tol = opts.objective_tolerance * acc.objective.abs();
+            if pred <= tol {
+                report.termination = Termination::ConvergedObjective;
+                break 'outer;
+            }
+            x_new.copy_from(&x);
+            x_new += &delta;
+            problem.apply(&mut trial, &x_new);
+            let f_new = problem.objective(&trial, loss);
+            report.evaluations += 1;
+            let gain = (acc.objective - f_new) / pred;
+            if f_new.is_finite() && gain > UNDAMPED_MIN_GAIN {
+                let step = (0..k)
+                    .map(|j| delta[j].abs() * col_rms[j])
+                    .fold(0.0, f64::max);
+                report.last_step_mm = step;
+                let small_change = acc.objective - f_new <= tol;
+                f_cur = f_new;
+                x.copy_from(&x_new);
+                problem.apply(robot, &x);
+                lambda = (lambda / 3.0).max(MIN_LAMBDA);
+                nu = 2.0;
+                if step <= opts.step_tolerance_mm {
+                    report.termination = Termination::ConvergedStep;
+                    break 'outer;
+                }
+                if small_change {
+                    report.termination = Termination::ConvergedObjective;
+                    break 'outer;
+                }
+                acc = problem.accumulate(robot, loss, level);
+                report.evaluations += 1;
+                report.final_objective = acc.objective;
+                continue 'outer;
+            }
+            problem.apply(&mut trial, &x);
         }
         let mut first_try = true;
         loop {

@@ -14,6 +14,7 @@ pub mod result_payload;
 pub mod result_prediction;
 pub mod result_robot;
 pub mod result_sections;
+pub mod result_selection;
 pub mod robot;
 pub mod row_extras;
 pub mod set_label;

@@ -180,6 +180,9 @@ pub struct CalibrationResult {
     /// Whether the result is a calibration; required on reading ([`KNOWN_STATUSES`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub status: Option<StatusValue>,
+    /// The automatic model choice (`--model auto`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model_selection: Option<super::result_selection::ModelSelectionSection>,
     /// The estimates' covariance.
     #[serde(
         default,
@@ -343,6 +346,7 @@ impl CalibrationResult {
             tracker_frame,
             errors,
             downweighted_points: None,
+            model_selection: None,
             identifiability: None,
             implausible_reason: None,
             inputs: None,

@@ -59,13 +59,13 @@ pub enum ObjectiveName {
     /// The sum of squared errors.
     #[serde(rename = "least-squares")]
     LeastSquares,
-    /// A sum of norms, then the Cauchy loss.
+    /// Least squares, then the Cauchy loss.
     #[serde(rename = "robust (Cauchy)")]
     RobustCauchy,
-    /// A sum of norms, then least squares with outliers down-weighted (the default).
+    /// Least squares, then with outliers down-weighted (the default).
     #[serde(rename = "adaptive")]
     Adaptive,
-    /// A sum of norms, then the Huber loss.
+    /// Least squares, then the Huber loss.
     #[serde(rename = "robust (Huber)")]
     RobustHuber,
 }
@@ -77,14 +77,14 @@ impl ObjectiveName {
             ObjectiveName::SumOfNorms => "sum of displacement error norms (eq. 4)",
             ObjectiveName::LeastSquares => "sum of squared displacement errors",
             ObjectiveName::RobustCauchy => {
-                "robust Cauchy loss (sum of norms first, then down-weighting outliers)"
+                "robust Cauchy loss (least squares first, then down-weighting outliers)"
             }
             ObjectiveName::RobustHuber => {
-                "robust Huber loss (sum of norms first, then down-weighting outliers)"
+                "robust Huber loss (least squares first, then down-weighting outliers)"
             }
             ObjectiveName::Adaptive => {
                 "squared displacement errors, outliers down-weighted beyond a data-scaled \
-                 threshold (sum of norms first)"
+                 threshold (least squares first)"
             }
         }
     }

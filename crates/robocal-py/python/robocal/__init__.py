@@ -299,9 +299,10 @@ def calibrate(
     fix: Names = (),
     free: Names = (),
     beta: Joints = "none",
-    compliance: Joints = "none",
+    compliance: Optional[Joints] = None,
     payload_kg: Optional[float] = None,
-    harmonics: int = 0,
+    harmonics: Optional[int] = None,
+    model: str = "auto",
     affine: bool = False,
     rank_tol: Optional[float] = None,
     max_iterations: int = 1000,
@@ -320,8 +321,10 @@ def calibrate(
     the CLI flag of the same name (README, "calibrate"): ``objective`` "adaptive" (default),
     "sum-of-norms" (the paper's eq. 4), "least-squares" or "robust" (with ``robust_loss``
     "cauchy" or "huber"); ``fix``/``free`` parameter names; ``beta`` "parallel", "none" or joint
-    numbers; ``compliance`` "auto", "none" or joint numbers, with ``payload_kg``; ``harmonics``
-    0..8; ``tracker_sigma=(fixed_mm, per_m_mm)``; and so on.
+    numbers; ``model`` "auto" (default: the families the data support, by cross-validation;
+    ``result`` records the choice in ``model_selection``) or "geometric"; ``compliance`` "auto",
+    "none" or joint numbers, with ``payload_kg``, and ``harmonics`` 0..8 fix that family (None:
+    chosen by ``model="auto"``, none with "geometric"); ``tracker_sigma=(fixed_mm, per_m_mm)``; and so on.
 
     Rows outside the joint limits raise :class:`InputError` unless ``nominal_limits``. A solver
     that does not converge raises :class:`NumericalError` (``keep_partial=True``: a result marked
@@ -339,6 +342,7 @@ def calibrate(
         compliance=compliance,
         payload_kg=payload_kg,
         harmonics=harmonics,
+        model=model,
         affine=affine,
         rank_tol=rank_tol,
         max_iterations=max_iterations,

@@ -1,0 +1,303 @@
+//! The model the data support (`--model auto`): cross-validation over the calibration data
+//! among the geometric model and the geometric model plus transmission harmonics (1, 2), joint
+//! compliance under gravity, and their combinations.
+//!
+//! Each candidate is fitted once to all calibration points (the whole calibration, plausibility
+//! gate included), then refitted on each of [`FOLDS`] folds with the fold's poses left out,
+//! warm-started from the full fit with the same identified parameters, frame and final loss
+//! (the folds in parallel). Rows of one pose (several reflectors, 6-DoF rows) stay in one fold.
+//! The candidate's cross-validated error is the mean position error of every calibration point
+//! under the fit that left it out; its standard error that mean's (per-point spread over the
+//! square root of the count).
+//!
+//! The choice (the one-standard-error rule): among the candidates whose full fit converged and
+//! passed the plausibility gate, the one with the fewest identified parameters whose error is
+//! within one standard error of the lowest. The robot as given (the first candidate) is part of
+//! every other: when its fit fails, does not converge or fails the gate, it is the choice, and
+//! its calibration reports why. A family therefore stays only when it lowers the
+//! cross-validated error by more than the best candidate's standard error, and the simpler model
+//! wins a tie.
+
+use crate::error::Result;
+use crate::identification::cross_validation::{cross_validate, CrossValidation};
+use crate::identification::pipeline::{calibrate, CalibrationData, CalibrationSettings};
+use crate::model::family::{compliance, transmission};
+use crate::model::Robot;
+
+/// Folds of the cross-validation.
+pub const FOLDS: usize = 5;
+
+/// Harmonics per joint the selection tries (besides none).
+pub const HARMONICS: [usize; 2] = [1, 2];
+
+/// Iteration limit of a candidate's full fit: a candidate the solver cannot fit in this many
+/// iterations is not chosen (the chosen model's own calibration keeps the user's limit). A
+/// well-posed fit converges in a handful (Gauss-Newton steps, see [`super::solver`]); one that
+/// needs more has nearly undetermined parameters whose values the data do not support.
+pub const CANDIDATE_MAX_ITERATIONS: usize = 25;
+
+/// Which model a calibration fits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ModelChoice {
+    /// The robot as given, with the families it has (`--model geometric` and explicit flags).
+    #[default]
+    Given,
+    /// Choose the families the data support (see the module docs).
+    Auto(AutoFamilies),
+}
+
+/// The families the automatic choice selects; a family the user fixed is not selected (the
+/// given robot carries it, or not, in every candidate).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AutoFamilies {
+    /// Select the transmission harmonics (none, 1 or 2 per revolute joint).
+    pub harmonics: bool,
+    /// Select joint compliance under gravity (none, or every joint `compliance auto` takes).
+    pub compliance: bool,
+}
+
+impl Default for AutoFamilies {
+    fn default() -> Self {
+        AutoFamilies {
+            harmonics: true,
+            compliance: true,
+        }
+    }
+}
+
+/// One candidate model and its cross-validation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    /// Its non-geometric families, e.g. `["compliance", "harmonics 2"]` (empty: geometric).
+    pub families: Vec<String>,
+    /// Parameters its full fit identified.
+    pub identified: usize,
+    /// Cross-validated mean position error (mm); `None` when the candidate was rejected before
+    /// (its full fit failed, did not converge or failed the plausibility gate).
+    pub cv_mean_mm: Option<f64>,
+    /// Its standard error (mm).
+    pub cv_std_error_mm: Option<f64>,
+    /// Why it cannot be chosen (fit failed, did not converge, failed the plausibility gate).
+    pub rejected: Option<String>,
+    /// Whether it is the chosen model.
+    pub chosen: bool,
+}
+
+impl Candidate {
+    /// Its name for tables: `geometric` or `geometric + ...`.
+    pub fn name(&self) -> String {
+        if self.families.is_empty() {
+            "geometric".into()
+        } else {
+            format!("geometric + {}", self.families.join(" + "))
+        }
+    }
+}
+
+/// The outcome of the automatic choice.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelSelection {
+    /// Folds of the cross-validation.
+    pub folds: usize,
+    /// Every candidate, simplest first.
+    pub candidates: Vec<Candidate>,
+    /// The chosen model (the robot to calibrate).
+    pub robot: Robot,
+}
+
+impl ModelSelection {
+    /// The chosen candidate.
+    pub fn chosen(&self) -> &Candidate {
+        self.candidates
+            .iter()
+            .find(|c| c.chosen)
+            .expect("one candidate is chosen")
+    }
+}
+
+/// The non-geometric families of `robot`, as [`Candidate::families`] names them.
+pub fn families(robot: &Robot) -> Vec<String> {
+    let mut out = Vec::new();
+    if !compliance::joints(robot).is_empty() {
+        out.push("compliance".to_string());
+    }
+    let h = transmission::harmonics(robot);
+    if h > 0 {
+        out.push(format!("harmonics {h}"));
+    }
+    out
+}
+
+/// The candidate robots: `nominal` as given, then with the families `auto` selects.
+pub fn candidates(nominal: &Robot, auto: AutoFamilies) -> Result<Vec<Robot>> {
+    let compliant = compliance::auto_joints(nominal);
+    let with_compliance: &[bool] = if auto.compliance && !compliant.is_empty() {
+        &[false, true]
+    } else {
+        &[false]
+    };
+    let harmonics: Vec<Option<usize>> = if auto.harmonics {
+        std::iter::once(None)
+            .chain(HARMONICS.iter().map(|&h| Some(h)))
+            .collect()
+    } else {
+        vec![None]
+    };
+    let all: Vec<usize> = (0..nominal.dof()).collect();
+    let mut out = Vec::new();
+    for &c in with_compliance {
+        for h in &harmonics {
+            let mut r = nominal.clone();
+            if c {
+                compliance::enable(&mut r, &compliant, None)?;
+            }
+            if let Some(h) = *h {
+                transmission::enable(&mut r, &all, h)?;
+            }
+            out.push(r);
+        }
+    }
+    // Simplest first: fewer parameters, then the order above.
+    out.sort_by_key(|r| r.param_count());
+    Ok(out)
+}
+
+/// Chooses the model the calibration data support among the [`candidates`] of `nominal` (see
+/// the module docs). `settings.model` is ignored: each candidate is fitted as given.
+pub fn select(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    auto: AutoFamilies,
+) -> Result<ModelSelection> {
+    let robots = candidates(nominal, auto)?;
+    let mut fit_settings = settings.clone();
+    fit_settings.model = ModelChoice::Given;
+    fit_settings.solver.max_iterations =
+        settings.solver.max_iterations.min(CANDIDATE_MAX_ITERATIONS);
+    let data = CalibrationData {
+        validation: None,
+        ..data
+    };
+    let mut candidates = Vec::with_capacity(robots.len());
+    for (i, robot) in robots.iter().enumerate() {
+        let mut cand = Candidate {
+            families: families(robot),
+            identified: 0,
+            cv_mean_mm: None,
+            cv_std_error_mm: None,
+            rejected: None,
+            chosen: false,
+        };
+        match calibrate(robot, data, &fit_settings, &()) {
+            // The robot as given is part of every candidate: its error is the calibration's.
+            Err(e) if i == 0 => return Err(e),
+            Err(e) => cand.rejected = Some(format!("the fit failed: {e}")),
+            Ok(cal) => {
+                cand.identified = cal.identifiability.identified.len();
+                let whole = cal.whole_solve();
+                if !whole.termination.converged() {
+                    cand.rejected = Some(format!(
+                        "the solver {} after {} iterations",
+                        whole.termination.describe(),
+                        whole.iterations
+                    ));
+                } else if cal.plausibility.implausible() {
+                    cand.rejected = Some(format!(
+                        "failed the plausibility gate: {}",
+                        cal.plausibility
+                            .failures()
+                            .map(|f| f.detail.clone())
+                            .collect::<Vec<_>>()
+                            .join("; ")
+                    ));
+                }
+                if cand.rejected.is_some() {
+                    candidates.push(cand);
+                    continue;
+                }
+                match cross_validate(&cal, data.calibration, FOLDS) {
+                    Ok(CrossValidation {
+                        mean_mm,
+                        std_error_mm,
+                        ..
+                    }) => {
+                        cand.cv_mean_mm = Some(mean_mm);
+                        cand.cv_std_error_mm = Some(std_error_mm);
+                    }
+                    Err(e) => {
+                        cand.rejected = Some(format!("the cross-validation failed: {e}"));
+                    }
+                }
+            }
+        }
+        candidates.push(cand);
+    }
+    let chosen = choose(&candidates);
+    candidates[chosen].chosen = true;
+    Ok(ModelSelection {
+        folds: FOLDS,
+        candidates,
+        robot: robots[chosen].clone(),
+    })
+}
+
+/// The one-standard-error rule over the selectable candidates (simplest first in `c`): the
+/// simplest whose error is within one standard error of the lowest. The first candidate (the
+/// robot as given) when none is selectable.
+fn choose(c: &[Candidate]) -> usize {
+    // The families refine the robot as given: on top of a fit that failed, did not converge or
+    // is implausible they are not chosen, and its calibration says why.
+    if c.first().map_or(true, |x| x.rejected.is_some()) {
+        return 0;
+    }
+    let ok = |x: &Candidate| x.rejected.is_none() && x.cv_mean_mm.is_some();
+    let Some(best) = c
+        .iter()
+        .filter(|x| ok(x))
+        .min_by(|a, b| a.cv_mean_mm.unwrap().total_cmp(&b.cv_mean_mm.unwrap()))
+    else {
+        return 0;
+    };
+    let limit = best.cv_mean_mm.unwrap() + best.cv_std_error_mm.unwrap_or(0.0);
+    c.iter()
+        .enumerate()
+        .filter(|(_, x)| ok(x) && x.cv_mean_mm.unwrap() <= limit)
+        .min_by_key(|(i, x)| (x.identified, *i))
+        .map_or(0, |(i, _)| i)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cand(identified: usize, mean: f64, se: f64, rejected: bool) -> Candidate {
+        Candidate {
+            families: vec![],
+            identified,
+            cv_mean_mm: Some(mean),
+            cv_std_error_mm: Some(se),
+            rejected: rejected.then(|| "no".into()),
+            chosen: false,
+        }
+    }
+
+    #[test]
+    fn the_simplest_within_one_standard_error_of_the_best_is_chosen() {
+        // A family that gains less than the standard error does not stay.
+        let c = [cand(26, 0.050, 0.003, false), cand(36, 0.048, 0.003, false)];
+        assert_eq!(choose(&c), 0);
+        // One that gains more does.
+        let c = [cand(26, 0.100, 0.002, false), cand(36, 0.088, 0.001, false)];
+        assert_eq!(choose(&c), 1);
+        // A rejected candidate is never chosen, however low its error.
+        let c = [cand(26, 0.100, 0.002, false), cand(36, 0.010, 0.001, true)];
+        assert_eq!(choose(&c), 0);
+        // Nothing selectable: the robot as given.
+        let c = [cand(26, 0.100, 0.002, true), cand(36, 0.010, 0.001, true)];
+        assert_eq!(choose(&c), 0);
+        // The robot as given rejected: no family on top of it.
+        let c = [cand(26, 0.100, 0.002, true), cand(36, 0.010, 0.001, false)];
+        assert_eq!(choose(&c), 0);
+    }
+}

@@ -1,0 +1,158 @@
+//! The automatic model choice on simulated cells: geometry where the errors are geometric,
+//! compliance where the arm sags under gravity, harmonics where the transmissions err; and the
+//! iteration counts of the default objective.
+
+use super::*;
+use crate::experiment::{PAPER_LINK_MASSES_KG, PAPER_PAYLOAD_KG};
+use crate::model::family::transmission;
+use crate::model::presets::preset;
+use crate::model::Robot;
+use crate::simulation::{random_poses, GravityModel, PoseSampler};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// `n` random poses of `truth`, deflected by `gravity` when given, measured by the tests'
+/// tracker (0.010 mm + 0.005 mm/m per axis).
+fn measure(
+    truth: &Robot,
+    gravity: Option<&GravityModel>,
+    n: usize,
+    rng: &mut ChaCha8Rng,
+) -> Observations {
+    let tr = super::tests::tracker(0.010, 0.005);
+    let sampler = PoseSampler {
+        floor_z_mm: 0.0,
+        footprint_radius_mm: 800.0,
+        max_tries_per_pose: 10_000,
+    };
+    let qs = random_poses(truth, n, &sampler, rng).unwrap();
+    let mut obs = Observations::new(truth.dof());
+    for (i, q) in qs.iter().enumerate() {
+        let actual = gravity.map_or_else(|| q.clone(), |g| g.deflected(truth, q));
+        obs.push(q, tr.measure(&truth.tool_position(&actual), rng), i + 2)
+            .unwrap();
+    }
+    obs
+}
+
+fn auto() -> CalibrationSettings {
+    CalibrationSettings {
+        model: ModelChoice::Auto(AutoFamilies::default()),
+        ..Default::default()
+    }
+}
+
+fn chosen(truth: &Robot, gravity: Option<&GravityModel>, seed: u64) -> (Vec<String>, Calibration) {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let cal = measure(truth, gravity, 75, &mut rng);
+    let c = calibrate(
+        &preset("kuka-kr480-r3330").unwrap(),
+        CalibrationData {
+            calibration: &cal,
+            plane: None,
+            validation: None,
+        },
+        &auto(),
+        &(),
+    )
+    .unwrap();
+    let sel = c.model_selection.as_ref().expect("a selection");
+    assert_eq!(sel.candidates.iter().filter(|c| c.chosen).count(), 1);
+    (sel.chosen().families.clone(), c)
+}
+
+#[test]
+fn geometric_errors_choose_the_geometric_model() {
+    let truth = preset("kuka-kr480-r3330-table3").unwrap();
+    for seed in [1, 2, 3] {
+        let (families, c) = chosen(&truth, None, seed);
+        assert!(families.is_empty(), "seed {seed}: {families:?}");
+        // The chosen model is the one calibrated, and the selection is recorded.
+        assert!(selection::families(&c.nominal).is_empty());
+        let r = c.to_result();
+        assert!(r.model_selection.is_some());
+    }
+}
+
+#[test]
+fn gravity_sag_chooses_compliance() {
+    let truth = preset("kuka-kr480-r3330-table3").unwrap();
+    let sag = GravityModel::new(
+        vec![0.0, 2e-8, 2e-8, 0.0, 0.0, 0.0],
+        PAPER_LINK_MASSES_KG.to_vec(),
+        PAPER_PAYLOAD_KG,
+    );
+    for seed in [1, 2, 3] {
+        let (families, c) = chosen(&truth, Some(&sag), seed);
+        assert!(
+            families.iter().any(|f| f == "compliance"),
+            "seed {seed}: {families:?}"
+        );
+        assert!(!compliance_joints(&c.nominal).is_empty());
+    }
+}
+
+fn compliance_joints(r: &Robot) -> Vec<usize> {
+    crate::model::family::compliance::joints(r)
+}
+
+#[test]
+fn transmission_errors_choose_harmonics() {
+    let mut truth = preset("kuka-kr480-r3330-table3").unwrap();
+    let all: Vec<usize> = (0..6).collect();
+    transmission::enable(&mut truth, &all, 1).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(99);
+    for j in 1..=3 {
+        for name in [format!("tsin{j}_1"), format!("tcos{j}_1")] {
+            let p = truth.param_by_name(&name).unwrap();
+            let deg: f64 = rng.gen_range(0.01..0.02) * if rng.gen() { 1.0 } else { -1.0 };
+            truth.set(p, p.unit().to_internal(deg));
+        }
+    }
+    for seed in [1, 2, 3] {
+        let (families, _) = chosen(&truth, None, seed);
+        assert!(
+            families.iter().any(|f| f.starts_with("harmonics")),
+            "seed {seed}: {families:?}"
+        );
+        assert!(!families.iter().any(|f| f == "compliance"), "{families:?}");
+    }
+}
+
+/// The default objective (least squares, then the adaptive reweighting) converges in a handful
+/// of iterations on clean paper-like data, with and without the joint families.
+#[test]
+fn the_default_objective_converges_in_a_handful_of_iterations() {
+    let truth = preset("kuka-kr480-r3330-table3").unwrap();
+    for seed in [4, 5, 6] {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let cal = measure(&truth, None, 75, &mut rng);
+        for h in [0, 1, 2] {
+            let mut nominal = preset("kuka-kr480-r3330").unwrap();
+            let all: Vec<usize> = (0..6).collect();
+            transmission::enable(&mut nominal, &all, h).unwrap();
+            let c = calibrate(
+                &nominal,
+                CalibrationData {
+                    calibration: &cal,
+                    plane: None,
+                    validation: None,
+                },
+                &CalibrationSettings::default(),
+                &(),
+            )
+            .unwrap();
+            let whole = c.whole_solve();
+            assert!(whole.termination.converged(), "{whole:?}");
+            assert!(
+                whole.iterations <= 15,
+                "seed {seed}, {h} harmonics: {} iterations ({:?})",
+                whole.iterations,
+                c.stages
+                    .iter()
+                    .map(|s| (s.loss.name(), s.report.iterations))
+                    .collect::<Vec<_>>()
+            );
+        }
+    }
+}
