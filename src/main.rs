@@ -7,6 +7,7 @@
 mod interrupt;
 
 use robocal::exit;
+use std::io::Write;
 
 fn main() {
     reset_sigpipe();
@@ -15,17 +16,22 @@ fn main() {
         Ok(()) => interrupt::exit(exit::OK, || {}),
         Err(e) => {
             if let Some(clap_err) = e.downcast_ref::<clap::Error>() {
-                // clap prints usage errors, --help and --version itself, with its own exit codes.
+                // clap prints usage errors, --help and --version itself, with its own exit codes;
+                // a stream that cannot take them is exit 4 like any other failed write.
                 let code = clap_err.exit_code();
-                interrupt::exit(code, || {
-                    let _ = clap_err.print();
-                });
+                let printed = clap_err.print().and_then(|()| flush_stdout());
+                interrupt::exit(if printed.is_ok() { code } else { exit::IO }, || {});
             }
+            // Where standard error cannot take the message either, the exit code says it all.
             interrupt::exit(exit::code_for(&e), || {
-                eprintln!("error: {}", exit::message(&e))
+                let _ = writeln!(std::io::stderr(), "error: {}", exit::message(&e));
             })
         }
     }
+}
+
+fn flush_stdout() -> std::io::Result<()> {
+    std::io::stdout().flush()
 }
 
 /// Rust ignores SIGPIPE, so printing to a closed pipe (`robocal demo | head`) would panic; restore

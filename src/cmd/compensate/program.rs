@@ -68,7 +68,7 @@ pub(super) fn run(
         files.push(write(outputs, p, changes_csv(&res).as_bytes())?);
     }
     commit_all(files)?;
-    print_listing(r, &res, &settings);
+    print_listing(r, &res, &settings)?;
     Ok(())
 }
 
@@ -151,7 +151,11 @@ pub(super) fn changes_csv(res: &CompensatedProgram) -> String {
     s
 }
 
-fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettings) {
+fn print_listing(
+    r: &ProgramRun<'_>,
+    res: &CompensatedProgram,
+    s: &ProgramSettings,
+) -> anyhow::Result<()> {
     let n = res.changes.len();
     let applied = res.changes.iter().filter(|c| c.applied).count();
     let poses = res
@@ -159,7 +163,7 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
         .iter()
         .filter(|c| c.kind == TargetKind::Pose)
         .count();
-    println!(
+    outln!(
         "{}: {n} target(s) ({} joint, {poses} Cartesian), {}; solved on the calibrated model of {}",
         r.program.display(),
         n - poses,
@@ -169,12 +173,16 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
             "position only"
         },
         r.params.display()
-    );
+    )?;
     if n > 0 {
-        println!(
+        outln!(
             "  {:<16} {:>6}  {:<6}  {:>11}  {:>11}  status",
-            "target", "line", "kind", "corr. mm", "corr. deg"
-        );
+            "target",
+            "line",
+            "kind",
+            "corr. mm",
+            "corr. deg"
+        )?;
     }
     for c in res.changes.iter().take(LISTED) {
         let (cm, cd) = if c.applied {
@@ -185,17 +193,17 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
         } else {
             ("-".to_owned(), "-".to_owned())
         };
-        println!(
+        outln!(
             "  {:<16} {:>6}  {:<6}  {cm:>11}  {cd:>11}  {}{}",
             c.name,
             c.line,
             kind(c.kind),
             c.status,
             if c.applied { "" } else { " (left unchanged)" }
-        );
+        )?;
     }
     if n > LISTED {
-        println!("  ... and {} more (see --changes)", n - LISTED);
+        outln!("  ... and {} more (see --changes)", n - LISTED)?;
     }
     let max = |f: fn(&Change) -> f64| {
         res.changes
@@ -204,7 +212,7 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
             .map(f)
             .fold(0.0, f64::max)
     };
-    println!(
+    outln!(
         "  {applied} compensated, {} left unchanged; largest correction {:.4} mm, {:.4} deg; \
          checked by forward kinematics on the calibrated model after rounding: within {:.4} mm, \
          {:.4} deg (limit {} mm, {} deg)",
@@ -215,17 +223,18 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
         max(|c| c.verified_deg),
         s.verify_mm,
         s.verify_deg
-    );
+    )?;
     for c in res.changes.iter().filter(|c| !c.applied) {
-        eprintln!(
+        errln!(
             "warning: {}: {}; left unchanged (--keep-going)",
             r.program.display(),
             describe(c)
-        );
+        )?;
     }
     let shown = super::super::io_plan::shown;
     match r.changes {
-        Some(p) => println!("wrote {} and {}", shown(r.out), shown(p)),
-        None => println!("wrote {}", shown(r.out)),
+        Some(p) => outln!("wrote {} and {}", shown(r.out), shown(p))?,
+        None => outln!("wrote {}", shown(r.out))?,
     }
+    Ok(())
 }

@@ -173,11 +173,21 @@ impl AtomicFile {
     }
 }
 
-/// Commits several files so that they are replaced together: all are completed and synced
-/// first, then renamed one after the other with no interruption between them (a signal handler
+/// Commits several files so that they are replaced together: all are claimed for this process
+/// ([`crate::io::claim_outputs`]: refused while another run is writing one of them), completed
+/// and synced first, then renamed one after the other with no interruption between them (a signal handler
 /// calling [`remove_temporaries`] waits for the renames). Streams are copied last. On a failure
 /// before the renames nothing is replaced and every temporary file is removed.
 pub fn commit_all(mut files: Vec<AtomicFile>) -> Result<()> {
+    // Another process writing one of these outputs now would interleave its set with this one.
+    let targets: Vec<&Path> = files
+        .iter()
+        .filter_map(|f| match &f.dest {
+            Dest::Rename { path, .. } => Some(path.as_path()),
+            Dest::Stream { .. } => None,
+        })
+        .collect();
+    crate::io::claims::claim_outputs(&targets)?;
     let mut spooled = Vec::new();
     for f in &mut files {
         spooled.push(f.finish()?);

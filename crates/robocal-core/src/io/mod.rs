@@ -1,6 +1,7 @@
 //! File formats: measurement CSV, atomic output, calibration results, robot files.
 
 pub mod atomic;
+pub mod claims;
 pub(crate) mod columns;
 pub mod export;
 pub mod input;
@@ -22,6 +23,7 @@ mod temporaries;
 pub use atomic::{
     commit_all, remove_temporaries, resolve_output, write_all_atomic, write_atomic, AtomicFile,
 };
+pub use claims::claim_outputs;
 pub use measurements::{
     parse_measurements, read_measurements, write_measurements, Measurement, MeasurementReader,
     MeasurementSet, Positions,
