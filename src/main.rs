@@ -19,8 +19,14 @@ fn main() {
                 // clap prints usage errors, --help and --version itself, with its own exit codes;
                 // a stream that cannot take them is exit 4 like any other failed write.
                 let code = clap_err.exit_code();
-                let printed = clap_err.print().and_then(|()| flush_stdout());
-                interrupt::exit(if printed.is_ok() { code } else { exit::IO }, || {});
+                match clap_err.print().and_then(|()| flush_stdout()) {
+                    // A usage error keeps its code when standard error cannot take its message.
+                    Err(e) if !clap_err.use_stderr() => interrupt::exit(exit::IO, || {
+                        let _ =
+                            writeln!(std::io::stderr(), "error: writing to standard output: {e}");
+                    }),
+                    _ => interrupt::exit(code, || {}),
+                }
             }
             // Where standard error cannot take the message either, the exit code says it all.
             interrupt::exit(exit::code_for(&e), || {

@@ -154,7 +154,7 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
     f.write_all(text.as_bytes())
         .map_err(|e| anyhow::anyhow!("{}: {e}", s.out.display()))?;
     f.commit()?;
-    errln!(
+    outln!(
         "wrote {} ({}, {} joints)",
         s.out.display(),
         match s.format {

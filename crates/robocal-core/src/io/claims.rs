@@ -142,13 +142,10 @@ mod imp {
             } else {
                 format!(" (process {holder})")
             };
-            return Err(std::io::Error::new(
-                std::io::ErrorKind::ResourceBusy,
-                format!(
-                    "another robocal run{who} is writing this output; nothing was written: run \
+            return Err(std::io::Error::other(format!(
+                "another robocal run{who} is writing this output; nothing was written: run \
                      again once it has finished, or give another output"
-                ),
-            ));
+            )));
         }
         f.set_len(0)?;
         f.rewind()?;
