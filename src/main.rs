@@ -11,6 +11,7 @@ use std::io::Write;
 
 fn main() {
     reset_sigpipe();
+    ignore_sigxfsz();
     interrupt::install();
     match robocal::run_from(std::env::args_os()) {
         Ok(()) => interrupt::exit(exit::OK, || {}),
@@ -53,3 +54,18 @@ fn reset_sigpipe() {
 
 #[cfg(not(unix))]
 fn reset_sigpipe() {}
+
+/// A file-size limit (`ulimit -f`) would kill the process with SIGXFSZ, leaving its temporary
+/// file; ignored, the write fails with "File too large" instead, which ends the run like any
+/// failed write (exit 4, temporaries removed, earlier outputs as they were).
+#[cfg(unix)]
+fn ignore_sigxfsz() {
+    // SAFETY: called first thing in main, before any other thread exists; SIG_IGN is a valid
+    // disposition for SIGXFSZ.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
+}
+
+#[cfg(not(unix))]
+fn ignore_sigxfsz() {}

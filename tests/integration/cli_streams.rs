@@ -1,6 +1,7 @@
-//! Output streams and concurrent runs: a full standard output or standard error is exit 4 with a
-//! message where one can still be printed (never a panic), and two runs writing the same outputs
-//! at once leave one run's complete set (the other is refused and told why).
+//! Output streams, concurrent runs and file limits: a full standard output or standard error is
+//! exit 4 with a message where one can still be printed (never a panic); two runs writing the
+//! same outputs at once leave one run's complete set (the other is refused and told why); a
+//! file-size limit is exit 4 with the temporaries removed; any legal output name can be written.
 
 use crate::util::fixtures::cell;
 use crate::util::*;
@@ -323,4 +324,54 @@ fn concurrent_pairs(dir: &Path, args: &dyn Fn(&str) -> Vec<String>, files: usize
         );
     }
     eprintln!("{refused} of 20 pairs overlapped: the second run was refused");
+}
+
+/// A file-size limit (`ulimit -f`, SIGXFSZ): exit 4 with a message, the earlier outputs as they
+/// were, no temporary left.
+#[cfg(unix)]
+#[test]
+fn a_file_size_limit_is_exit_4_and_leaves_the_old_outputs() {
+    let d = Dir::new();
+    let out = d.write("s.csv", "old csv\n");
+    d.write("s.truth.json", "old truth\n");
+    let before = tree(d.path());
+    let script = format!(
+        "ulimit -f 16 && exec '{}' simulate --robot {KUKA} --truth {TRUTH} --poses 3000 --out '{}'",
+        env!("CARGO_BIN_EXE_robocal"),
+        p(&out)
+    );
+    let o = std::process::Command::new("sh")
+        .args(["-c", &script])
+        .output()
+        .expect("sh runs");
+    let stderr = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(4), "{stderr}");
+    assert!(stderr.contains("File too large"), "{stderr}");
+    assert!(stderr.contains("s.csv"), "{stderr}");
+    assert_eq!(
+        tree(d.path()),
+        before,
+        "outputs changed or temporaries left"
+    );
+}
+
+/// An output name of 255 bytes (the longest most file systems allow) is written: the temporary
+/// file's name does not grow with it.
+#[test]
+fn an_output_name_of_255_bytes_is_written() {
+    let d = Dir::new();
+    let out = d.join(format!("{}.csv", "p".repeat(251)));
+    let args = [
+        "plan",
+        "--robot",
+        KUKA,
+        "--poses",
+        "30",
+        "--candidates",
+        "100",
+        "--out",
+    ];
+    ok(&[&args[..], &[p(&out)]].concat());
+    assert!(out.is_file());
+    assert_eq!(tree(d.path()).len(), 1);
 }

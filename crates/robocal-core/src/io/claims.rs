@@ -4,7 +4,7 @@
 //! naming the first one's process, before it writes anything.
 //!
 //! A claim is an advisory lock (`flock`) on a lock file named after the output's absolute path
-//! in a private directory of the user's (`$TMPDIR/robocal-claims-UID`), never beside the outputs:
+//! in robocal's private directory ([`private_dir`]), never beside the outputs:
 //! nothing is created in the user's directories, and the operating system releases every lock
 //! when the process ends, however it ends. Claims are held until the process exits. Without
 //! Unix, claims are not made.
@@ -49,6 +49,29 @@ fn key(path: &Path) -> PathBuf {
     }
 }
 
+/// robocal's private directory (`$TMPDIR/robocal-UID`, mode 0700, created if needed): the
+/// claims on outputs and the records of temporary files, never anything beside the outputs.
+#[cfg(unix)]
+pub(crate) fn private_dir() -> std::io::Result<PathBuf> {
+    use std::os::unix::fs::{DirBuilderExt, MetadataExt};
+    // SAFETY: getuid has no preconditions and cannot fail.
+    let uid = unsafe { libc::getuid() };
+    let dir = std::env::temp_dir().join(format!("robocal-{uid}"));
+    match std::fs::DirBuilder::new().mode(0o700).create(&dir) {
+        Ok(()) => {}
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+        Err(e) => return Err(e),
+    }
+    let m = std::fs::symlink_metadata(&dir)?;
+    if !m.is_dir() || m.uid() != uid {
+        return Err(std::io::Error::other(format!(
+            "{} is not a directory of this user's",
+            dir.display()
+        )));
+    }
+    Ok(dir)
+}
+
 /// FNV-1a, 64 bits: the lock file's name from the key (the same in every process).
 fn fnv1a(bytes: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
@@ -72,25 +95,13 @@ mod imp {
     /// The claims this process holds: the output's key and its open, locked lock file.
     static HELD: Mutex<Vec<(PathBuf, File)>> = Mutex::new(Vec::new());
 
-    /// The private directory of the lock files (created with mode 0700).
+    /// The directory of the lock files.
     fn lock_dir() -> std::io::Result<PathBuf> {
-        use std::os::unix::fs::{DirBuilderExt, MetadataExt};
-        // SAFETY: getuid has no preconditions and cannot fail.
-        let uid = unsafe { libc::getuid() };
-        let dir = std::env::temp_dir().join(format!("robocal-claims-{uid}"));
-        match std::fs::DirBuilder::new().mode(0o700).create(&dir) {
-            Ok(()) => {}
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
-            Err(e) => return Err(e),
+        let d = super::private_dir()?.join("claims");
+        match std::fs::create_dir(&d) {
+            Err(e) if e.kind() != std::io::ErrorKind::AlreadyExists => Err(e),
+            _ => Ok(d),
         }
-        let m = std::fs::symlink_metadata(&dir)?;
-        if !m.is_dir() || m.uid() != uid {
-            return Err(std::io::Error::other(format!(
-                "{} is not a directory of this user's",
-                dir.display()
-            )));
-        }
-        Ok(dir)
     }
 
     pub(super) fn claim(paths: &[&Path]) -> Result<()> {
