@@ -3,6 +3,7 @@
 pub mod atomic;
 pub mod claims;
 pub(crate) mod columns;
+pub(crate) mod csv_lines;
 pub mod export;
 pub mod input;
 pub mod joint_limits;
