@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
-    /// The nominal robot: a preset name or a TOML robot file.
+    /// The nominal robot: a preset name, a TOML robot file or a URDF.
     #[arg(long)]
     robot: String,
     /// Calibration measurements (CSV: q1..qn in degrees (mm for a prismatic joint) or the
@@ -619,10 +619,11 @@ fn print_plausibility(c: &Calibration) -> anyhow::Result<()> {
     let p = &c.plausibility;
     outln!()?;
     if p.passed() {
+        let names: Vec<&str> = p.checks.iter().map(|c| c.kind.name()).collect();
         outln!(
-            "plausibility: all {} checks passed (units, handedness, nominal error, parameter \
-             moves, convergence)",
-            p.checks.len()
+            "plausibility: all {} checks passed ({})",
+            p.checks.len(),
+            names.join(", ")
         )?;
         return Ok(());
     }

@@ -20,7 +20,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct CompensateArgs {
-    /// The nominal robot (what the controller believes): a preset name or a TOML robot file
+    /// The nominal robot (what the controller believes): a preset name, a TOML robot file or a URDF
     /// [default: the robot embedded in the result; when given, it must agree with that one].
     #[arg(long)]
     robot: Option<String>,

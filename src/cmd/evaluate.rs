@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct EvaluateArgs {
-    /// The nominal robot: a preset name or a TOML robot file [default: the robot embedded in
+    /// The nominal robot: a preset name, a TOML robot file or a URDF [default: the robot embedded in
     /// the result; when given, it must agree with that one].
     #[arg(long)]
     robot: Option<String>,

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct FkArgs {
-    /// A preset name or a TOML robot file [with --params, default: the robot embedded in the
+    /// A preset name, a TOML robot file or a URDF [with --params, default: the robot embedded in the
     /// result; when given, it must agree with that one].
     #[arg(long)]
     robot: Option<String>,

@@ -19,7 +19,7 @@ const MAX_CANDIDATES: usize = 200_000;
 
 #[derive(Args, Debug)]
 pub struct PlanArgs {
-    /// The nominal robot: a preset name or a TOML robot file.
+    /// The nominal robot: a preset name, a TOML robot file or a URDF.
     #[arg(long)]
     robot: String,
     /// Number of poses to choose (besides those of --include).

@@ -14,7 +14,7 @@ pub enum RobotCmd {
 
 #[derive(Args, Debug)]
 pub struct ShowArgs {
-    /// A preset name (see `robocal robot list`) or a TOML robot file.
+    /// A preset name (see `robocal robot list`), a TOML robot file or a URDF.
     robot: String,
     /// Show the calibrated parameters of a result file instead of the nominal ones.
     #[arg(long)]

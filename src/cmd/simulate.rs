@@ -20,7 +20,7 @@ const BAR_FROM: usize = 10_000;
 
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
-    /// The nominal robot, the model the controller believes: a preset or a TOML robot file.
+    /// The nominal robot, the model the controller believes: a preset, a TOML robot file or a URDF.
     #[arg(long)]
     robot: String,
     /// The robot that really moves: a preset (e.g. kuka-kr480-r3330-table3), a TOML robot file,
