@@ -3,6 +3,7 @@
 //! (SIGKILL cannot be caught: the temporaries it leaves are removed at the next write of the same
 //! output, see `robocal_core::io::atomic`.)
 
+use std::io::Write;
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 /// Held by whoever ends the process: the main thread reporting its result, or the signal
@@ -34,7 +35,8 @@ pub fn install() {
                 exit(robocal::exit::INTERRUPTED, || {
                     let removed = robocal_core::io::remove_temporaries();
                     clear_progress_line();
-                    eprintln!(
+                    let _ = writeln!(
+                        std::io::stderr(),
                         "error: interrupted by {name}; {removed} unfinished temporary file(s) \
                          removed, no output half-written"
                     );
@@ -51,6 +53,6 @@ pub fn install() {}
 fn clear_progress_line() {
     use std::io::IsTerminal;
     if std::io::stderr().is_terminal() {
-        eprint!("\r\x1b[2K");
+        let _ = write!(std::io::stderr(), "\r\x1b[2K");
     }
 }

@@ -5,6 +5,8 @@
 //! function with generated argument vectors. This is the program's front end, not a stable API:
 //! use `robocal-core` from other code.
 
+#[macro_use]
+mod output;
 mod cmd;
 pub mod exit;
 mod progress;
@@ -23,5 +25,6 @@ where
     T: Into<OsString> + Clone,
 {
     let cli = cmd::Cli::try_parse_from(args)?;
-    cmd::run(cli)
+    cmd::run(cli)?;
+    output::flush_out()
 }

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
-    /// The nominal robot: a preset name or a TOML robot file.
+    /// The nominal robot: a preset name, a TOML robot file or a URDF.
     #[arg(long)]
     robot: String,
     /// Calibration measurements (CSV: q1..qn in degrees (mm for a prismatic joint) or the
@@ -327,7 +327,7 @@ fn read(
 ) -> anyhow::Result<robocal_core::identification::SplitData> {
     let set = read_measurements(path, robot.joint_space(), Positions::Required)?;
     for w in &set.warnings {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}")?;
     }
     let split = split_measurements(&set)?;
     let mut o = OutsideLimits::new(robot, path);
@@ -376,17 +376,17 @@ impl TryFrom<&CalibrateArgs> for Settings {
         let betas = apply_beta(&mut robot, &a.beta)?;
         let compliant = apply_joint_families(&mut robot, a)?;
         if compliant.is_empty() && a.compliance.as_deref().map(str::trim) == Some("auto") {
-            eprintln!(
+            errln!(
                 "note: --compliance auto: no joint of robot `{}` turns under gravity (every axis                  is parallel to its `gravity`); no compliance added",
                 robot.name()
-            );
+            )?;
         }
         if betas.is_empty() && a.beta.trim() == "parallel" {
-            eprintln!(
+            errln!(
                 "note: --beta parallel: robot `{}` has no pair of consecutive parallel axes; no \
                  tilt parameter added",
                 robot.name()
-            );
+            )?;
         }
         let fix = param_list(&robot, &a.fix, "--fix")?;
         let free = param_list(&robot, &a.free, "--free")?;
@@ -493,16 +493,16 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     if let Some(v) = &s.validate {
         let vd = read(v, robot, s.nominal_limits, &mut outside)?;
         if !vd.plane.is_empty() {
-            eprintln!(
+            errln!(
                 "note: {}: {} plane point(s) ignored in the validation set",
                 v.display(),
                 vd.plane.len()
-            );
+            )?;
         }
         validation = merge(validation, &vd.calibration)?;
         validation = merge(validation, &vd.validation)?;
     }
-    println!(
+    outln!(
         "robot {} ({} joints, {}){}; {} calibration point(s){}{}",
         robot.name(),
         robot.dof(),
@@ -530,7 +530,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         } else {
             format!(", {} validation point(s)", validation.len())
         },
-    );
+    )?;
     let bar = crate::progress::Bar::new("calibrating");
     let result = calibrate(
         robot,
@@ -547,15 +547,15 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let converged = cal.solver().termination.converged();
     let implausible = cal.plausibility.implausible();
     if let Some(sel) = &cal.model_selection {
-        print_selection(sel);
+        print_selection(sel)?;
     }
-    print_report(&cal, converged, implausible);
-    print_plausibility(&cal);
+    print_report(&cal, converged, implausible)?;
+    print_plausibility(&cal)?;
     if let Some(why) = &cal.covariance.unavailable {
-        eprintln!(
+        errln!(
             "warning: standard deviations unavailable (written as null): {why} (--rank-tol \
              {rank_tolerance:e} given explicitly)"
-        );
+        )?;
     }
     let mut res = cal.to_result();
     res.inputs = Some(record_inputs(&s)?);
@@ -585,7 +585,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     };
     if converged && !implausible {
         res.write(&s.out)?;
-        println!("result written to {}", s.out.display());
+        outln!("result written to {}", s.out.display())?;
         return Ok(());
     }
     if converged {
@@ -593,17 +593,17 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         let summary = common::indent(&cal.plausibility.summary());
         if s.accept_implausible {
             res.write(&s.out)?;
-            println!(
+            outln!(
                 "result written to {} marked \"status\": \"implausible\"",
                 s.out.display()
-            );
-            eprintln!(
+            )?;
+            errln!(
                 "WARNING: IMPLAUSIBLE FIT WRITTEN (--accept-implausible): the fit failed the \
                  plausibility gate and is NOT a calibration:\n{summary}\n{} is marked \
                  \"status\": \"implausible\"; compensate refuses it unless given \
                  --accept-implausible too",
                 s.out.display()
-            );
+            )?;
             return Ok(());
         }
         return Err(exit::implausible(format!(
@@ -642,21 +642,26 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
 }
 
 /// Prints the automatic model choice: every candidate with its cross-validated error.
-pub(crate) fn print_selection(sel: &robocal_core::identification::ModelSelection) {
-    println!();
-    println!(
+pub(crate) fn print_selection(
+    sel: &robocal_core::identification::ModelSelection,
+) -> anyhow::Result<()> {
+    outln!()?;
+    outln!(
         "model: {} (--model auto: cross-validation over the calibration data, {} folds by pose; \
          a family stays only when it lowers the error by more than the standard error)",
         sel.chosen().name(),
         sel.folds
-    );
-    println!(
+    )?;
+    outln!(
         "  {:<40} {:>10} {:>16} {:>10}",
-        "candidate", "parameters", "CV mean (mm)", "std. err."
-    );
+        "candidate",
+        "parameters",
+        "CV mean (mm)",
+        "std. err."
+    )?;
     for c in &sel.candidates {
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
-        println!(
+        outln!(
             "{} {:<40} {:>10} {:>16} {:>10}{}",
             if c.chosen { "*" } else { " " },
             c.name(),
@@ -666,37 +671,39 @@ pub(crate) fn print_selection(sel: &robocal_core::identification::ModelSelection
             c.rejected
                 .as_ref()
                 .map_or(String::new(), |r| format!("  not selectable: {r}"))
-        );
+        )?;
     }
+    Ok(())
 }
 
 /// Prints the plausibility gate's outcome: one line when it passed, every failed check with its
 /// likely cause otherwise.
-fn print_plausibility(c: &Calibration) {
+fn print_plausibility(c: &Calibration) -> anyhow::Result<()> {
     let p = &c.plausibility;
-    println!();
+    outln!()?;
     if p.passed() {
         let names: Vec<&str> = p.checks.iter().map(|c| c.kind.name()).collect();
-        println!(
+        outln!(
             "plausibility: all {} checks passed ({})",
             p.checks.len(),
             names.join(", ")
-        );
-        return;
+        )?;
+        return Ok(());
     }
-    println!(
+    outln!(
         "plausibility: {} of {} checks FAILED",
         p.failures().count(),
         p.checks.len()
-    );
+    )?;
     if !c.solver().termination.converged() {
         if let Some(f) = p.failures().find(|f| f.kind == CheckKind::Convergence) {
-            println!("  convergence: {}", f.detail);
+            outln!("  convergence: {}", f.detail)?;
         }
     }
     if p.implausible() {
-        println!("{}", common::indent(&p.summary()));
+        outln!("{}", common::indent(&p.summary()))?;
     }
+    Ok(())
 }
 
 /// Appends the points of `b` to `a` (validation points from two sources).
@@ -736,7 +743,7 @@ fn stats_table(title: &str, cols: &[(&str, ErrorStats)]) -> String {
     s
 }
 
-fn print_report(c: &Calibration, converged: bool, implausible: bool) {
+fn print_report(c: &Calibration, converged: bool, implausible: bool) -> anyhow::Result<()> {
     let partial = if !converged {
         " -- PARTIAL: the solver did not converge; not a calibration"
     } else if implausible {
@@ -746,26 +753,26 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
     };
     let reg = &c.registration;
     let tf = robocal_core::io::result::FrameVec::from_tracker_frame(&reg.frame);
-    println!();
+    outln!()?;
     match reg.initial {
         robocal_core::registration::InitialFrame::Plane {
             n,
             tilt_deg,
             max_error_mm,
             ..
-        } => println!(
+        } => outln!(
             "initial measurement frame from {n} plane points (plane tilt {tilt_deg:.3} deg; \
              largest error under it {max_error_mm:.3} mm)"
-        ),
+        )?,
         robocal_core::registration::InitialFrame::LeastSquares => {
-            println!("initial measurement frame: least-squares fit (no plane points)")
+            outln!("initial measurement frame: least-squares fit (no plane points)")?
         }
     }
-    println!(
+    outln!(
         "tracker frame in the base frame (mm, deg): x {:.4}  y {:.4}  z {:.4}  A {:.5}  B {:.5}  C {:.5}",
         tf.x, tf.y, tf.z, tf.a, tf.b, tf.c
-    );
-    print_weighting(&c.weighting);
+    )?;
+    print_weighting(&c.weighting)?;
     let before_cols: Vec<(&str, ErrorStats)> =
         std::iter::once(("Calibration", c.calibration.before_stats()))
             .chain(
@@ -774,21 +781,21 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
                     .map(|v| ("Validation", v.before_stats())),
             )
             .collect();
-    println!();
-    print!(
+    outln!()?;
+    out!(
         "{}",
         stats_table(
             "Table II. Error before calibration (nominal model, fitted measurement frame)",
             &before_cols
         )
-    );
+    )?;
     let tf = &c.tool_fit;
     let tools: Vec<String> = tf
         .tools
         .iter()
         .map(|t| format!("({:.3}, {:.3}, {:.3})", t[0], t[1], t[2]))
         .collect();
-    println!(
+    outln!(
         "with the fitted tool{} {} (mm, flange frame): mean {:.4} mm, RMS {:.4} mm, max {:.4} mm{}",
         if tools.len() > 1 { "s" } else { "" },
         tools.join(", "),
@@ -800,45 +807,52 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
         } else {
             " (not used: the nominal geometry misses the data even so)"
         }
-    );
+    )?;
     if let Some(o) = &c.calibration.orientation_deg {
         let (b, a) = (ErrorStats::from_norms(&o.0), ErrorStats::from_norms(&o.1));
-        println!(
+        outln!(
             "orientation error (deg): before mean {:.4}, max {:.4}; after mean {:.4}, max {:.4}",
-            b.mean_mm, b.max_mm, a.mean_mm, a.max_mm
-        );
+            b.mean_mm,
+            b.max_mm,
+            a.mean_mm,
+            a.max_mm
+        )?;
     }
     if let Some(af) = &reg.affine {
         let sv = af.tr.singular_values();
-        println!(
+        outln!(
             "affine Tr (eq. 8-11): mean {:.4} mm, max {:.4} mm; singular values {:.6} {:.6} {:.6}",
-            af.stats.mean_mm, af.stats.max_mm, sv[0], sv[1], sv[2]
-        );
+            af.stats.mean_mm,
+            af.stats.max_mm,
+            sv[0],
+            sv[1],
+            sv[2]
+        )?;
     }
     let id = &c.identifiability;
-    println!();
-    println!(
+    outln!()?;
+    outln!(
         "identifiability: {} parameters identified, {} fixed (rank tolerance {:.0e}); condition \
          number of the scaled Jacobian {:.1}",
         id.identified.len(),
         id.fixed.len(),
         id.rank_tolerance,
         id.condition_number
-    );
+    )?;
     for f in &id.fixed {
-        println!(
+        outln!(
             "  {:<8} fixed: {}",
             f.param.name(),
             super::flags::with_flags(&f.describe())
-        );
+        )?;
     }
-    println!();
+    outln!()?;
     let pv = c.param_vector();
     let entry = |p: Param| pv.get(p).expect("a parameter of the calibrated robot");
-    println!(
+    outln!(
         "Table III. Calibrated parameters of the robot (* fixed at its nominal value){partial}"
-    );
-    print!(
+    )?;
+    out!(
         "{}",
         layout(&c.calibrated, &|p| {
             let v = num(c.calibrated.get_display(p), 4);
@@ -848,9 +862,9 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
                 format!("{v} ")
             }
         })
-    );
-    println!("Standard deviations (same layout; - fixed, n/a unavailable)");
-    print!(
+    )?;
+    outln!("Standard deviations (same layout; - fixed, n/a unavailable)")?;
+    out!(
         "{}",
         layout(&c.calibrated, &|p| {
             let e = entry(p);
@@ -860,41 +874,43 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
                 None => "- ".to_string(),
             }
         })
-    );
+    )?;
     let corr = c.covariance.most_correlated(5);
     if !corr.is_empty() {
-        println!(
+        outln!(
             "most correlated: {}",
             corr.iter()
                 .map(|k| format!("{}/{} {:+.3}", k.a.name(), k.b.name(), k.rho))
                 .collect::<Vec<_>>()
                 .join(", ")
-        );
+        )?;
     }
-    println!();
+    outln!()?;
     let s = c.solver();
-    println!(
+    outln!(
         "solver ({}): {} after {} iteration(s); objective {:.6} -> {:.6}",
         c.settings.objective.name(),
         s.termination.describe(),
         c.stages.iter().map(|s| s.report.iterations).sum::<usize>(),
         c.stages[0].report.initial_objective,
         s.final_objective
-    );
+    )?;
     if let Some(scale) = c.robust_scale_mm {
-        println!(
+        outln!(
             "robust scale {scale:.4} mm; {} point(s) down-weighted{}",
             c.downweighted.len(),
             if c.downweighted.is_empty() { "" } else { ":" }
-        );
+        )?;
         for d in &c.downweighted {
             let orientation = d
                 .orientation_deg
                 .map_or(String::new(), |a| format!(", orientation {a:.4} deg"));
-            println!(
+            outln!(
                 "  line {:>5}: error {:.4} mm{orientation}, weight {:.4}",
-                d.line, d.error_mm, d.weight
-            );
+                d.line,
+                d.error_mm,
+                d.weight
+            )?;
         }
     }
     let after_cols: Vec<(&str, ErrorStats)> =
@@ -905,25 +921,26 @@ fn print_report(c: &Calibration, converged: bool, implausible: bool) {
                     .map(|v| ("Validation", v.after_stats())),
             )
             .collect();
-    println!();
-    print!(
+    outln!()?;
+    out!(
         "{}",
         stats_table(
             &format!("Table IV. Error after calibration (calibrated model){partial}"),
             &after_cols
         )
-    );
-    print_prediction(c);
+    )?;
+    print_prediction(c)?;
+    Ok(())
 }
 
 /// The predicted error at new poses, beside the measured validation mean when there is one.
-fn print_prediction(c: &Calibration) {
+fn print_prediction(c: &Calibration) -> anyhow::Result<()> {
     let Some(p) = &c.prediction else {
-        println!("predicted error at new poses: unavailable (no standard deviations)");
-        return;
+        outln!("predicted error at new poses: unavailable (no standard deviations)")?;
+        return Ok(());
     };
     let measured = c.validation.as_ref().map(|v| v.after_stats().mean_mm);
-    println!(
+    outln!(
         "Predicted at new poses like the calibration poses: mean {:.4} mm, std {:.4} mm, RMS \
          {:.4} mm (noise {:.4} mm per axis, parameter uncertainty {:.4} mm RMS){}",
         p.mean_mm,
@@ -938,35 +955,37 @@ fn print_prediction(c: &Calibration) {
             ),
             None => String::new(),
         }
-    );
+    )?;
+    Ok(())
 }
 
 /// One line on the point weights the fit used.
-fn print_weighting(w: &robocal_core::observations::AppliedWeighting) {
+fn print_weighting(w: &robocal_core::observations::AppliedWeighting) -> anyhow::Result<()> {
     use robocal_core::observations::WeightSource;
     let model = |t: &Option<robocal_core::observations::TrackerSigma>| {
         t.map(|t| format!("{} mm + {} mm/m per axis", t.fixed_mm, t.per_m_mm))
             .unwrap_or_default()
     };
     match w.source {
-        WeightSource::Column => println!("points weighted by their sigma_mm column"),
-        WeightSource::Given => println!(
+        WeightSource::Column => outln!("points weighted by their sigma_mm column")?,
+        WeightSource::Given => outln!(
             "points weighted by the tracker model {} (--tracker-sigma)",
             model(&w.tracker)
-        ),
-        WeightSource::Automatic => println!(
+        )?,
+        WeightSource::Automatic => outln!(
             "points weighted by a typical tracker, {}: the data are in a tracker's frame (the \
              tracker {:.0} mm from the base); --tracker-sigma gives your tracker's model, \
              --tracker-sigma off weighs every point the same",
             model(&w.tracker),
             w.tracker_distance_mm
-        ),
-        WeightSource::None => println!(
+        )?,
+        WeightSource::None => outln!(
             "every point weighs the same (the measurement frame's origin is {:.0} mm from the \
              base: not a tracker's own frame, or --tracker-sigma off)",
             w.tracker_distance_mm
-        ),
+        )?,
     }
+    Ok(())
 }
 
 /// The result's `inputs`: the robot file (not a preset), the data and the validation file, each

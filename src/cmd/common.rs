@@ -170,21 +170,22 @@ pub fn joints_arg(s: &str, robot: &Robot) -> anyhow::Result<Vec<f64>> {
 /// Warns (stderr) when a result file is not a calibration: a partial result (`calibrate
 /// --keep-partial` after the solver did not converge) or an implausible one (`calibrate
 /// --accept-implausible` after the fit failed the plausibility gate).
-pub fn warn_not_calibrated(res: &CalibrationResult, path: &Path) {
+pub fn warn_not_calibrated(res: &CalibrationResult, path: &Path) -> anyhow::Result<()> {
     use robocal_core::io::result::NotCalibrated;
     match res.not_calibrated() {
-        Some(NotCalibrated::Partial(why)) => eprintln!(
+        Some(NotCalibrated::Partial(why)) => errln!(
             "warning: {} is a PARTIAL result, not a calibration ({why})",
             path.display()
-        ),
-        Some(NotCalibrated::Implausible(why)) => eprintln!(
+        )?,
+        Some(NotCalibrated::Implausible(why)) => errln!(
             "warning: {} is an IMPLAUSIBLE result, not a calibration: it failed the \
              plausibility gate and was kept with --accept-implausible:\n{}",
             path.display(),
             indent(&why)
-        ),
+        )?,
         None => {}
     }
+    Ok(())
 }
 
 /// Indents every line of `text` by four spaces.
@@ -204,7 +205,7 @@ pub fn check_limits(
 ) -> anyhow::Result<()> {
     if nominal_limits {
         if let Some(w) = o.to_warning() {
-            eprintln!("warning: {w} (used anyway: --nominal-limits)");
+            errln!("warning: {w} (used anyway: --nominal-limits)")?;
             outside.push(o);
         }
         return Ok(());

@@ -20,7 +20,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct CompensateArgs {
-    /// The nominal robot (what the controller believes): a preset name or a TOML robot file
+    /// The nominal robot (what the controller believes): a preset name, a TOML robot file or a URDF
     /// [default: the robot embedded in the result; when given, it must agree with that one].
     #[arg(long)]
     robot: Option<String>,
@@ -217,12 +217,12 @@ impl TryFrom<&CompensateArgs> for Settings {
                     super::common::indent(&why)
                 )));
             }
-            eprintln!(
+            errln!(
                 "WARNING: --accept-implausible: compensating with {}, a result that FAILED the \
                  plausibility gate; the commanded joints may be far from right:\n{}",
                 a.params.display(),
                 super::common::indent(&why)
-            );
+            )?;
         }
         Ok(Settings {
             nominal,
@@ -293,10 +293,10 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
             MeasurementReader::open(path, joints, Positions::Optional).with_context(context)?;
         check_extra_columns(path, joints, reader.extra_columns())?;
         if reader.has_positions() {
-            eprintln!(
+            errln!(
                 "note: {}: the x,y,z columns (measured positions) are not used or carried",
                 path.display()
-            );
+            )?;
         }
         let mut w = CommandedWriter::to_output(
             outputs.open(&out)?,
@@ -335,16 +335,16 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
             tally.tick(&pb);
         }
         for warning in reader.finish().with_context(context)? {
-            eprintln!("warning: {warning}");
+            errln!("warning: {warning}")?;
         }
         if outside.count > 0 {
-            eprintln!(
+            errln!(
                 "warning: {}: {} desired pose(s) outside the joint limits; solved from the \
                  nearest pose within them: {}",
                 path.display(),
                 outside.count,
                 outside.text()
-            );
+            )?;
         }
         (path, w)
     } else {
@@ -355,17 +355,17 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
             read_targets(path, joints).with_context(|| format!("--targets {}", path.display()))?;
         check_extra_columns(path, joints, &set.extra_columns)?;
         if full_pose && !set.has_orientation {
-            eprintln!(
+            errln!(
                 "note: {}: no a,b,c columns: the targets are positions, compensated position-only \
                  (orientation free, configuration not checked)",
                 path.display()
-            );
+            )?;
             full_pose = false;
         } else if position_only && set.has_orientation {
-            eprintln!(
+            errln!(
                 "note: {}: --position-only: the a,b,c columns (orientations) are not used",
                 path.display()
-            );
+            )?;
         }
         let mut w = CommandedWriter::to_output(
             outputs.open(&out)?,
@@ -412,14 +412,14 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
             )));
         }
         for f in &tally.failed.items {
-            eprintln!("warning: {}: {f}", input.display());
+            errln!("warning: {}: {f}", input.display())?;
         }
         if tally.failed.count > LISTED {
-            eprintln!(
+            errln!(
                 "warning: ... and {} more (see the status column of {})",
                 tally.failed.count - LISTED,
                 super::io_plan::shown(&out)
-            );
+            )?;
         }
     }
     writer.commit()?;
@@ -431,7 +431,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         &out,
         input,
         &tally,
-    );
+    )?;
     Ok(())
 }
 
@@ -566,45 +566,48 @@ fn print_summary(
     out: &std::path::Path,
     input: &std::path::Path,
     t: &Tally,
-) {
+) -> anyhow::Result<()> {
     let mode = match (joints, full_pose) {
         (true, true) => "desired poses; target = nominal tool pose (eq. 13, full pose)",
         (true, false) => "desired poses; target = nominal tool position (eq. 13, position only)",
         (false, true) => "Cartesian targets (base frame, full pose)",
         (false, false) => "Cartesian targets (base frame, position only)",
     };
-    println!(
+    outln!(
         "{}: {} {mode}; solved on the calibrated model of {}",
         input.display(),
         t.rows,
         params.display()
-    );
+    )?;
     for (s, n) in IkStatus::ALL.iter().zip(t.counts) {
-        println!("  {:<14} {n:>8}", s.as_str());
+        outln!("  {:<14} {n:>8}", s.as_str())?;
     }
-    println!(
+    outln!(
         "  residual       max {:.3e} mm over converged rows, {:.3e} mm over all (tolerance {:e} mm)",
         t.max_residual_converged, t.max_residual, tolerance_mm
-    );
+    )?;
     if full_pose {
-        println!(
+        outln!(
             "  orientation    max {:.3e} deg over converged rows, {:.3e} deg over all \
              (tolerance {:e} deg)",
-            t.max_residual_deg_converged, t.max_residual_deg, tolerance_deg
-        );
+            t.max_residual_deg_converged,
+            t.max_residual_deg,
+            tolerance_deg
+        )?;
     }
     let it_mean = t.iterations as f64 / t.rows.max(1) as f64;
-    println!(
+    outln!(
         "  iterations     mean {it_mean:.1}, max {}",
         t.max_iterations
-    );
+    )?;
     for (m, unit) in t.max_change.iter().zip(["deg", "mm"]) {
         if let Some((ch, line, i)) = m {
-            println!(
+            outln!(
                 "  joint change   max {ch:.4} {unit} (line {line}, q{})",
                 i + 1
-            );
+            )?;
         }
     }
-    println!("wrote {} ({} rows)", super::io_plan::shown(out), t.rows);
+    outln!("wrote {} ({} rows)", super::io_plan::shown(out), t.rows)?;
+    Ok(())
 }

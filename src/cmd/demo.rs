@@ -119,22 +119,22 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     write_all_atomic(&refs)?;
     bar.finish();
 
-    print_run(&exp);
+    print_run(&exp)?;
     print_model_choice(&exp)?;
     if let Some(e) = &elasto {
-        print_elasto(&exp, e, dir);
+        print_elasto(&exp, e, dir)?;
     }
-    print_files(&exp, dir);
-    println!("report: {}", path(HTML_FILE).display());
+    print_files(&exp, dir)?;
+    outln!("report: {}", path(HTML_FILE).display())?;
     Ok(())
 }
 
 /// Prints `text` wrapped at 100 columns.
-fn para(text: &str) {
+fn para(text: &str) -> anyhow::Result<()> {
     let mut line = String::new();
     for w in text.split_whitespace() {
         if !line.is_empty() && line.len() + 1 + w.len() > 100 {
-            println!("{line}");
+            outln!("{line}")?;
             line.clear();
         }
         if !line.is_empty() {
@@ -143,23 +143,24 @@ fn para(text: &str) {
         line.push_str(w);
     }
     if !line.is_empty() {
-        println!("{line}");
+        outln!("{line}")?;
     }
+    Ok(())
 }
 
-fn print_run(exp: &Experiment) {
+fn print_run(exp: &Experiment) -> anyhow::Result<()> {
     let cfg = &exp.config;
     let s = &cfg.session;
     let cal = &exp.calibration;
-    println!(
+    outln!(
         "robocal demo: the experiment of Samak et al. (2019) on a simulated KUKA KR 480 R3330, seed {}",
         s.seed
-    );
-    println!(
+    )?;
+    outln!(
         "  nominal model  {} (Table I, tool T0 of eq. 7): what the controller believes",
         cfg.nominal.name()
-    );
-    println!(
+    )?;
+    outln!(
         "  true robot     {} (the paper's Table III){}",
         cfg.truth.name(),
         if s.gravity.is_some() {
@@ -167,13 +168,13 @@ fn print_run(exp: &Experiment) {
         } else {
             ""
         }
-    );
+    )?;
     if let Some(g) = &s.gravity {
-        println!(
+        outln!(
             "                 joint compliances {} rad/(N m),",
             number_list(&g.compliance_rad_per_nm, ",")
-        );
-        println!(
+        )?;
+        outln!(
             "                 link masses {} kg, payload {} kg{}",
             number_list(&g.link_masses_kg, ","),
             g.payload_kg,
@@ -182,31 +183,38 @@ fn print_run(exp: &Experiment) {
             } else {
                 ""
             }
-        );
+        )?;
         if let Some(d) = &exp.session.deflection_mm {
             let st = ErrorStats::from_norms(d);
-            println!(
+            outln!(
                 "                 the tool sags {:.3} mm on average, {:.3} mm at most",
-                st.mean_mm, st.max_mm
-            );
+                st.mean_mm,
+                st.max_mm
+            )?;
         }
     }
     let t = &s.tracker_frame;
-    println!(
+    outln!(
         "  laser tracker  at x {} y {} z {} mm, A {} B {} C {} deg;",
-        t.x, t.y, t.z, t.a, t.b, t.c
-    );
-    println!(
+        t.x,
+        t.y,
+        t.z,
+        t.a,
+        t.b,
+        t.c
+    )?;
+    outln!(
         "                 noise {:.3} mm + {:.3} mm/m per axis (1 sigma)",
-        s.noise_mm, s.noise_per_m
-    );
-    println!(
+        s.noise_mm,
+        s.noise_per_m
+    )?;
+    outln!(
         "  points         {} plane + {} calibration + {} validation",
         if s.plane_points { 3 } else { 0 },
         s.poses,
         s.validation_poses
-    );
-    println!();
+    )?;
+    outln!()?;
     match cal.registration.initial {
         InitialFrame::Plane { n, tilt_deg, .. } => para(&format!(
             "Measurement frame: initial from the {n} plane points (plane tilt {tilt_deg:.3} deg), \
@@ -217,8 +225,8 @@ fn print_run(exp: &Experiment) {
             "Measurement frame: least-squares fit to the {} calibration points, refined (eq. 11).",
             cal.calibration.before.len()
         )),
-    }
-    println!();
+    }?;
+    outln!()?;
     let e = &exp.result.errors;
     let mut cols = vec![Column {
         label: "Calibration points",
@@ -232,14 +240,14 @@ fn print_run(exp: &Experiment) {
             paper: paper::table2_validation(),
         });
     }
-    print!(
+    out!(
         "{}",
         error_table(
             "Table II. Error before calibration (nominal model, fitted measurement frame)",
             &cols
         )
-    );
-    println!();
+    )?;
+    outln!()?;
     let id = &cal.identifiability;
     let solver = cal.solver();
     para(&format!(
@@ -253,10 +261,10 @@ fn print_run(exp: &Experiment) {
             .iter()
             .map(|s| s.report.iterations)
             .sum::<usize>()
-    ));
-    println!();
-    print!("{}", parameter_table(exp));
-    println!();
+    ))?;
+    outln!()?;
+    out!("{}", parameter_table(exp))?;
+    outln!()?;
     let mut cols = vec![Column {
         label: "Calibration points",
         ours: e.calibration.after,
@@ -269,14 +277,14 @@ fn print_run(exp: &Experiment) {
             paper: paper::table4_validation(),
         });
     }
-    print!(
+    out!(
         "{}",
         error_table(
             "Table IV. Error after calibration, predicted (calibrated model, same measurements)",
             &cols
         )
-    );
-    println!();
+    )?;
+    outln!()?;
 
     let n = exp.compensation.len();
     let converged = exp
@@ -296,9 +304,9 @@ fn print_run(exp: &Experiment) {
          {converged} of {n} converged, largest joint change {max_change:.4} deg. Verification: \
          the commanded joints measured again in the same cell (new tracker noise, seed {}).",
         cfg.verification_seed
-    ));
-    println!();
-    print!(
+    ))?;
+    outln!()?;
+    out!(
         "{}",
         error_table(
             "Table V. Error after calibration, measured (compensated calibration poses)",
@@ -315,7 +323,7 @@ fn print_run(exp: &Experiment) {
                 },
             ]
         )
-    );
+    )?;
     let (v, p, b) = (
         exp.verified().mean_mm,
         exp.predicted().mean_mm,
@@ -327,8 +335,9 @@ fn print_run(exp: &Experiment) {
         percent(v, p),
         percent(0.293, 0.174),
         b / v
-    ));
-    println!();
+    ))?;
+    outln!()?;
+    Ok(())
 }
 
 /// The experiment again on the same measurements (same seeds), calibrated with joint compliance
@@ -365,14 +374,14 @@ fn print_model_choice(exp: &Experiment) -> anyhow::Result<()> {
     para(
         "The paper's model is geometric. The model `robocal calibrate` chooses by default on the \
          same calibration points (--model auto, default objective):",
-    );
-    super::calibrate::print_selection(&sel);
-    println!();
+    )?;
+    super::calibrate::print_selection(&sel)?;
+    outln!()?;
     Ok(())
 }
 
 /// The geometric calibration beside the elasto-geometric one, and the verification of both.
-fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) {
+fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) -> anyhow::Result<()> {
     let payload = geo
         .config
         .session
@@ -381,14 +390,14 @@ fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) {
         .map_or(0.0, |g| g.payload_kg);
     para(&format!(
         "Beyond the paper: the same measurements calibrated with joint compliance under gravity          (the elasto-geometric model: each joint turns by its compliance times the gravity torque          about its axis; coefficients from the chain's geometry, the {payload} kg payload known),          then compensated and verified the same way:"
-    ));
+    ))?;
     let val = |e: &Experiment| {
         e.result
             .errors
             .validation
             .map_or(f64::NAN, |v| v.after.mean_mm)
     };
-    println!("{:<34} {:>12} {:>18}", "", "Geometric", "Elasto-geometric");
+    outln!("{:<34} {:>12} {:>18}", "", "Geometric", "Elasto-geometric")?;
     for (label, a, b) in [
         ("Validation mean (mm)", val(geo), val(el)),
         (
@@ -402,15 +411,15 @@ fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) {
             el.verified().max_mm,
         ),
     ] {
-        println!("{label:<34} {a:>12.3} {b:>18.3}");
+        outln!("{label:<34} {a:>12.3} {b:>18.3}")?;
     }
-    println!(
+    outln!(
         "{:<34} {:>12} {:>18}",
         "Identified parameters",
         geo.calibration.identifiability.identified.len(),
         el.calibration.identifiability.identified.len()
-    );
-    para("By hand, on the files below:");
+    )?;
+    para("By hand, on the files below:")?;
     command(&[
         "robocal calibrate".to_owned(),
         format!("--robot {PAPER_NOMINAL}"),
@@ -420,15 +429,16 @@ fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) {
         format!("--payload-kg {payload}"),
         "--model geometric".to_owned(),
         format!("--out {}", sh(&dir.join("result-elasto.json"))),
-    ]);
-    println!();
+    ])?;
+    outln!()?;
+    Ok(())
 }
 
-fn print_files(exp: &Experiment, dir: &Path) {
+fn print_files(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
     let cfg = &exp.config;
     let s = &cfg.session;
     let p = |name: &str| sh(&dir.join(name));
-    println!("Files in {}:", dir.display());
+    outln!("Files in {}:", dir.display())?;
     let n_cal = exp.desired.rows.len();
     for (names, what) in [
         (
@@ -460,7 +470,7 @@ fn print_files(exp: &Experiment, dir: &Path) {
             "the report, the histogram (Fig. 2)".to_owned(),
         ),
     ] {
-        println!("  {names:<28} {what}");
+        outln!("  {names:<28} {what}")?;
     }
     let mut gravity = Vec::new();
     if let Some(g) = &s.gravity {
@@ -478,7 +488,7 @@ fn print_files(exp: &Experiment, dir: &Path) {
     para(
         "Each step by hand, giving the same files again (in the source tree, `cargo run --release \
          --` stands for `robocal`):",
-    );
+    )?;
     let mut simulate = vec![
         "robocal simulate".to_owned(),
         robot.clone(),
@@ -490,7 +500,7 @@ fn print_files(exp: &Experiment, dir: &Path) {
     simulate.extend(gravity.iter().cloned());
     simulate.push(format!("--out {}", p(files::CELL)));
     simulate.push(format!("--validation-out {}", p(files::VALIDATION)));
-    command(&simulate);
+    command(&simulate)?;
     command(&[
         "robocal calibrate".to_owned(),
         robot.clone(),
@@ -501,7 +511,7 @@ fn print_files(exp: &Experiment, dir: &Path) {
         format!("--data {}", p(files::CELL)),
         format!("--validate {}", p(files::VALIDATION)),
         format!("--out {}", p(files::RESULT)),
-    ]);
+    ])?;
     command(&[
         "robocal compensate".to_owned(),
         robot.clone(),
@@ -509,7 +519,7 @@ fn print_files(exp: &Experiment, dir: &Path) {
         format!("--joints {}", p(files::DESIRED)),
         format!("--out {}", p(files::COMMANDED)),
         "--position-only".to_owned(),
-    ]);
+    ])?;
     let mut verify = vec![
         "robocal simulate".to_owned(),
         robot.clone(),
@@ -519,24 +529,25 @@ fn print_files(exp: &Experiment, dir: &Path) {
     ];
     verify.extend(gravity.iter().cloned());
     verify.push(format!("--out {}", p(files::VERIFY)));
-    command(&verify);
+    command(&verify)?;
     command(&[
         "robocal evaluate".to_owned(),
         robot,
         format!("--params {}", p(files::RESULT)),
         format!("--data {}", p(files::VERIFY)),
-    ]);
+    ])?;
     command(&[
         "robocal report".to_owned(),
         p(files::RESULT),
         format!("--verify {}", p(files::VERIFY)),
         "--paper".to_owned(),
         format!("--out {}", p("by-hand")),
-    ]);
+    ])?;
+    Ok(())
 }
 
 /// Prints a shell command made of `parts`, continued with `\` on new lines before 100 columns.
-fn command(parts: &[String]) {
+fn command(parts: &[String]) -> anyhow::Result<()> {
     let mut line = String::from("  ");
     let mut out = String::new();
     for (i, part) in parts.iter().enumerate() {
@@ -550,5 +561,6 @@ fn command(parts: &[String]) {
         line.push_str(part);
     }
     out.push_str(&line);
-    println!("{out}");
+    outln!("{out}")?;
+    Ok(())
 }

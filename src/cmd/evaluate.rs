@@ -18,7 +18,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
 pub struct EvaluateArgs {
-    /// The nominal robot: a preset name or a TOML robot file [default: the robot embedded in
+    /// The nominal robot: a preset name, a TOML robot file or a URDF [default: the robot embedded in
     /// the result; when given, it must agree with that one].
     #[arg(long)]
     robot: Option<String>,
@@ -115,7 +115,7 @@ impl TryFrom<&EvaluateArgs> for Settings {
         let outputs = plan.check()?;
         let (nominal, mut calibrated, result) = calibrated_model(a.robot.as_deref(), &a.params)?;
         common::apply_payload(&mut calibrated, a.payload_kg)?;
-        common::warn_not_calibrated(&result, &a.params);
+        common::warn_not_calibrated(&result, &a.params)?;
         let against = match a.against {
             AgainstArg::Auto => Against::Auto,
             AgainstArg::Model => Against::Model,
@@ -192,7 +192,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         not_converged.note(&r);
     }
     for w in reader.finish().with_context(context)? {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}")?;
     }
     let n_outside = outside.count();
     // Refused before anything is written (the per-point writer is dropped).
@@ -210,7 +210,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     if let Some(w) = per_point {
         w.commit()?;
     }
-    not_converged.report();
+    not_converged.report()?;
     let n = norms[0].len();
     let series: Vec<Series> = names
         .iter()
@@ -267,7 +267,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         if let Some(p) = &per_point_path {
             o.insert("per_point".into(), p.display().to_string().into());
         }
-        println!("{}", serde_json::to_string_pretty(&o)?);
+        outln!("{}", serde_json::to_string_pretty(&o)?)?;
     } else {
         print_table(
             (&data, &params, per_point_path.as_deref()),
@@ -276,7 +276,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             &series,
             &res,
             refit_frame.then_some(&frame),
-        );
+        )?;
     }
     Ok(())
 }
@@ -319,20 +319,21 @@ impl Statuses {
     }
 
     /// Tells the user about them.
-    fn report(&self) {
+    fn report(&self) -> anyhow::Result<()> {
         if self.count == 0 {
-            return;
+            return Ok(());
         }
         let more = if self.count > self.listed.len() {
             format!(", ... ({} more)", self.count - self.listed.len())
         } else {
             String::new()
         };
-        eprintln!(
+        errln!(
             "note: {} row(s) were not converged in compensation; their errors are included: {}{more}",
             self.count,
             self.listed.join(", ")
-        );
+        )?;
+        Ok(())
     }
 }
 
@@ -364,7 +365,7 @@ fn print_table(
     series: &[Series],
     res: &CalibrationResult,
     refit: Option<&robocal_core::frame::TrackerFrame>,
-) {
+) -> anyhow::Result<()> {
     let what = match reference {
         Reference::Model => "validation: measured points against the models at the measured joints",
         Reference::Desired => {
@@ -382,44 +383,44 @@ fn print_table(
         }
         None => format!("tracker frame of {}", params.display()),
     };
-    println!("{}: {} points; {what}; {frame}", data.display(), n);
+    outln!("{}: {} points; {what}; {frame}", data.display(), n)?;
     match reference {
         Reference::Model => {
             for s in series {
-                println!("  {:<11} {}", s.name, s.description);
+                outln!("  {:<11} {}", s.name, s.description)?;
             }
-            println!();
-            println!("{:<14} {:>12} {:>12}", "", series[0].name, series[1].name);
+            outln!()?;
+            outln!("{:<14} {:>12} {:>12}", "", series[0].name, series[1].name)?;
             for (label, f) in STAT_ROWS {
-                println!(
+                outln!(
                     "{label:<14}{}{}",
                     cell(f(&series[0].stats)),
                     cell(f(&series[1].stats))
-                );
+                )?;
             }
             let (b, c) = (series[0].stats.mean_mm, series[1].stats.mean_mm);
             if b > 0.0 {
-                println!(
+                outln!(
                     "mean error {} by {:.1}% with the calibrated model",
                     if c <= b { "reduced" } else { "increased" },
                     100.0 * (b - c).abs() / b
-                );
+                )?;
             }
         }
         Reference::Desired => {
             // Verification beside what the calibration predicted (the result's Table IV).
             let cal = res.errors.calibration.after;
             let val = res.errors.validation.map(|v| v.after);
-            println!(
+            outln!(
                 "  predicted: the calibrated model's errors in {} (Table IV)",
                 params.display()
-            );
-            println!();
-            print!("{:<14} {:>12} {:>12}", "", "verification", "pred. cal.");
+            )?;
+            outln!()?;
+            out!("{:<14} {:>12} {:>12}", "", "verification", "pred. cal.")?;
             if val.is_some() {
-                print!(" {:>12}", "pred. val.");
+                out!(" {:>12}", "pred. val.")?;
             }
-            println!();
+            outln!()?;
             for (label, f) in STAT_ROWS {
                 // A result file without p95 reads it as 0: show it as unknown.
                 let pred = |s: &ErrorStats| {
@@ -429,15 +430,15 @@ fn print_table(
                         f(s)
                     }
                 };
-                print!(
+                out!(
                     "{label:<14}{}{}",
                     cell(f(&series[0].stats)),
                     cell(pred(&cal))
-                );
+                )?;
                 if let Some(v) = &val {
-                    print!("{}", cell(pred(v)));
+                    out!("{}", cell(pred(v)))?;
                 }
-                println!();
+                outln!()?;
             }
             // One prediction everywhere: the expected mean error at new poses spread like the
             // calibration poses (calibrate's `prediction`); Table IV's calibration points only
@@ -455,14 +456,15 @@ fn print_table(
                 ),
             };
             if p > 0.0 {
-                println!(
+                outln!(
                     "verification mean {m:.4} mm vs {p:.4} mm {basis} ({:+.0}%)",
                     100.0 * (m - p) / p
-                );
+                )?;
             }
         }
     }
     if let Some(p) = per_point_path {
-        println!("wrote {} ({n} rows)", io_plan::shown(p));
+        outln!("wrote {} ({n} rows)", io_plan::shown(p))?;
     }
+    Ok(())
 }

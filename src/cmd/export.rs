@@ -145,16 +145,16 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
     let robot = export::geometric_nominal(&s.calibrated)?;
     let text = export::export(&robot, s.format, &s.notes)?;
     if s.notes.iter().any(|n| n.starts_with("Left out")) {
-        eprintln!(
+        errln!(
             "warning: exported the geometry only: {}",
             s.notes.last().map_or("", String::as_str)
-        );
+        )?;
     }
     let mut f = robocal_core::io::AtomicFile::create(&s.out)?;
     f.write_all(text.as_bytes())
         .map_err(|e| anyhow::anyhow!("{}: {e}", s.out.display()))?;
     f.commit()?;
-    eprintln!(
+    outln!(
         "wrote {} ({}, {} joints)",
         s.out.display(),
         match s.format {
@@ -162,6 +162,6 @@ pub fn run(a: ExportArgs) -> anyhow::Result<()> {
             ExportFormat::Toml => "robocal robot file",
         },
         robot.dof()
-    );
+    )?;
     Ok(())
 }

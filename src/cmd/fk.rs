@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 #[derive(Args, Debug)]
 pub struct FkArgs {
-    /// A preset name or a TOML robot file [with --params, default: the robot embedded in the
+    /// A preset name, a TOML robot file or a URDF [with --params, default: the robot embedded in the
     /// result; when given, it must agree with that one].
     #[arg(long)]
     robot: Option<String>,
@@ -35,7 +35,7 @@ impl TryFrom<&FkArgs> for Settings {
     fn try_from(a: &FkArgs) -> anyhow::Result<Settings> {
         let model = common::model(a.robot.as_deref(), a.params.as_deref())?;
         if let (Some((_, res)), Some(p)) = (&model.calibrated, &a.params) {
-            common::warn_not_calibrated(res, p);
+            common::warn_not_calibrated(res, p)?;
         }
         let q = common::joints_arg(&a.joints, model.active())?;
         Ok(Settings {
@@ -52,26 +52,30 @@ pub fn run(a: FkArgs) -> anyhow::Result<()> {
     let pose = r.tool_pose(&q);
     let p = pose.translation.vector;
     if json {
-        println!("{}", serde_json::json!({ "x": p.x, "y": p.y, "z": p.z }));
+        outln!("{}", serde_json::json!({ "x": p.x, "y": p.y, "z": p.z }))?;
     } else {
         let v = robocal_core::frame::vec_rad_to_deg(&robocal_core::frame_vector(&pose));
-        println!(
+        outln!(
             "tool position (mm, base frame): x = {:.4}  y = {:.4}  z = {:.4}",
-            p.x, p.y, p.z
-        );
-        println!(
+            p.x,
+            p.y,
+            p.z
+        )?;
+        outln!(
             "tool orientation (deg, A B C):     A = {:.4}  B = {:.4}  C = {:.4}",
-            v[3], v[4], v[5]
-        );
+            v[3],
+            v[4],
+            v[5]
+        )?;
         let out = r.joints_outside_limits(&q);
         if !out.is_empty() {
-            eprintln!(
+            errln!(
                 "warning: joint(s) {} outside the robot's limits",
                 out.iter()
                     .map(|i| format!("q{}", i + 1))
                     .collect::<Vec<_>>()
                     .join(", ")
-            );
+            )?;
         }
     }
     Ok(())

@@ -257,6 +257,9 @@ impl IoPlan {
             }
             written.push((o, id));
         }
+        // Claimed before any work: a second run writing the same outputs is refused now.
+        let files: Vec<&Path> = written.iter().map(|(o, _)| o.file()).collect();
+        robocal_core::io::claim_outputs(&files)?;
         let stdout = if stdout {
             Some(claim_stdout().map_err(|e| {
                 anyhow::Error::from(robocal_core::Error::Io {

@@ -53,8 +53,9 @@ enum Command {
     /// The paper's whole experiment in simulation: its tables beside the paper's, a report, and
     /// the files of every step.
     Demo(demo::DemoArgs),
-    /// Choose the poses worth measuring: D-optimal selection from random candidates within the
-    /// joint limits (and the tracker's range), compared with random poses.
+    /// Choose the poses worth measuring: an optimal selection (I-optimal by default, or
+    /// D-optimal) from random candidates within the joint limits (and the tracker's range),
+    /// compared with random poses.
     Plan(plan::PlanArgs),
     /// The HTML report of a calibration result (tables, histogram, per-point errors, parameters).
     Report(report::ReportArgs),

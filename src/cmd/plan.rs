@@ -19,7 +19,7 @@ const MAX_CANDIDATES: usize = 200_000;
 
 #[derive(Args, Debug)]
 pub struct PlanArgs {
-    /// The nominal robot: a preset name or a TOML robot file.
+    /// The nominal robot: a preset name, a TOML robot file or a URDF.
     #[arg(long)]
     robot: String,
     /// Number of poses to choose (besides those of --include).
@@ -197,12 +197,12 @@ pub fn run(a: PlanArgs) -> anyhow::Result<()> {
     if let Some(path) = &s.include {
         let set = read_measurements(path, s.robot.joint_space(), Positions::Optional)?;
         for w in &set.warnings {
-            eprintln!("warning: {w}");
+            errln!("warning: {w}")?;
         }
         s.plan.include = set.rows.into_iter().map(|r| r.q).collect();
     }
     let p = plan(&s.robot, &s.plan)?;
-    print_plan(&s, &p);
+    print_plan(&s, &p)?;
     let set = MeasurementSet {
         path: s.out.clone(),
         joints: s.robot.joint_space().clone(),
@@ -221,13 +221,13 @@ pub fn run(a: PlanArgs) -> anyhow::Result<()> {
             .collect(),
     };
     write_measurements(&s.out, &set)?;
-    println!("{} poses written to {}", p.poses.len(), s.out.display());
+    outln!("{} poses written to {}", p.poses.len(), s.out.display())?;
     Ok(())
 }
 
-fn print_plan(s: &Settings, p: &Plan) {
+fn print_plan(s: &Settings, p: &Plan) -> anyhow::Result<()> {
     let n = s.plan.poses + s.plan.include.len();
-    println!(
+    outln!(
         "robot {} ({} joints): {} poses chosen from {} candidates (seed {}){}; {} identifiable \
          parameters",
         s.robot.name(),
@@ -241,8 +241,8 @@ fn print_plan(s: &Settings, p: &Plan) {
             format!(", {} included", s.plan.include.len())
         },
         p.identified.len()
-    );
-    println!(
+    )?;
+    outln!(
         "{} design: greedy, then {} exchange pass(es) replacing {} pose(s){}",
         match s.plan.criterion {
             Criterion::IOptimal => "I-optimal (workspace error)",
@@ -255,30 +255,33 @@ fn print_plan(s: &Settings, p: &Plan) {
         } else {
             ""
         }
-    );
+    )?;
     if s.plan.tracker_origin.is_some() {
         // The design is optimal for the fit that weighs each point as this tracker model does.
-        println!(
+        outln!(
             "the figures assume a fit that weighs each point by this tracker model: calibrate \
              does so by default for measurements in the tracker's own frame with the typical \
              model (0.010 mm + 0.005 mm/m); for another give `--tracker-sigma {},{}`",
-            s.plan.noise_mm, s.plan.noise_per_m
-        );
+            s.plan.noise_mm,
+            s.plan.noise_per_m
+        )?;
     }
-    println!();
-    println!("{:<44}{:>14}{:>14}", "", "planned", "random");
-    println!(
+    outln!()?;
+    outln!("{:<44}{:>14}{:>14}", "", "planned", "random")?;
+    outln!(
         "{:<44}{:>14.4}{:>14.4}",
-        "observability index O1 (scaled Jacobian)", p.planned.observability, p.random.observability
-    );
-    println!(
+        "observability index O1 (scaled Jacobian)",
+        p.planned.observability,
+        p.random.observability
+    )?;
+    outln!(
         "{:<44}{:>14.4}{:>14.4}",
         "predicted workspace model error, RMS (mm)",
         p.planned.workspace_rms_mm,
         p.random.workspace_rms_mm
-    );
-    println!();
-    println!(
+    )?;
+    outln!()?;
+    outln!(
         "Predicted standard deviations at {} mm noise per axis{}, {n} poses each",
         s.plan.noise_mm,
         if s.plan.tracker_origin.is_some() {
@@ -286,20 +289,24 @@ fn print_plan(s: &Settings, p: &Plan) {
         } else {
             String::new()
         }
-    );
-    println!(
+    )?;
+    outln!(
         "{:<12}{:>14}{:>14}{:>8}",
-        "parameter", "planned", "random", "unit"
-    );
+        "parameter",
+        "planned",
+        "random",
+        "unit"
+    )?;
     for (i, param) in p.identified.iter().enumerate() {
         let u = param.unit();
-        println!(
+        outln!(
             "{:<12}{:>14.5}{:>14.5}{:>8}",
             param.name(),
             u.from_internal(p.planned.std[i]),
             u.from_internal(p.random.std[i]),
             u.as_str()
-        );
+        )?;
     }
-    println!();
+    outln!()?;
+    Ok(())
 }

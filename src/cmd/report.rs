@@ -66,20 +66,22 @@ fn file_arg(
     result: &CalibrationResult,
     key: fn(&RecordedSettings) -> &Option<String>,
     flag: &str,
-) -> Option<PathBuf> {
+) -> anyhow::Result<Option<PathBuf>> {
     if let Some(p) = given {
-        return Some(p.clone());
+        return Ok(Some(p.clone()));
     }
-    let p = PathBuf::from(recorded(result, key)?);
+    let Some(p) = recorded(result, key).map(PathBuf::from) else {
+        return Ok(None);
+    };
     if p.is_file() {
-        Some(p)
+        Ok(Some(p))
     } else {
-        eprintln!(
+        errln!(
             "note: the result names {} as its {flag} file, which is not here; give {flag} FILE \
              to show its points",
             p.display()
-        );
-        None
+        )?;
+        Ok(None)
     }
 }
 
@@ -94,7 +96,7 @@ fn read(
     let set = read_measurements(p, joints, Positions::Required)
         .with_context(|| format!("{flag} {}", p.display()))?;
     for w in &set.warnings {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}")?;
     }
     Ok(Some(set))
 }
@@ -162,7 +164,7 @@ impl TryFrom<&ReportArgs> for Settings {
                 (Some(r), _) => format!("--robot {r}"),
                 (None, None) => format!("the robot embedded in {}", a.result.display()),
             })?;
-        super::common::warn_not_calibrated(&result, &a.result);
+        super::common::warn_not_calibrated(&result, &a.result)?;
         if a.paper {
             let paper_robot = common::robot(PAPER_ROBOT)?;
             if let Some(diff) =
@@ -177,8 +179,8 @@ impl TryFrom<&ReportArgs> for Settings {
                 )));
             }
         }
-        let data_path = file_arg(&a.data, &result, |s| &s.data, "--data");
-        let val_path = file_arg(&a.validate, &result, |s| &s.validate, "--validate");
+        let data_path = file_arg(&a.data, &result, |s| &s.data, "--data")?;
+        let val_path = file_arg(&a.validate, &result, |s| &s.validate, "--validate")?;
         Ok(Settings {
             result_path: a.result.clone(),
             result,
@@ -261,16 +263,16 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
             .push(robocal_report::Setting::new("Verification data", name(v)));
     }
     let files = write_report(&out, &report)?;
-    print_summary(&report);
-    println!(
+    print_summary(&report)?;
+    outln!(
         "report: {} (histogram: {})",
         files.html.display(),
         files.histogram_svg.display()
-    );
+    )?;
     Ok(())
 }
 
-fn print_summary(report: &ReportData) {
+fn print_summary(report: &ReportData) -> anyhow::Result<()> {
     for t in &report.error_tables {
         let rows: Vec<String> = t
             .rows
@@ -284,7 +286,7 @@ fn print_summary(report: &ReportData) {
                 )
             })
             .collect();
-        println!("{}: {}", t.title, rows.join(", "));
+        outln!("{}: {}", t.title, rows.join(", "))?;
     }
     let shown: usize = report
         .point_sets
@@ -292,6 +294,7 @@ fn print_summary(report: &ReportData) {
         .map(|s| s.points.iter().filter(|p| p.reach_mm.is_finite()).count())
         .sum();
     if shown == 0 {
-        println!("no measurement file: the report has no error-against-reach plot");
+        outln!("no measurement file: the report has no error-against-reach plot")?;
     }
+    Ok(())
 }

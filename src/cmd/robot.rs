@@ -14,7 +14,7 @@ pub enum RobotCmd {
 
 #[derive(Args, Debug)]
 pub struct ShowArgs {
-    /// A preset name (see `robocal robot list`) or a TOML robot file.
+    /// A preset name (see `robocal robot list`), a TOML robot file or a URDF.
     robot: String,
     /// Show the calibrated parameters of a result file instead of the nominal ones.
     #[arg(long)]
@@ -32,7 +32,7 @@ impl TryFrom<&ShowArgs> for ShowSettings {
     fn try_from(a: &ShowArgs) -> anyhow::Result<ShowSettings> {
         let model = common::model(Some(&a.robot), a.params.as_deref())?;
         if let (Some((_, res)), Some(p)) = (&model.calibrated, &a.params) {
-            common::warn_not_calibrated(res, p);
+            common::warn_not_calibrated(res, p)?;
         }
         Ok(ShowSettings { model })
     }
@@ -42,7 +42,7 @@ pub fn run(c: RobotCmd) -> anyhow::Result<()> {
     match c {
         RobotCmd::List => {
             for p in robocal_core::PRESETS {
-                println!("{p}");
+                outln!("{p}")?;
             }
             Ok(())
         }
@@ -60,7 +60,7 @@ pub fn run(c: RobotCmd) -> anyhow::Result<()> {
                 Some(_) => "calibrated parameters",
                 None => "parameters",
             };
-            println!(
+            outln!(
                 "{} ({} joints, {}), {label}:",
                 r.name(),
                 r.dof(),
@@ -68,33 +68,33 @@ pub fn run(c: RobotCmd) -> anyhow::Result<()> {
                     robocal_core::Convention::Mdh => "modified DH (Craig)",
                     robocal_core::Convention::Dh => "standard DH",
                 }
-            );
-            print!("{}", crate::tables::parameter_table(r, 4));
+            )?;
+            out!("{}", crate::tables::parameter_table(r, 4))?;
             let t0 = robocal_core::frame::vec_rad_to_deg(r.tool0());
-            println!(
+            outln!(
                 "T0 (nominal tool, mm/deg): [{}]",
                 t0.iter()
                     .map(|v| format!("{v}"))
                     .collect::<Vec<_>>()
                     .join(", ")
-            );
-            println!("Joint limits (model joint values):");
+            )?;
+            outln!("Joint limits (model joint values):")?;
             for (i, l) in r.limits().iter().enumerate() {
                 let u = r.joint_unit(i);
                 let r6 = |v: f64| (u.from_internal(v) * 1e6).round() / 1e6;
-                println!(
+                outln!(
                     "  q{}: {} .. {} {} ({})",
                     i + 1,
                     r6(l.min),
                     r6(l.max),
                     u.as_str(),
                     r.joint_type(i).as_str()
-                );
+                )?;
             }
             if let Some(c) = r.controller() {
-                println!("Controller axes (axis1..axis{}):", r.dof());
+                outln!("Controller axes (axis1..axis{}):", r.dof())?;
                 for line in crate::tables::controller_map(c, r) {
-                    println!("  {line}");
+                    outln!("  {line}")?;
                 }
             }
             Ok(())

@@ -20,7 +20,7 @@ const BAR_FROM: usize = 10_000;
 
 #[derive(Args, Debug)]
 pub struct SimulateArgs {
-    /// The nominal robot, the model the controller believes: a preset or a TOML robot file.
+    /// The nominal robot, the model the controller believes: a preset, a TOML robot file or a URDF.
     #[arg(long)]
     robot: String,
     /// The robot that really moves: a preset (e.g. kuka-kr480-r3330-table3), a TOML robot file,
@@ -419,7 +419,7 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     write_all_atomic(&refs)?;
 
     for w in &sim.warnings {
-        eprintln!("warning: {w}");
+        errln!("warning: {w}")?;
     }
     // "wrote cell.csv (3 plane, 75 calibration rows), ..."
     let mut per_file: Vec<(String, Vec<String>)> = Vec::new();
@@ -435,7 +435,7 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         .map(|(f, v)| format!("{f} ({} rows)", v.join(", ")))
         .collect::<Vec<_>>()
         .join(", ");
-    println!("wrote {listing} and {}", truth_out.display());
+    outln!("wrote {listing} and {}", truth_out.display())?;
     let origin = match &truth_file.geometric_errors {
         Some(e) => format!(
             " (random errors: {} mm, {} deg, seed {})",
@@ -444,22 +444,30 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         None => String::new(),
     };
     let t = &cfg.tracker_frame;
-    println!("truth robot: {}{origin}", truth_file.robot.name);
-    println!(
+    outln!("truth robot: {}{origin}", truth_file.robot.name)?;
+    outln!(
         "tracker at x={} y={} z={} mm, A={} B={} C={} deg; noise {} mm + {} mm/m per axis",
-        t.x, t.y, t.z, t.a, t.b, t.c, cfg.noise_mm, cfg.noise_per_m
-    );
+        t.x,
+        t.y,
+        t.z,
+        t.a,
+        t.b,
+        t.c,
+        cfg.noise_mm,
+        cfg.noise_per_m
+    )?;
     if let Some(g) = &truth_file.gravity_effect {
-        println!(
+        outln!(
             "gravity deflection moved the tool by {:.3} mm on average (max {:.3} mm)",
-            g.mean_mm, g.max_mm
-        );
+            g.mean_mm,
+            g.max_mm
+        )?;
     }
     if !truth_file.outliers.is_empty() {
-        println!(
+        outln!(
             "{} outliers injected (lines listed in the truth file)",
             truth_file.outliers.len()
-        );
+        )?;
     }
     Ok(())
 }

@@ -10,7 +10,8 @@ use crate::util::fixtures::{cell, many_poses};
 use crate::util::*;
 use std::path::Path;
 
-/// Names of the temporary files (`.NAME.PID.tmp`) in `dir`.
+/// Names of the files in `dir` named like temporary files (`.robocal-PID-RANDOM.tmp`, or any
+/// hidden `.tmp`).
 fn temporaries(dir: &Path) -> Vec<String> {
     snapshot(dir)
         .into_keys()
@@ -715,17 +716,14 @@ fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    let tmp = out.with_file_name(format!(
-        ".{}.{}.tmp",
-        out.file_name().unwrap().to_str().unwrap(),
-        child.id()
-    ));
+    let dir = out.parent().unwrap();
+    let prefix = format!(".robocal-{}-", child.id());
     let start = std::time::Instant::now();
-    while !tmp.exists() {
+    while !temporaries(dir).iter().any(|n| n.starts_with(&prefix)) {
         assert!(
             start.elapsed() < std::time::Duration::from_secs(60),
-            "no temporary file {}",
-            tmp.display()
+            "no temporary file {prefix}*.tmp in {}",
+            dir.display()
         );
         std::thread::sleep(std::time::Duration::from_millis(2));
     }
@@ -765,15 +763,20 @@ fn temporaries_of_killed_runs_are_removed_at_the_next_write() {
     let d = dir.path();
     let out = d.join("out.csv");
     std::fs::write(&out, "old output\n").unwrap();
-    // SIGKILL cannot be caught: its temporary stays until the next write of the same output.
+    // SIGKILL cannot be caught: its temporary stays until the next run that writes a file.
     let args = long_compensation(d, &out);
     let (_, signal, _) = interrupt(&args, &out, libc::SIGKILL);
     assert_eq!(signal, Some(libc::SIGKILL));
     assert_eq!(temporaries(d).len(), 1);
     assert_eq!(std::fs::read_to_string(&out).unwrap(), "old output\n");
-    // A made-up one of a process that cannot exist, beside each output of simulate.
-    for name in [".out.csv.999999999.tmp", ".out.truth.json.999999999.tmp"] {
-        std::fs::write(d.join(name), "left behind").unwrap();
+    // Files named like temporaries of a process that cannot exist, which robocal did not make
+    // (no record of them): a user's, never removed.
+    let users = [
+        ".out.csv.999999999.tmp",
+        ".robocal-999999999-0000000000000001.tmp",
+    ];
+    for name in users {
+        std::fs::write(d.join(name), "the user's").unwrap();
     }
     let o = robocal(&[
         "simulate",
@@ -787,20 +790,9 @@ fn temporaries_of_killed_runs_are_removed_at_the_next_write() {
         p(&out),
     ]);
     o.assert_ok();
-    assert_eq!(temporaries(d), Vec::<String>::new());
-    // Another output's temporaries are not touched.
-    std::fs::write(d.join(".other.csv.999999999.tmp"), "x").unwrap();
-    let o = robocal(&[
-        "compensate",
-        "--robot",
-        KUKA,
-        "--params",
-        p(&d.join("res.json")),
-        "--joints",
-        p(&d.join("j.csv")),
-        "--out",
-        p(&out),
-    ]);
-    o.assert_ok();
-    assert_eq!(temporaries(d), [".other.csv.999999999.tmp"]);
+    // The killed run's temporary is gone (its record proved it robocal's); the user's files stay.
+    assert_eq!(temporaries(d), users);
+    for name in users {
+        assert_eq!(std::fs::read_to_string(d.join(name)).unwrap(), "the user's");
+    }
 }

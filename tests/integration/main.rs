@@ -38,6 +38,7 @@ mod cli_settings;
 mod cli_shell;
 mod cli_simulate;
 mod cli_stations;
+mod cli_streams;
 #[cfg(unix)]
 mod cli_trust_files;
 mod cli_trust_fits;

@@ -115,7 +115,7 @@ pub(super) fn run(
         files.push(write(outputs, p, changes_csv(&res).as_bytes())?);
     }
     commit_all(files)?;
-    print_listing(r, &res, &settings);
+    print_listing(r, &res, &settings)?;
     Ok(())
 }
 
@@ -228,7 +228,11 @@ pub(super) fn changes_csv(res: &CompensatedProgram) -> String {
     s
 }
 
-fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettings) {
+fn print_listing(
+    r: &ProgramRun<'_>,
+    res: &CompensatedProgram,
+    s: &ProgramSettings,
+) -> anyhow::Result<()> {
     let n = res.changes.len();
     let applied = res.changes.iter().filter(|c| c.applied).count();
     let poses = res
@@ -236,7 +240,7 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
         .iter()
         .filter(|c| c.kind == TargetKind::Pose)
         .count();
-    println!(
+    outln!(
         "{}: {n} target(s) ({} joint, {poses} Cartesian), {}; solved on the calibrated model of {}",
         r.program.display(),
         n - poses,
@@ -246,12 +250,16 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
             "position only"
         },
         r.params.display()
-    );
+    )?;
     if n > 0 {
-        println!(
+        outln!(
             "  {:<16} {:>6}  {:<6}  {:>11}  {:>11}  status",
-            "target", "line", "kind", "corr. mm", "corr. deg"
-        );
+            "target",
+            "line",
+            "kind",
+            "corr. mm",
+            "corr. deg"
+        )?;
     }
     for c in res.changes.iter().take(LISTED) {
         let (cm, cd) = if c.applied {
@@ -262,17 +270,17 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
         } else {
             ("-".to_owned(), "-".to_owned())
         };
-        println!(
+        outln!(
             "  {:<16} {:>6}  {:<6}  {cm:>11}  {cd:>11}  {}{}",
             c.name,
             c.line,
             kind(c.kind),
             c.status,
             if c.applied { "" } else { " (left unchanged)" }
-        );
+        )?;
     }
     if n > LISTED {
-        println!("  ... and {} more (see --changes)", n - LISTED);
+        outln!("  ... and {} more (see --changes)", n - LISTED)?;
     }
     let max = |f: fn(&Change) -> f64| {
         res.changes
@@ -281,13 +289,13 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
             .map(f)
             .fold(0.0, f64::max)
     };
-    println!(
+    outln!(
         "  motions: {} in the program, {} compensated, {} left unchanged",
         res.motions.len(),
         res.motions.len() - res.unchanged_motions().count(),
         res.unchanged_motions().count()
-    );
-    println!(
+    )?;
+    outln!(
         "  {applied} compensated, {} left unchanged; largest correction {:.4} mm, {:.4} deg; \
          checked by forward kinematics on the calibrated model after rounding: within {:.4} mm, \
          {:.4} deg (limit {} mm, {} deg)",
@@ -298,26 +306,27 @@ fn print_listing(r: &ProgramRun<'_>, res: &CompensatedProgram, s: &ProgramSettin
         max(|c| c.verified_deg),
         s.verify_mm,
         s.verify_deg
-    );
+    )?;
     for c in res.changes.iter().filter(|c| !c.applied) {
-        eprintln!(
+        errln!(
             "warning: {}: {}; left unchanged (--keep-going)",
             r.program.display(),
             describe(c)
-        );
+        )?;
     }
     for m in res.unchanged_motions() {
-        println!("  unchanged: {}", describe_motion(m));
-        eprintln!(
+        outln!("  unchanged: {}", describe_motion(m))?;
+        errln!(
             "warning: {}: {}; left unchanged (--keep-going)",
             r.program.display(),
             describe_motion(m)
-        );
+        )?;
     }
     let shown = super::super::io_plan::shown;
     let dat = (res.texts.len() > 1).then(|| dat_path(r.out));
     let mut wrote = vec![shown(r.out)];
     wrote.extend(dat.as_deref().map(shown));
     wrote.extend(r.changes.map(shown));
-    println!("wrote {}", wrote.join(" and "));
+    outln!("wrote {}", wrote.join(" and "))?;
+    Ok(())
 }

@@ -181,7 +181,7 @@ pub fn real_data() -> Option<PathBuf> {
         Some(d)
     } else {
         eprintln!(
-            "skipped: real data not found at {} (see DESIGN.md; the folder is optional)",
+            "skipped: real data not found at {} (optional; see README.md, section Real data)",
             d.display()
         );
         None

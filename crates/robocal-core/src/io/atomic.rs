@@ -1,16 +1,17 @@
 //! Writing files so that a failed or interrupted run never leaves a half-written file, never
 //! destroys an earlier result and never replaces anything but a regular file: the content goes to
-//! a temporary file `.NAME.PID.tmp` beside the target, which is renamed over it only once
-//! complete. A symbolic link to a regular file is written through (see [`resolve_output`]).
+//! a temporary file `.robocal-PID-RANDOM.tmp` beside the target, which is renamed over it only
+//! once complete. A symbolic link to a regular file is written through (see [`resolve_output`]).
 //!
 //! Temporary files are registered while open, so that a signal handler can remove them all
-//! ([`remove_temporaries`]); those a killed run left behind are removed at the next write of the
-//! same output.
+//! ([`remove_temporaries`]), and recorded in robocal's private directory; those a killed run left
+//! behind are removed by the next run that writes a file (only files a record proves are
+//! robocal's: never a user's file, whatever its name).
 
 use crate::error::{Error, Result};
 pub use crate::io::target::resolve_output;
 pub use crate::io::temporaries::remove_temporaries;
-use crate::io::temporaries::{registry, remove_stale, temporary_name};
+use crate::io::temporaries::{registry, remove_stale, temporary_name, Record};
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
@@ -57,34 +58,36 @@ pub struct AtomicFile {
 impl AtomicFile {
     /// Starts writing `target`. Fails (naming the path) if its directory does not exist or is not
     /// writable, if `target` is (or links to) a directory, device, FIFO or socket, or if the run
-    /// is being interrupted. Temporaries of `target` left by runs that no longer exist are
-    /// removed. An existing target's permissions are kept.
+    /// is being interrupted. Temporaries left by runs that no longer exist are removed. An existing target's permissions are kept.
     pub fn create(target: &Path) -> Result<AtomicFile> {
         let path = resolve_output(target)?;
-        let name = path
-            .file_name()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "out".into());
         let dir = match path.parent() {
             Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
             _ => PathBuf::from("."),
         };
-        let tmp = dir.join(temporary_name(&name));
-        let file = {
+        let (tmp, file) = {
             // Created and registered under the lock: a signal handler removing the temporaries
             // sees it, or this sees that the run is being interrupted.
             let mut reg = registry();
             if reg.closed() {
                 return Err(interrupted(target));
             }
-            remove_stale(&reg, &dir, &name);
-            let file = File::options()
-                .write(true)
-                .create_new(true)
-                .open(&tmp)
-                .map_err(|e| io_err(target, e))?;
-            reg.add(tmp.clone());
-            file
+            remove_stale(&reg);
+            let mut attempt = 0;
+            let (tmp, file) = loop {
+                let tmp = dir.join(temporary_name());
+                match File::options().write(true).create_new(true).open(&tmp) {
+                    Ok(file) => break (tmp, file),
+                    // A file of that name exists (never opened, never replaced): draw another.
+                    Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && attempt < 8 => {
+                        attempt += 1;
+                    }
+                    Err(e) => return Err(io_err(target, e)),
+                }
+            };
+            let record = Record::write(&tmp, &file);
+            reg.add(tmp.clone(), record);
+            (tmp, file)
         };
         if let Ok(m) = std::fs::metadata(&path) {
             let _ = file.set_permissions(m.permissions());
@@ -119,7 +122,8 @@ impl AtomicFile {
         let tmp = if std::fs::remove_file(&tmp).is_ok() {
             None
         } else {
-            reg.add(tmp.clone());
+            let record = Record::write(&tmp, &file);
+            reg.add(tmp.clone(), record);
             Some(tmp)
         };
         Ok(AtomicFile {
@@ -173,11 +177,21 @@ impl AtomicFile {
     }
 }
 
-/// Commits several files so that they are replaced together: all are completed and synced
-/// first, then renamed one after the other with no interruption between them (a signal handler
+/// Commits several files so that they are replaced together: all are claimed for this process
+/// ([`crate::io::claim_outputs`]: refused while another run is writing one of them), completed
+/// and synced first, then renamed one after the other with no interruption between them (a signal handler
 /// calling [`remove_temporaries`] waits for the renames). Streams are copied last. On a failure
 /// before the renames nothing is replaced and every temporary file is removed.
 pub fn commit_all(mut files: Vec<AtomicFile>) -> Result<()> {
+    // Another process writing one of these outputs now would interleave its set with this one.
+    let targets: Vec<&Path> = files
+        .iter()
+        .filter_map(|f| match &f.dest {
+            Dest::Rename { path, .. } => Some(path.as_path()),
+            Dest::Stream { .. } => None,
+        })
+        .collect();
+    crate::io::claims::claim_outputs(&targets)?;
     let mut spooled = Vec::new();
     for f in &mut files {
         spooled.push(f.finish()?);
@@ -313,25 +327,65 @@ mod tests {
         v
     }
 
+    /// Only a file that a record of a dead run names, with the recorded device and inode, is
+    /// removed as stale; files named like temporaries without such a record are the user's.
+    #[cfg(unix)]
     #[test]
-    fn stale_temporaries_of_dead_runs_are_removed_at_the_next_write() {
+    fn only_recorded_temporaries_of_dead_runs_are_removed() {
+        use std::os::unix::fs::MetadataExt;
         let d = scratch("stale");
-        let stale = d.join(".r.json.999999999.tmp");
+        let records = crate::io::claims::private_dir()
+            .unwrap()
+            .join("temporaries");
+        std::fs::create_dir_all(&records).unwrap();
+        let record = |name: &str, file: &Path, ino_offset: u64| {
+            let m = std::fs::metadata(file).unwrap();
+            let text = format!(
+                "{} {}\n{}",
+                m.dev(),
+                m.ino() + ino_offset,
+                std::path::absolute(file).unwrap().display()
+            );
+            std::fs::write(records.join(name), text).unwrap();
+        };
+        // A dead run's temporary (pid 999999999 cannot exist), recorded.
+        let stale = d.join(".robocal-999999999-00000000000000aa.tmp");
         std::fs::write(&stale, "left by a killed run").unwrap();
-        // A live process's temporary (pid 1 always exists), another output's, a directory.
-        std::fs::write(d.join(".r.json.1.tmp"), "live").unwrap();
-        std::fs::write(d.join(".q.json.999999999.tmp"), "other output").unwrap();
-        std::fs::create_dir(d.join(".r.json.999999998.tmp")).unwrap();
+        record("999999999-00000000000000aa", &stale, 0);
+        // A user's file under such a name, no record; one whose record names another inode
+        // (the temporary was removed and the name reused); a live process's (pid 1).
+        std::fs::write(d.join(".robocal-999999999-00000000000000bb.tmp"), "user").unwrap();
+        let reused = d.join(".robocal-999999999-00000000000000cc.tmp");
+        std::fs::write(&reused, "user").unwrap();
+        record("999999999-00000000000000cc", &reused, 1);
+        let live = d.join(".robocal-1-00000000000000dd.tmp");
+        std::fs::write(&live, "live").unwrap();
+        record("1-00000000000000dd", &live, 0);
         write_atomic(&d.join("r.json"), b"new").unwrap();
         assert_eq!(
             names(&d),
             [
-                ".q.json.999999999.tmp",
-                ".r.json.1.tmp",
-                ".r.json.999999998.tmp",
+                ".robocal-1-00000000000000dd.tmp",
+                ".robocal-999999999-00000000000000bb.tmp",
+                ".robocal-999999999-00000000000000cc.tmp",
                 "r.json"
             ]
         );
+        // The dead runs' records are gone, the live one's stays.
+        assert!(!records.join("999999999-00000000000000aa").exists());
+        assert!(!records.join("999999999-00000000000000cc").exists());
+        assert!(records.join("1-00000000000000dd").exists());
+        std::fs::remove_file(records.join("1-00000000000000dd")).unwrap();
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn a_name_of_255_bytes_can_be_written() {
+        let d = scratch("long");
+        let p = d.join(format!("{}.csv", "n".repeat(251)));
+        write_atomic(&p, b"x").unwrap();
+        assert_eq!(std::fs::read(&p).unwrap(), b"x");
+        assert_eq!(names(&d).len(), 1);
         std::fs::remove_dir_all(&d).unwrap();
     }
 

@@ -13,6 +13,7 @@
 //! can never silently disagree.
 
 use crate::error::{Error, Result};
+pub(crate) use crate::io::csv_lines::LineCounted;
 use crate::model::{JointSpace, JointType};
 use std::io::Read;
 use std::path::Path;
@@ -46,15 +47,33 @@ pub(crate) struct ColumnLayout {
     pub extra: Vec<usize>,
     /// Their names.
     pub extra_columns: Vec<String>,
+    /// The delimiter the header was read with (`,`, `;` or tab).
+    pub delimiter: u8,
 }
 
-/// A CSV reader with robocal's settings: a header row, fields trimmed, equal row lengths.
-pub(crate) fn csv_reader<R: Read>(reader: R) -> csv::Reader<R> {
+/// A header name as robocal knows it: the names of its columns (`q1`, `axis1`, `x`, `set`, `id`,
+/// `a`...) in any case become lower case; any other name is kept as written.
+fn known_name(h: &str) -> String {
+    let lower = h.to_ascii_lowercase();
+    let known = joint_column_index(&lower).is_some()
+        || ["x", "y", "z", "a", "b", "c", "set", "id"].contains(&lower.as_str());
+    if known {
+        lower
+    } else {
+        h.to_owned()
+    }
+}
+
+/// A CSV reader with robocal's settings: a header row, fields trimmed, equal row lengths, the
+/// delimiter of the header line (`,`, `;` or tab), true line numbers ([`LineCounted`]).
+pub(crate) fn csv_reader<R: Read>(reader: R) -> csv::Reader<LineCounted<R>> {
+    let counted = LineCounted::new(reader);
     csv::ReaderBuilder::new()
         .has_headers(true)
         .trim(csv::Trim::All)
         .flexible(false)
-        .from_reader(reader)
+        .delimiter(counted.delimiter())
+        .from_reader(counted)
 }
 
 /// `q{k}` or `axis{k}`: whether it is an axis column, and k.
@@ -84,7 +103,7 @@ impl ColumnLayout {
     /// `read_xyz` false, `x,y,z` are extra columns. `expected` describes the columns the file
     /// needs, for the empty-file message.
     pub fn read<R: Read>(
-        rdr: &mut csv::Reader<R>,
+        rdr: &mut csv::Reader<LineCounted<R>>,
         path: &Path,
         dof: usize,
         read_xyz: bool,
@@ -93,10 +112,11 @@ impl ColumnLayout {
         let perr = |field: Option<&str>, msg: String| Error::parse(path, Some(1), field, msg);
         let headers: Vec<String> = rdr
             .headers()
-            .map_err(|e| csv_error(path, e))?
+            .map_err(|e| csv_error(path, e, None::<&LineCounted<R>>))?
             .iter()
-            .map(|h| h.trim_start_matches('\u{feff}').to_owned())
+            .map(|h| known_name(h.trim_start_matches('\u{feff}')))
             .collect();
+        let delimiter = rdr.get_ref().delimiter();
         if headers.iter().all(|h| h.is_empty()) {
             return Err(perr(
                 None,
@@ -110,6 +130,7 @@ impl ColumnLayout {
             extra: Vec::new(),
             extra_columns: Vec::new(),
             headers: Vec::new(),
+            delimiter,
         };
         for (k, h) in headers.iter().enumerate() {
             if h.is_empty() {
@@ -149,6 +170,18 @@ impl ColumnLayout {
         }
         layout.headers = headers;
         Ok(layout)
+    }
+
+    /// The header as read, for messages: "header is `a,b`, read as 2 columns separated by
+    /// commas".
+    pub fn header_seen(&self) -> String {
+        format!(
+            "header is `{}`, read as {} column{} separated by {}",
+            self.headers.join(","),
+            self.headers.len(),
+            if self.headers.len() == 1 { "" } else { "s" },
+            crate::io::csv_lines::delimiter_name(self.delimiter)
+        )
     }
 
     /// The number in column `k` of `record` (at `line`): rejects empty cells, text and
@@ -210,10 +243,10 @@ impl ColumnLayout {
                     Some(1),
                     Some(&name(j)),
                     format!(
-                        "missing column (the robot has {dof} joints: {}..{}; header is `{}`)",
+                        "missing column (the robot has {dof} joints: {}..{}; {})",
                         name(0),
                         name(dof - 1),
-                        self.headers.join(",")
+                        self.header_seen()
                     ),
                 )),
             }
@@ -303,26 +336,34 @@ impl ColumnLayout {
 
 /// Reads the next row that is not blank into `record`; its 1-based line, or `None` at the end.
 pub(crate) fn next_record<R: Read>(
-    rdr: &mut csv::Reader<R>,
+    rdr: &mut csv::Reader<LineCounted<R>>,
     record: &mut csv::StringRecord,
     path: &Path,
 ) -> Result<Option<usize>> {
     loop {
-        if !rdr.read_record(record).map_err(|e| csv_error(path, e))? {
+        let read = rdr.read_record(record);
+        if !read.map_err(|e| csv_error(path, e, Some(rdr.get_ref())))? {
             return Ok(None);
         }
         if !record.iter().all(|f| f.is_empty()) {
-            return Ok(Some(
-                record.position().map(|p| p.line() as usize).unwrap_or(0),
-            ));
+            let byte = record.position().map_or(0, csv::Position::byte);
+            return Ok(Some(rdr.get_ref().line_at(byte)));
         }
     }
 }
 
 /// A CSV reader's error as a robocal error: an I/O failure (e.g. the path is a directory) as
-/// [`Error::Io`], anything else as [`Error::Parse`] with the line.
-pub(crate) fn csv_error(path: &Path, e: csv::Error) -> Error {
-    let line = e.position().map(|p| p.line() as usize);
+/// [`Error::Io`], anything else as [`Error::Parse`] with the line (counted by `lines` where
+/// given: the header's errors are on line 1).
+pub(crate) fn csv_error<R: Read>(
+    path: &Path,
+    e: csv::Error,
+    lines: Option<&LineCounted<R>>,
+) -> Error {
+    let line = e.position().map(|p| match lines {
+        Some(l) => l.line_at(p.byte()),
+        None => p.line() as usize,
+    });
     let msg = match e.kind() {
         csv::ErrorKind::UnequalLengths {
             expected_len, len, ..

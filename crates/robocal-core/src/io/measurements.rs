@@ -117,7 +117,7 @@ pub fn parse_measurements<R: Read>(
 /// rejects a file without rows and returns the warnings. [`read_measurements`] is this reader
 /// collecting every row.
 pub struct MeasurementReader<R: Read> {
-    rdr: csv::Reader<R>,
+    rdr: csv::Reader<crate::io::columns::LineCounted<R>>,
     path: PathBuf,
     joints: JointSpace,
     layout: ColumnLayout,
@@ -157,8 +157,8 @@ impl<R: Read> MeasurementReader<R> {
                 Some(&joint_column(0)),
                 format!(
                     "missing column (the robot has {dof} joints: q1..q{dof}, or the controller's \
-                     axis1..axis{dof}; header is `{}`)",
-                    layout.headers.join(",")
+                     axis1..axis{dof}; {})",
+                    layout.header_seen()
                 ),
             ));
         };
@@ -171,7 +171,10 @@ impl<R: Read> MeasurementReader<R> {
                 return Err(perr(
                     Some(1),
                     Some(["x", "y", "z"][a]),
-                    "missing column (measured positions need x,y,z in mm)".into(),
+                    format!(
+                        "missing column (measured positions need x,y,z in mm; {})",
+                        layout.header_seen()
+                    ),
                 ));
             }
             _ => None,
@@ -355,6 +358,35 @@ mod tests {
         assert_eq!(s.rows[1].line, 3);
         assert!((s.rows[1].q[1] + 40f64.to_radians()).abs() < 1e-15);
         assert_eq!(s.rows[0].p, Some(Vector3::new(1.0, 2.0, 3.0)));
+    }
+
+    #[test]
+    fn dialects_are_read_and_lines_are_true() {
+        let lf = "q1,q2,x,y,z\n\n1,2,7,8,9\n1,5,7,8,9\n";
+        for text in [
+            lf.to_owned(),
+            lf.replace('\n', "\r\n"),
+            lf.replace('\n', "\r"),
+            lf.replace(',', ";"),
+            lf.replace(',', "\t"),
+            format!("\u{feff}{}", lf.replace("q", "Q").replace("x,y,z", "X,Y,Z")),
+        ] {
+            let s = parse(&text, Positions::Required).unwrap();
+            assert_eq!(s.rows.iter().map(|r| r.line).collect::<Vec<_>>(), [3, 4]);
+            assert_eq!(s.rows[1].q[1], 5f64.to_radians());
+        }
+        // Errors name the true line, whatever the line endings.
+        let bad = "q1,q2,x,y,z\r\n\r\n1,2,7,8,9\r\n1,oops,7,8,9\r\n";
+        assert!(err(bad, Positions::Required).contains(":4: field `q2`"));
+        assert!(err(&bad.replace("\r\n", "\r"), Positions::Required).contains(":4: field `q2`"));
+    }
+
+    #[test]
+    fn a_header_that_does_not_match_says_how_it_was_read() {
+        let e = err("q1|q2|x|y|z\n1|2|7|8|9\n", Positions::Required);
+        assert!(e.contains("read as 1 column separated by commas"), "{e}");
+        let e = err("q_1,q_2,x,y,z\n1,2,3,4,5\n", Positions::Required);
+        assert!(e.contains("read as 5 columns separated by commas"), "{e}");
     }
 
     #[test]

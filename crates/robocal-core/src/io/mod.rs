@@ -1,7 +1,9 @@
 //! File formats: measurement CSV, atomic output, calibration results, robot files.
 
 pub mod atomic;
+pub mod claims;
 pub(crate) mod columns;
+pub(crate) mod csv_lines;
 pub mod export;
 pub mod input;
 pub mod inputs;
@@ -24,6 +26,7 @@ mod temporaries;
 pub use atomic::{
     commit_all, remove_temporaries, resolve_output, write_all_atomic, write_atomic, AtomicFile,
 };
+pub use claims::claim_outputs;
 pub use measurements::{
     parse_measurements, read_measurements, write_measurements, Measurement, MeasurementReader,
     MeasurementSet, Positions,

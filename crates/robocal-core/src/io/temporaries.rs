@@ -1,6 +1,7 @@
-//! The temporary files of [`crate::io::AtomicFile`]: a registry of those this process has open,
-//! so that an interrupted run can remove them ([`remove_temporaries`]), and the clean-up of
-//! temporaries that a killed run left behind (`.NAME.PID.tmp` whose process is gone).
+//! The temporary files of [`crate::io::AtomicFile`]: their names (`.robocal-PID-RANDOM.tmp`), a
+//! registry of those this process has open, so that an interrupted run can remove them
+//! ([`remove_temporaries`]), and records that prove which files are robocal's temporaries, so
+//! that those a killed run left behind are removed later ([`remove_stale`]) and nothing else is.
 
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, MutexGuard, PoisonError};
@@ -9,7 +10,7 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 /// under this lock, so that [`remove_temporaries`] (called from a signal-handling thread) sees a
 /// consistent set and no new file can appear after it.
 pub(crate) struct Registry {
-    open: Vec<PathBuf>,
+    open: Vec<(PathBuf, Record)>,
     /// Set by [`remove_temporaries`]: the run is being interrupted, no new temporary file is
     /// started and none is renamed into place.
     closed: bool,
@@ -34,18 +35,20 @@ impl Registry {
 
     /// Whether `tmp` is one of this process's open temporary files.
     pub(crate) fn contains(&self, tmp: &Path) -> bool {
-        self.open.iter().any(|p| p == tmp)
+        self.open.iter().any(|(p, _)| p == tmp)
     }
 
-    pub(crate) fn add(&mut self, tmp: PathBuf) {
-        self.open.push(tmp);
+    /// Registers `tmp` and the record that proves it is robocal's.
+    pub(crate) fn add(&mut self, tmp: PathBuf, record: Record) {
+        self.open.push((tmp, record));
     }
 
-    /// Forgets `tmp` (renamed into place or removed); whether it was registered.
+    /// Forgets `tmp` (renamed into place or removed) and removes its record; whether it was
+    /// registered.
     pub(crate) fn forget(&mut self, tmp: &Path) -> bool {
-        match self.open.iter().position(|p| p == tmp) {
+        match self.open.iter().position(|(p, _)| p == tmp) {
             Some(k) => {
-                self.open.swap_remove(k);
+                self.open.swap_remove(k).1.remove();
                 true
             }
             None => false,
@@ -62,56 +65,157 @@ pub fn remove_temporaries() -> usize {
     let mut reg = registry();
     reg.closed = true;
     let mut removed = 0;
-    for tmp in reg.open.drain(..) {
+    for (tmp, record) in reg.open.drain(..) {
         if std::fs::remove_file(&tmp).is_ok() {
             removed += 1;
         }
+        record.remove();
     }
     removed
 }
 
-/// The name of the temporary file this process writes `name` through: `.NAME.PID.tmp`.
-pub(crate) fn temporary_name(name: &str) -> String {
-    format!(".{name}.{}.tmp", std::process::id())
+/// The longest name a temporary file gets (`.robocal-PID-RANDOM.tmp`): short whatever the
+/// output's name, so that any legal output name can be written.
+pub(crate) const MAX_NAME: usize = 48;
+
+/// A fresh name for a temporary file: `.robocal-PID-RANDOM.tmp`, independent of the output's
+/// name (so never too long) and unlikely to exist; the file is created with `create_new`, which
+/// never opens an existing file, and a new name is drawn if one does.
+pub(crate) fn temporary_name() -> String {
+    let name = format!(
+        ".robocal-{}-{:016x}.tmp",
+        std::process::id(),
+        rand::random::<u64>()
+    );
+    debug_assert!(name.len() <= MAX_NAME);
+    name
 }
 
-/// The process id in a file name of the form `.NAME.PID.tmp`, if it has that form.
-fn temporary_pid(file_name: &str, name: &str) -> Option<u32> {
-    let pid = file_name
-        .strip_prefix('.')?
-        .strip_prefix(name)?
-        .strip_prefix('.')?
-        .strip_suffix(".tmp")?;
-    if pid.is_empty() || !pid.bytes().all(|b| b.is_ascii_digit()) {
-        return None;
+/// The record (in robocal's private directory, never beside the outputs) that proves a
+/// temporary file is robocal's: the file's absolute path, device and inode. Only a file a
+/// record names, with the same device and inode, whose process no longer exists, is ever removed
+/// as stale: a user's file is never taken for a temporary, whatever its name.
+pub(crate) struct Record {
+    path: Option<PathBuf>,
+}
+
+impl Record {
+    /// Records the temporary `tmp` (just created, open as `file`). Without a private directory
+    /// (or without Unix) nothing is recorded and the file is only removed by this process.
+    pub(crate) fn write(tmp: &Path, file: &std::fs::File) -> Record {
+        Record {
+            path: imp::write_record(tmp, file),
+        }
     }
-    pid.parse().ok()
+
+    /// Removes the record (the temporary was renamed into place or removed).
+    pub(crate) fn remove(&self) {
+        if let Some(p) = &self.path {
+            let _ = std::fs::remove_file(p);
+        }
+    }
 }
 
-/// Removes the temporary files `.NAME.PID.tmp` of `name` in `dir` that a run which no longer
-/// exists left behind (killed by SIGKILL or a power cut, which no handler can catch). A file is
-/// left alone when its process is alive (another run writing the same output) or when that
-/// cannot be told (not Unix); only regular files are removed. Called with the registry held, so
-/// that this process's own temporaries are known.
-pub(crate) fn remove_stale(reg: &Registry, dir: &Path, name: &str) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    let own = std::process::id();
-    for e in entries.flatten() {
-        let file_name = e.file_name();
-        let Some(pid) = file_name.to_str().and_then(|f| temporary_pid(f, name)) else {
-            continue;
+/// Removes the temporary files that runs which no longer exist left behind (killed by SIGKILL
+/// or a power cut, which no handler can catch), as their records name them: only a regular file
+/// with the recorded device and inode. Records of live processes (or when that cannot be told)
+/// are left alone. Called with the registry held, so that this process's own temporaries are
+/// known.
+pub(crate) fn remove_stale(reg: &Registry) {
+    imp::remove_stale(reg);
+}
+
+#[cfg(unix)]
+mod imp {
+    use super::{process_alive, Registry};
+    use std::os::unix::ffi::OsStrExt;
+    use std::os::unix::fs::MetadataExt;
+    use std::path::{Path, PathBuf};
+
+    fn records_dir() -> Option<PathBuf> {
+        let d = crate::io::claims::private_dir().ok()?.join("temporaries");
+        match std::fs::create_dir(&d) {
+            Ok(()) => Some(d),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Some(d),
+            Err(_) => None,
+        }
+    }
+
+    pub(super) fn write_record(tmp: &Path, file: &std::fs::File) -> Option<PathBuf> {
+        let m = file.metadata().ok()?;
+        let abs = std::path::absolute(tmp).ok()?;
+        let rec = records_dir()?.join(format!(
+            "{}-{:016x}",
+            std::process::id(),
+            rand::random::<u64>()
+        ));
+        let mut text = format!("{} {}\n", m.dev(), m.ino()).into_bytes();
+        text.extend_from_slice(abs.as_os_str().as_bytes());
+        std::fs::File::options()
+            .write(true)
+            .create_new(true)
+            .open(&rec)
+            .and_then(|mut f| std::io::Write::write_all(&mut f, &text))
+            .ok()?;
+        Some(rec)
+    }
+
+    pub(super) fn remove_stale(reg: &Registry) {
+        let Some(dir) = records_dir() else {
+            return;
         };
-        let path = dir.join(&file_name);
-        if reg.contains(&path) || (pid != own && process_alive(pid)) {
-            continue;
-        }
-        // Never a directory or a symbolic link, whatever its name.
-        if e.file_type().is_ok_and(|t| t.is_file()) {
-            let _ = std::fs::remove_file(&path);
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            return;
+        };
+        for e in entries.flatten() {
+            let name = e.file_name();
+            let Some(pid) = name
+                .to_str()
+                .and_then(|n| n.split_once('-'))
+                .and_then(|(pid, _)| pid.parse::<u32>().ok())
+            else {
+                continue;
+            };
+            if pid == std::process::id() || process_alive(pid) {
+                continue;
+            }
+            let Ok(text) = std::fs::read(e.path()) else {
+                continue;
+            };
+            let Some(k) = text.iter().position(|b| *b == b'\n') else {
+                let _ = std::fs::remove_file(e.path());
+                continue;
+            };
+            let (head, path) = (
+                &text[..k],
+                Path::new(std::ffi::OsStr::from_bytes(&text[k + 1..])),
+            );
+            let mut ids = std::str::from_utf8(head)
+                .unwrap_or("")
+                .split(' ')
+                .map(|v| v.parse::<u64>().ok());
+            if let (Some(Some(dev)), Some(Some(ino))) = (ids.next(), ids.next()) {
+                let same = std::fs::symlink_metadata(path)
+                    .is_ok_and(|m| m.is_file() && m.dev() == dev && m.ino() == ino);
+                if same && !reg.contains(path) {
+                    let _ = std::fs::remove_file(path);
+                }
+            }
+            let _ = std::fs::remove_file(e.path());
         }
     }
+}
+
+#[cfg(not(unix))]
+mod imp {
+    use super::Registry;
+    use std::path::{Path, PathBuf};
+
+    pub(super) fn write_record(_tmp: &Path, _file: &std::fs::File) -> Option<PathBuf> {
+        None
+    }
+
+    pub(super) fn remove_stale(_reg: &Registry) {}
 }
 
 /// Whether a process with id `pid` exists (`kill(pid, 0)`: it does if the call succeeds or is
@@ -140,16 +244,14 @@ mod tests {
     use super::*;
 
     #[test]
-    fn temporary_names_are_recognized_exactly() {
-        assert_eq!(temporary_pid(".out.csv.123.tmp", "out.csv"), Some(123));
-        assert_eq!(temporary_pid(".out.csv.123.tmp", "out"), None);
-        assert_eq!(temporary_pid(".out.csv..tmp", "out.csv"), None);
-        assert_eq!(temporary_pid(".out.csv.12a.tmp", "out.csv"), None);
-        assert_eq!(temporary_pid("out.csv.123.tmp", "out.csv"), None);
-        assert_eq!(temporary_pid(".out.csv.123", "out.csv"), None);
-        assert_eq!(
-            temporary_pid(".out.csv.99999999999999.tmp", "out.csv"),
-            None
+    fn temporary_names_are_short_and_fresh() {
+        let a = temporary_name();
+        let b = temporary_name();
+        assert_ne!(a, b);
+        assert!(a.len() <= MAX_NAME, "{a}");
+        assert!(
+            a.starts_with(&format!(".robocal-{}-", std::process::id())),
+            "{a}"
         );
     }
 

@@ -132,15 +132,18 @@ pub(super) fn select(
         Error::parse(path, line, field, msg)
     };
     let links: Vec<&str> = robot.links.iter().map(|l| l.name.as_str()).collect();
+    // Looked up once per joint: a set, so that reading is linear in the file's size.
+    let link_set: std::collections::HashSet<&str> = links.iter().copied().collect();
     // The joint that has each link as its child.
     let mut parent_joint: BTreeMap<&str, &urdf_rs::Joint> = BTreeMap::new();
     let mut children: BTreeMap<&str, Vec<&urdf_rs::Joint>> = BTreeMap::new();
     for j in &robot.joints {
-        let line = line_of_element(text, "joint", &j.name);
+        // Found in the text only for a message (a search per joint would be quadratic).
+        let line = || line_of_element(text, "joint", &j.name);
         for l in [&j.parent.link, &j.child.link] {
-            if !links.contains(&l.as_str()) {
+            if !link_set.contains(l.as_str()) {
                 return Err(err(
-                    line,
+                    line(),
                     None,
                     format!(
                         "joint `{}` names link `{l}`, which the file does not define",
@@ -151,7 +154,7 @@ pub(super) fn select(
         }
         if parent_joint.insert(&j.child.link, j).is_some() {
             return Err(err(
-                line,
+                line(),
                 None,
                 format!(
                     "link `{}` is the child of two joints: a URDF is a tree",
@@ -168,7 +171,7 @@ pub(super) fn select(
         .collect();
     let base = match &sel.base_link {
         Some(b) => {
-            if !links.contains(&b.as_str()) {
+            if !link_set.contains(b.as_str()) {
                 return Err(err(
                     None,
                     None,
@@ -206,7 +209,7 @@ pub(super) fn select(
     };
     let tip = match &sel.tip_link {
         Some(t) => {
-            if !links.contains(&t.as_str()) {
+            if !link_set.contains(t.as_str()) {
                 return Err(err(
                     None,
                     None,
@@ -290,8 +293,11 @@ pub(super) fn select(
     path_joints.reverse();
     let mut steps = Vec::new();
     for j in path_joints {
-        let line = line_of_element(text, "joint", &j.name);
-        let jerr = |msg: String| err(line, None, format!("joint `{}`: {msg}", j.name));
+        // The line is looked up only for a message: a search per joint would be quadratic.
+        let jerr = |msg: String| {
+            let line = line_of_element(text, "joint", &j.name);
+            err(line, None, format!("joint `{}`: {msg}", j.name))
+        };
         let o = &j.origin;
         if o.xyz.0.iter().chain(&o.rpy.0).any(|v| !v.is_finite()) {
             return Err(jerr("the origin is not finite".into()));
