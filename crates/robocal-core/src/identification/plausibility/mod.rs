@@ -496,7 +496,7 @@ pub fn assess_data(robot: &Robot, obs: &Observations) -> Plausibility {
         rms,
         limit_mm,
         "mm",
-        !(rms > limit_mm),
+        rms.is_nan() || rms <= limit_mm,
         format!(
             "the model misses the points by {rms:.3} mm RMS after the best rigid fit, {:.2}% of \
              the robot's reach of {reach:.0} mm; limit: {}% ({limit_mm:.1} mm)",
