@@ -105,16 +105,15 @@ pub(super) fn check_non_geometric(fit: &Fit) -> Check {
         if let Some((deg, j, i)) = largest_deflection(fit) {
             let ratio = deg / plausible::JOINT_DEFLECTION_DEG;
             if worst.as_ref().map_or(true, |w| ratio > w.ratio) {
-                let obs = fit.calibration;
                 worst = Some(Excess {
                     name: format!("the deflection of joint {}", j + 1),
                     ratio,
                     detail: format!(
                         "the compliance and transmission parameters turn joint {} by {} deg at \
-                         {}; plausible: {} deg",
+                         calibration point {}; plausible: {} deg",
                         j + 1,
                         sig(deg),
-                        obs.describe(obs.line(i)),
+                        i + 1,
                         plausible::JOINT_DEFLECTION_DEG
                     ),
                 });

@@ -155,8 +155,9 @@ pub(super) fn weight_share(fit: &Fit) -> Check {
         "share",
         passed,
         format!(
-            "the heaviest point ({}) carries {:.1}% of the total weight; limit: {}%",
-            obs.describe(obs.line(i)),
+            "the heaviest point (calibration point {}) carries {:.1}% of the total weight; \
+             limit: {}%",
+            i + 1,
             100.0 * share,
             100.0 * WEIGHT_SHARE_LIMIT
         ),
