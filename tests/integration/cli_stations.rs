@@ -2,40 +2,9 @@
 //! `--orientation-sigma-deg` (6-DoF rows) calibrate like any other data, and `evaluate` knows a
 //! set measured from another tracker station (refused, or fitted with `--refit-frame`).
 
+use crate::util::fixtures::three_reflectors;
 use crate::util::*;
 use std::path::Path;
-
-/// The KR 480 robot file with three reflectors (target 1 is the paper's T0).
-fn three_reflectors(dir: &Path) -> std::path::PathBuf {
-    let text = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/kr480-r3330.toml"),
-    )
-    .unwrap();
-    let line = text.lines().find(|l| l.starts_with("tool = [")).unwrap();
-    let inner = &line[line.find('[').unwrap() + 1..line.find(']').unwrap()];
-    let v: Vec<f64> = inner
-        .split(',')
-        .map(|s| s.trim().parse().unwrap())
-        .collect();
-    let mut t2 = v.clone();
-    t2[0] += 180.0;
-    let mut t3 = v.clone();
-    t3[1] += 160.0;
-    let list = |v: &[f64]| {
-        format!(
-            "[{}]",
-            v.iter()
-                .map(|x| x.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    };
-    let tools = format!("tools = [{}, {}, {}]", list(&v), list(&t2), list(&t3));
-    let out = text.replacen(line, &format!("{line}\n{tools}"), 1);
-    let path = dir.join("kr3.toml");
-    std::fs::write(&path, out).unwrap();
-    path
-}
 
 /// 75 poses of a random KR 480 truth (seed `seed`), written to `cell.csv` in `dir` with its
 /// truth file.

@@ -3,7 +3,7 @@
 //! every family pass, and what calibrate writes every command reads.
 
 use crate::util::bad_input::expect_refused;
-use crate::util::fixtures::cell;
+use crate::util::fixtures::{cell, three_reflectors};
 use crate::util::*;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -85,38 +85,6 @@ fn a_point_weighted_far_above_the_others_is_refused_naming_its_line() {
             "calibration point 10)".to_owned(),
         ],
     );
-}
-
-/// The KR 480 robot file with three reflectors (target 1 the paper's T0), as
-/// `cli_stations` makes it.
-fn three_reflectors(dir: &Path) -> PathBuf {
-    let text = std::fs::read_to_string(example("kr480-r3330.toml")).unwrap();
-    let line = text.lines().find(|l| l.starts_with("tool = [")).unwrap();
-    let inner = &line[line.find('[').unwrap() + 1..line.find(']').unwrap()];
-    let v: Vec<f64> = inner
-        .split(',')
-        .map(|s| s.trim().parse().unwrap())
-        .collect();
-    let shifted = |k: usize, by: f64| {
-        let mut t = v.clone();
-        t[k] += by;
-        format!(
-            "[{}]",
-            t.iter()
-                .map(|x| x.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        )
-    };
-    let tools = format!(
-        "tools = [{}, {}, {}]",
-        shifted(0, 0.0),
-        shifted(0, 180.0),
-        shifted(1, 160.0)
-    );
-    let path = dir.join("kr3.toml");
-    std::fs::write(&path, text.replacen(line, &format!("{line}\n{tools}"), 1)).unwrap();
-    path
 }
 
 #[test]
