@@ -15,6 +15,7 @@
 //! - [`selection`], [`cross_validation`]: the model the data support, chosen by
 //!   cross-validation by pose;
 //! - [`pipeline`]: registration + all of the above ([`calibrate`]);
+//! - [`set_errors`]: per-point errors before and after, and the down-weighted points;
 //! - [`plausibility`]: the gate run after every fit (units, handedness, nominal error, parameter
 //!   moves and ranges, convergence) and the likely cause of a failure;
 //! - [`bounds`]: bounded parameters (a physical compliance) held at their bound when the data
@@ -34,6 +35,7 @@ pub mod precision;
 pub mod prediction;
 pub mod report;
 pub mod selection;
+pub mod set_errors;
 pub(crate) mod simd;
 pub mod solver;
 pub mod split;

@@ -25,6 +25,7 @@ use crate::identification::plausibility::{self, Plausibility};
 use crate::identification::precision;
 use crate::identification::prediction::{predict, Prediction};
 use crate::identification::selection::{self, AutoFamilies, ModelChoice, ModelSelection};
+pub use crate::identification::set_errors::{DownWeighted, SetErrors};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
@@ -35,7 +36,6 @@ use crate::progress::{self, Observer};
 use crate::registration::{
     fit_tools, register, Registration, RegistrationObjective, RegistrationOptions, ToolFit,
 };
-use crate::stats::ErrorStats;
 
 /// Everything that steers a calibration.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -72,77 +72,6 @@ pub struct CalibrationData<'a> {
     pub validation: Option<&'a Observations>,
 }
 
-/// Error norms of one set of points under the nominal and the calibrated model (mm): the
-/// nominal model with the registration's frame (Table II), the calibrated one with the frame
-/// the identification held.
-#[derive(Debug, Clone, PartialEq)]
-pub struct SetErrors {
-    /// CSV line of each point.
-    pub lines: Vec<usize>,
-    /// Nominal model (Table II).
-    pub before: Vec<f64>,
-    /// Calibrated model (Table IV).
-    pub after: Vec<f64>,
-    /// Orientation errors (deg) before and after, for 6-DoF data.
-    pub orientation_deg: Option<(Vec<f64>, Vec<f64>)>,
-}
-
-impl SetErrors {
-    fn new(
-        obs: &Observations,
-        reg: &Registration,
-        nominal: &Robot,
-        frame: &crate::frame::TrackerFrame,
-        cal: &Robot,
-    ) -> SetErrors {
-        let before = Problem::new(nominal, &[], obs, &reg.frame);
-        let after = Problem::new(nominal, &[], obs, frame);
-        SetErrors {
-            lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
-            before: before.error_norms(nominal),
-            after: after.error_norms(cal),
-            orientation_deg: before
-                .orientation_errors_deg(nominal)
-                .zip(after.orientation_errors_deg(cal)),
-        }
-    }
-
-    /// The errors of `obs` with a frame of their own for each model: the nominal model with the
-    /// rigid frame fitted to it, the calibrated one with the frame fitted to it (data measured
-    /// from another tracker station). Returns the errors and the calibrated model's frame.
-    fn refit(
-        obs: &Observations,
-        nominal: &Robot,
-        cal: &Robot,
-    ) -> Result<(SetErrors, crate::frame::TrackerFrame)> {
-        let fb = crate::registration::refit_frame(nominal, obs)?;
-        let fa = crate::registration::refit_frame(cal, obs)?;
-        let before = Problem::new(nominal, &[], obs, &fb);
-        let after = Problem::new(nominal, &[], obs, &fa);
-        Ok((
-            SetErrors {
-                lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
-                before: before.error_norms(nominal),
-                after: after.error_norms(cal),
-                orientation_deg: before
-                    .orientation_errors_deg(nominal)
-                    .zip(after.orientation_errors_deg(cal)),
-            },
-            fa,
-        ))
-    }
-
-    /// Statistics before calibration.
-    pub fn before_stats(&self) -> ErrorStats {
-        ErrorStats::from_norms(&self.before)
-    }
-
-    /// Statistics after calibration.
-    pub fn after_stats(&self) -> ErrorStats {
-        ErrorStats::from_norms(&self.after)
-    }
-}
-
 /// One solver run of the identification.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stage {
@@ -150,55 +79,6 @@ pub struct Stage {
     pub loss: Loss,
     /// What the solver did.
     pub report: SolverReport,
-}
-
-/// A calibration point the robust loss down-weighted.
-#[derive(Debug, Clone, PartialEq)]
-pub struct DownWeighted {
-    /// Index among the calibration points.
-    pub index: usize,
-    /// CSV line.
-    pub line: usize,
-    /// Error norm under the calibrated model (mm).
-    pub error_mm: f64,
-    /// Orientation error under the calibrated model (deg), for 6-DoF rows.
-    pub orientation_deg: Option<f64>,
-    /// Its weight relative to a perfectly fitting point (1).
-    pub weight: f64,
-}
-
-impl DownWeighted {
-    /// The observations whose residual as the loss sees it (position and orientation rows,
-    /// weighted; [`Problem::fit_norms`]) exceeds the robust scale `c` (mm), worst first: an
-    /// orientation row far off is listed like a position far off.
-    fn list(
-        problem: &Problem,
-        robot: &Robot,
-        errors: &SetErrors,
-        loss: &Loss,
-        c: f64,
-    ) -> Vec<DownWeighted> {
-        let norms = problem.fit_norms(robot);
-        let mut out: Vec<(f64, DownWeighted)> = norms
-            .iter()
-            .enumerate()
-            .filter(|(_, &r)| r > c)
-            .map(|(i, &r)| {
-                (
-                    r,
-                    DownWeighted {
-                        index: i,
-                        line: errors.lines[i],
-                        error_mm: errors.after[i],
-                        orientation_deg: errors.orientation_deg.as_ref().map(|(_, a)| a[i]),
-                        weight: loss.weight(r),
-                    },
-                )
-            })
-            .collect();
-        out.sort_by(|a, b| b.0.total_cmp(&a.0));
-        out.into_iter().map(|(_, d)| d).collect()
-    }
 }
 
 /// The outcome of [`calibrate`].

@@ -1,0 +1,130 @@
+//! The errors of a point set before and after calibration (Tables II and IV), and the points the
+//! robust loss down-weighted: what the pipeline ([`super::pipeline`]) reports per point.
+
+use crate::error::Result;
+use crate::identification::objective::Loss;
+use crate::identification::system::Problem;
+use crate::model::Robot;
+use crate::observations::Observations;
+use crate::registration::Registration;
+use crate::stats::ErrorStats;
+
+/// Error norms of one set of points under the nominal and the calibrated model (mm): the
+/// nominal model with the registration's frame (Table II), the calibrated one with the frame
+/// the identification held.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SetErrors {
+    /// CSV line of each point.
+    pub lines: Vec<usize>,
+    /// Nominal model (Table II).
+    pub before: Vec<f64>,
+    /// Calibrated model (Table IV).
+    pub after: Vec<f64>,
+    /// Orientation errors (deg) before and after, for 6-DoF data.
+    pub orientation_deg: Option<(Vec<f64>, Vec<f64>)>,
+}
+
+impl SetErrors {
+    pub(crate) fn new(
+        obs: &Observations,
+        reg: &Registration,
+        nominal: &Robot,
+        frame: &crate::frame::TrackerFrame,
+        cal: &Robot,
+    ) -> SetErrors {
+        let before = Problem::new(nominal, &[], obs, &reg.frame);
+        let after = Problem::new(nominal, &[], obs, frame);
+        SetErrors {
+            lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
+            before: before.error_norms(nominal),
+            after: after.error_norms(cal),
+            orientation_deg: before
+                .orientation_errors_deg(nominal)
+                .zip(after.orientation_errors_deg(cal)),
+        }
+    }
+
+    /// The errors of `obs` with a frame of their own for each model: the nominal model with the
+    /// rigid frame fitted to it, the calibrated one with the frame fitted to it (data measured
+    /// from another tracker station). Returns the errors and the calibrated model's frame.
+    pub(crate) fn refit(
+        obs: &Observations,
+        nominal: &Robot,
+        cal: &Robot,
+    ) -> Result<(SetErrors, crate::frame::TrackerFrame)> {
+        let fb = crate::registration::refit_frame(nominal, obs)?;
+        let fa = crate::registration::refit_frame(cal, obs)?;
+        let before = Problem::new(nominal, &[], obs, &fb);
+        let after = Problem::new(nominal, &[], obs, &fa);
+        Ok((
+            SetErrors {
+                lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
+                before: before.error_norms(nominal),
+                after: after.error_norms(cal),
+                orientation_deg: before
+                    .orientation_errors_deg(nominal)
+                    .zip(after.orientation_errors_deg(cal)),
+            },
+            fa,
+        ))
+    }
+
+    /// Statistics before calibration.
+    pub fn before_stats(&self) -> ErrorStats {
+        ErrorStats::from_norms(&self.before)
+    }
+
+    /// Statistics after calibration.
+    pub fn after_stats(&self) -> ErrorStats {
+        ErrorStats::from_norms(&self.after)
+    }
+}
+
+/// A calibration point the robust loss down-weighted.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DownWeighted {
+    /// Index among the calibration points.
+    pub index: usize,
+    /// CSV line.
+    pub line: usize,
+    /// Error norm under the calibrated model (mm).
+    pub error_mm: f64,
+    /// Orientation error under the calibrated model (deg), for 6-DoF rows.
+    pub orientation_deg: Option<f64>,
+    /// Its weight relative to a perfectly fitting point (1).
+    pub weight: f64,
+}
+
+impl DownWeighted {
+    /// The observations whose residual as the loss sees it (position and orientation rows,
+    /// weighted; [`Problem::fit_norms`]) exceeds the robust scale `c` (mm), worst first: an
+    /// orientation row far off is listed like a position far off.
+    pub(crate) fn list(
+        problem: &Problem,
+        robot: &Robot,
+        errors: &SetErrors,
+        loss: &Loss,
+        c: f64,
+    ) -> Vec<DownWeighted> {
+        let norms = problem.fit_norms(robot);
+        let mut out: Vec<(f64, DownWeighted)> = norms
+            .iter()
+            .enumerate()
+            .filter(|(_, &r)| r > c)
+            .map(|(i, &r)| {
+                (
+                    r,
+                    DownWeighted {
+                        index: i,
+                        line: errors.lines[i],
+                        error_mm: errors.after[i],
+                        orientation_deg: errors.orientation_deg.as_ref().map(|(_, a)| a[i]),
+                        weight: loss.weight(r),
+                    },
+                )
+            })
+            .collect();
+        out.sort_by(|a, b| b.0.total_cmp(&a.0));
+        out.into_iter().map(|(_, d)| d).collect()
+    }
+}
