@@ -1,0 +1,118 @@
+//! An interrupted or killed run leaves no temporary file behind and keeps the old output; the
+//! temporaries of killed runs are removed at the next write, and only those robocal made.
+#![cfg(unix)]
+
+use crate::cli_trust_files::{inputs, temporaries};
+use crate::util::fixtures::many_poses;
+use crate::util::*;
+use std::path::Path;
+
+/// The command that compensates the 200,000 poses of [`many_poses`] into `out`: a run long
+/// enough to be interrupted while its temporary file is open.
+fn long_compensation(d: &Path, out: &Path) -> Vec<String> {
+    [
+        "compensate",
+        "--robot",
+        KUKA,
+        "--params",
+        p(&d.join("res.json")),
+        "--joints",
+        p(many_poses()),
+        "--out",
+        p(out),
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect()
+}
+
+/// Starts `args`, waits until its temporary file for `out` exists, sends `signal`; gives the
+/// exit status and stderr.
+fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i32>, String) {
+    use std::os::unix::process::ExitStatusExt;
+    let child = command()
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let dir = out.parent().unwrap();
+    let prefix = format!(".robocal-{}-", child.id());
+    let start = std::time::Instant::now();
+    while !temporaries(dir).iter().any(|n| n.starts_with(&prefix)) {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(60),
+            "no temporary file {prefix}*.tmp in {}",
+            dir.display()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    // SAFETY: sends a signal to the child started above.
+    let r = unsafe { libc::kill(child.id() as i32, signal) };
+    assert_eq!(r, 0);
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    (o.status.code(), o.status.signal(), err)
+}
+
+#[test]
+fn sigint_and_sigterm_remove_the_temporary_and_keep_the_old_output() {
+    let dir = inputs();
+    let d = dir.path();
+    let out = d.join("out.csv");
+    std::fs::write(&out, "old output\n").unwrap();
+    let args = long_compensation(d, &out);
+    for (signal, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
+        let (code, _, err) = interrupt(&args, &out, signal);
+        assert_eq!(code, Some(130), "{name}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+        assert!(
+            err.contains(&format!(
+                "error: interrupted by {name}; 1 unfinished temporary file(s) removed"
+            )),
+            "{err}"
+        );
+        assert_eq!(std::fs::read_to_string(&out).unwrap(), "old output\n");
+        assert_eq!(temporaries(d), Vec::<String>::new(), "{name}");
+    }
+}
+
+#[test]
+fn temporaries_of_killed_runs_are_removed_at_the_next_write() {
+    let dir = inputs();
+    let d = dir.path();
+    let out = d.join("out.csv");
+    std::fs::write(&out, "old output\n").unwrap();
+    // SIGKILL cannot be caught: its temporary stays until the next run that writes a file.
+    let args = long_compensation(d, &out);
+    let (_, signal, _) = interrupt(&args, &out, libc::SIGKILL);
+    assert_eq!(signal, Some(libc::SIGKILL));
+    assert_eq!(temporaries(d).len(), 1);
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), "old output\n");
+    // Files named like temporaries of a process that cannot exist, which robocal did not make
+    // (no record of them): a user's, never removed.
+    let users = [
+        ".out.csv.999999999.tmp",
+        ".robocal-999999999-0000000000000001.tmp",
+    ];
+    for name in users {
+        std::fs::write(d.join(name), "the user's").unwrap();
+    }
+    let o = robocal(&[
+        "simulate",
+        "--robot",
+        KUKA,
+        "--truth",
+        TRUTH,
+        "--poses",
+        "5",
+        "--out",
+        p(&out),
+    ]);
+    o.assert_ok();
+    // The killed run's temporary is gone (its record proved it robocal's); the user's files stay.
+    assert_eq!(temporaries(d), users);
+    for name in users {
+        assert_eq!(std::fs::read_to_string(d.join(name)).unwrap(), "the user's");
+    }
+}
