@@ -40,6 +40,21 @@ fn args(v: &[&str]) -> Vec<String> {
     v.iter().map(|s| s.to_string()).collect()
 }
 
+/// `calibrate --robot ROBOT --data DATA --out OUT` and `extra`.
+fn calibrate_args(robot: &str, data: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
+    let mut a = args(&[
+        "calibrate",
+        "--robot",
+        robot,
+        "--data",
+        p(data),
+        "--out",
+        p(out),
+    ]);
+    a.extend(extra.iter().map(|s| s.to_string()));
+    a
+}
+
 #[test]
 fn a_point_weighted_far_above_the_others_is_refused_naming_its_line() {
     let dir = Dir::new();
@@ -49,15 +64,7 @@ fn a_point_weighted_far_above_the_others_is_refused_naming_its_line() {
         expect_refused(
             &format!("sigma {sigma}"),
             dir.path(),
-            &args(&[
-                "calibrate",
-                "--robot",
-                &example("ur5.toml"),
-                "--data",
-                p(&data),
-                "--out",
-                p(&out),
-            ]),
+            &calibrate_args(&example("ur5.toml"), &data, &out, &[]),
             3,
             &[format!(":{line}"), "sigma_mm".to_owned()],
         );
@@ -69,15 +76,7 @@ fn a_point_weighted_far_above_the_others_is_refused_naming_its_line() {
     expect_refused(
         "sigma 1e-3",
         dir.path(),
-        &args(&[
-            "calibrate",
-            "--robot",
-            &example("ur5.toml"),
-            "--data",
-            p(&data),
-            "--out",
-            p(&out),
-        ]),
+        &calibrate_args(&example("ur5.toml"), &data, &out, &[]),
         6,
         // The tenth calibration point.
         &[
@@ -136,15 +135,7 @@ fn one_reflector_with_a_joint_offset_is_refused_as_discarded_data() {
     expect_refused(
         "reflector 2 with q1 + 0.5 deg",
         dir.path(),
-        &args(&[
-            "calibrate",
-            "--robot",
-            p(&robot),
-            "--data",
-            p(&bad_data),
-            "--out",
-            p(&dir.join("out.json")),
-        ]),
+        &calibrate_args(p(&robot), &bad_data, &dir.join("out.json"), &[]),
         6,
         // A third of the points 30 mm off: the residuals (least-squares start) or the share
         // the robust loss sets aside, whichever the fit meets first.
@@ -475,20 +466,7 @@ fn every_family_on_the_example_calibrates_within_range_and_is_read_by_every_comm
     ];
     for (label, extra) in cases {
         let out = dir.join(format!("{label}.json"));
-        let mut a = vec![
-            "calibrate",
-            "--robot",
-            &example("ur5.toml"),
-            "--data",
-            p(data),
-            "--out",
-            p(&out),
-        ]
-        .into_iter()
-        .map(str::to_owned)
-        .collect::<Vec<_>>();
-        a.extend(extra.iter().map(|s| s.to_string()));
-        let o = robocal(&a);
+        let o = robocal(&calibrate_args(&example("ur5.toml"), data, &out, extra));
         // A fit may be refused (a family the 60 points cannot carry), never written wrong.
         if !o.success() {
             eprintln!("{label}: refused\n{}", o.stderr());
@@ -549,19 +527,11 @@ fn real_sets_with_every_family_pass_the_gate_and_every_reader() {
     for (k, (robot, extra)) in cases.iter().enumerate() {
         let data = d.join(format!("jacobi_{robot}_grid.csv"));
         let out = dir.join(format!("{robot}-{k}.json"));
-        let mut a = vec![
-            "calibrate".to_owned(),
-            "--robot".into(),
-            example(&format!("{robot}.toml")),
-            "--data".into(),
-            p(&data).into(),
-            "--validate".into(),
-            p(&d.join(format!("jacobi_{robot}_random.csv"))).into(),
-            "--out".into(),
-            p(&out).into(),
-        ];
-        a.extend(extra.iter().map(|s| s.to_string()));
-        robocal(&a).assert_ok();
+        let validation = d.join(format!("jacobi_{robot}_random.csv"));
+        let mut extra = extra.to_vec();
+        extra.extend(["--validate", p(&validation)]);
+        let robot_file = example(&format!("{robot}.toml"));
+        robocal(&calibrate_args(&robot_file, &data, &out, &extra)).assert_ok();
         assert_physical(&out);
         // No non-geometric parameter with an absurd value: every std below its value's range.
         let j = read_json(&out);
