@@ -107,9 +107,9 @@ pub trait ParameterFamily: Sync {
 
     /// The parameter's plausible range on `robot` (see [`plausible`]): the identifiability
     /// analysis, the plausibility gate and the bounds of the fit all read it. The default is the
-    /// geometric one of its unit ([`plausible::Plausible::geometric`]).
+    /// range of its unit ([`plausible::Plausible::of_unit`]).
     fn plausible(&self, robot: &Robot, p: Param) -> plausible::Plausible {
-        plausible::Plausible::geometric(robot, self.unit(p))
+        plausible::Plausible::of_unit(robot, self.unit(p))
     }
 
     /// The Jacobian columns of this family's parameters (in [`ParameterFamily::params`] order) at

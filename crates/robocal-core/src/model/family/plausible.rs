@@ -65,9 +65,10 @@ impl Plausible {
         }
     }
 
-    /// The range of a geometric parameter of `unit`: [`LENGTH_MOVE_FRACTION`] of the reach for
-    /// lengths, [`ANGLE_MOVE_DEG`] for angles (the default of every family).
-    pub fn geometric(robot: &Robot, unit: Unit) -> Plausible {
+    /// The range of a parameter of `unit`, the default of every family: [`LENGTH_MOVE_FRACTION`]
+    /// of the reach for lengths, [`ANGLE_MOVE_DEG`] for angles, [`COMPLIANCE_MAX_URAD_PER_NM`]
+    /// (never negative) for compliances, one degree at the reach for lumped coefficients.
+    pub fn of_unit(robot: &Robot, unit: Unit) -> Plausible {
         match unit {
             Unit::Mm => Plausible::moving(
                 LENGTH_MOVE_FRACTION * robot.reach_mm(),
