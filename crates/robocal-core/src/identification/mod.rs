@@ -14,7 +14,9 @@
 //! - [`prediction`]: the expected error at new poses (noise plus parameter uncertainty);
 //! - [`selection`], [`cross_validation`]: the model the data support, chosen by
 //!   cross-validation by pose;
-//! - [`pipeline`]: registration + all of the above ([`calibrate`]);
+//! - [`pipeline`]: registration + all of the above, for the model as given ([`calibrate_model`]);
+//! - [`model_choice`] and [`selection`]: which model; [`calibrate`], the entry point, chooses it
+//!   (`--model auto`) and runs the pipeline;
 //! - [`set_errors`]: per-point errors before and after, and the down-weighted points;
 //! - [`plausibility`]: the gate run after every fit (units, handedness, nominal error, parameter
 //!   moves and ranges, convergence) and the likely cause of a failure;
@@ -27,6 +29,7 @@ pub mod covariance;
 pub mod cross_validation;
 pub(crate) mod householder;
 pub mod identifiability;
+pub mod model_choice;
 pub mod objective;
 pub mod param_vector;
 pub mod pipeline;
@@ -56,14 +59,16 @@ pub use identifiability::{
     analyze, FixReason, FixedParam, Identifiability, IdentifiabilityOptions,
     DEFAULT_RANK_TOLERANCE, MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
 };
+pub use model_choice::{AutoFamilies, Candidate, ModelChoice, ModelSelection};
 pub use objective::{Loss, Objective, RobustLoss};
 pub use param_vector::{ParamEntry, ParamVector};
 pub use pipeline::{
-    calibrate, Calibration, CalibrationData, CalibrationSettings, DownWeighted, SetErrors, Stage,
+    calibrate_model, Calibration, CalibrationData, CalibrationSettings, DownWeighted, SetErrors,
+    Stage,
 };
 pub use plausibility::{Check, CheckKind, Plausibility};
 pub use prediction::{MapPoint, Prediction};
-pub use selection::{AutoFamilies, Candidate, ModelChoice, ModelSelection};
+pub use selection::calibrate;
 pub use solver::{solve, SolverOptions, SolverReport, Termination};
 pub use split::{split_measurements, SplitData};
 pub use system::Problem;

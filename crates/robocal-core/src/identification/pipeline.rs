@@ -16,6 +16,7 @@ use crate::identification::identifiability::{
     analyze_reduced, jacobian_r, FixReason, Identifiability, IdentifiabilityOptions,
     MAX_CONDITION_NUMBER, MIN_RANK_TOLERANCE,
 };
+use crate::identification::model_choice::{ModelChoice, ModelSelection};
 use crate::identification::objective::{
     robust_sigma, Loss, Objective, RobustLoss, ADAPTIVE_THRESHOLD_SIGMAS, ROBUST_SCALE_SIGMAS,
     SUM_OF_NORMS_SMOOTHING_MM,
@@ -24,7 +25,6 @@ use crate::identification::param_vector::ParamVector;
 use crate::identification::plausibility::{self, Plausibility};
 use crate::identification::precision;
 use crate::identification::prediction::{predict, Prediction};
-use crate::identification::selection::{self, AutoFamilies, ModelChoice, ModelSelection};
 pub use crate::identification::set_errors::{DownWeighted, SetErrors};
 use crate::identification::solver::{solve, SolverOptions, SolverReport, Termination};
 use crate::identification::system::{Level, Problem};
@@ -57,7 +57,7 @@ pub struct CalibrationSettings {
     /// their own (the errors then show the model's shape, not where the tracker stood).
     pub validation_refit_frame: bool,
     /// Which model to fit: the robot as given, or the families the data support
-    /// ([`selection`]).
+    /// ([`super::selection`]).
     pub model: ModelChoice,
 }
 
@@ -81,7 +81,7 @@ pub struct Stage {
     pub report: SolverReport,
 }
 
-/// The outcome of [`calibrate`].
+/// The outcome of [`calibrate_model`].
 #[derive(Debug, Clone)]
 pub struct Calibration {
     /// The nominal model (as given, beta parameters included).
@@ -158,21 +158,19 @@ impl Calibration {
     }
 }
 
-/// Runs a calibration of `nominal` (see the module docs). `observer` hears the stages
-/// (registration, identifiability, the solver's iterations per objective, uncertainty,
+/// Runs a calibration of `nominal` as given, whatever `settings.model` says (see the module
+/// docs; [`crate::identification::calibrate`] chooses the model first). `observer` hears the
+/// stages (registration, identifiability, the solver's iterations per objective, uncertainty,
 /// plausibility) as the work advances.
 ///
 /// A bounded parameter (a physical compliance) that the fit puts just beyond its bound is held
 /// at it and the calibration repeated ([`bounds`]).
-pub fn calibrate(
+pub fn calibrate_model(
     nominal: &Robot,
     data: CalibrationData,
     settings: &CalibrationSettings,
     observer: &dyn Observer,
 ) -> Result<Calibration> {
-    if let ModelChoice::Auto(auto) = settings.model {
-        return calibrate_auto(nominal, data, settings, auto, observer);
-    }
     let first = calibrate_once(nominal, data, settings, observer)?;
     let start = if first.tool_fit.applied {
         first.tool_fit.apply(nominal)
@@ -552,27 +550,6 @@ fn calibrate_once(
         weighting,
         model_selection: None,
     })
-}
-
-/// The calibration of the model the data support: the selection step ([`selection::select`]),
-/// then the chosen model's calibration.
-fn calibrate_auto(
-    nominal: &Robot,
-    data: CalibrationData,
-    settings: &CalibrationSettings,
-    auto: AutoFamilies,
-    observer: &dyn Observer,
-) -> Result<Calibration> {
-    observer.progress(progress::Stage::ModelSelection, 0, 1);
-    let chosen = selection::select(nominal, data, settings, auto)?;
-    let given = CalibrationSettings {
-        model: ModelChoice::Given,
-        ..settings.clone()
-    };
-    let mut cal = calibrate(&chosen.robot, data, &given, observer)?;
-    cal.settings.model = settings.model;
-    cal.model_selection = Some(chosen);
-    Ok(cal)
 }
 
 /// The stages of a solve as one report: the last stage's termination (a stage that does not

@@ -20,9 +20,15 @@
 
 use crate::error::Result;
 use crate::identification::cross_validation::{cross_validate, CrossValidation};
-use crate::identification::pipeline::{calibrate, CalibrationData, CalibrationSettings};
+pub use crate::identification::model_choice::{
+    AutoFamilies, Candidate, ModelChoice, ModelSelection,
+};
+use crate::identification::pipeline::{
+    calibrate_model, Calibration, CalibrationData, CalibrationSettings,
+};
 use crate::model::family::{compliance, transmission};
 use crate::model::Robot;
+use crate::progress::{self, Observer};
 
 /// Folds of the cross-validation.
 pub const FOLDS: usize = 5;
@@ -36,83 +42,29 @@ pub const HARMONICS: [usize; 2] = [1, 2];
 /// needs more has nearly undetermined parameters whose values the data do not support.
 pub const CANDIDATE_MAX_ITERATIONS: usize = 25;
 
-/// Which model a calibration fits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum ModelChoice {
-    /// The robot as given, with the families it has (`--model geometric` and explicit flags).
-    #[default]
-    Given,
-    /// Choose the families the data support (see the module docs).
-    Auto(AutoFamilies),
-}
-
-/// The families the automatic choice selects; a family the user fixed is not selected (the
-/// given robot carries it, or not, in every candidate).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct AutoFamilies {
-    /// Select the transmission harmonics (none, 1 or 2 per revolute joint).
-    pub harmonics: bool,
-    /// Select joint compliance under gravity (none, or every joint `compliance auto` takes).
-    pub compliance: bool,
-}
-
-impl Default for AutoFamilies {
-    fn default() -> Self {
-        AutoFamilies {
-            harmonics: true,
-            compliance: true,
-        }
-    }
-}
-
-/// One candidate model and its cross-validation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Candidate {
-    /// Its non-geometric families, e.g. `["compliance", "harmonics 2"]` (empty: geometric).
-    pub families: Vec<String>,
-    /// Parameters its full fit identified.
-    pub identified: usize,
-    /// Cross-validated mean position error (mm); `None` when the candidate was rejected before
-    /// (its full fit failed, did not converge or failed the plausibility gate).
-    pub cv_mean_mm: Option<f64>,
-    /// Its standard error (mm).
-    pub cv_std_error_mm: Option<f64>,
-    /// Why it cannot be chosen (fit failed, did not converge, failed the plausibility gate).
-    pub rejected: Option<String>,
-    /// Whether it is the chosen model.
-    pub chosen: bool,
-}
-
-impl Candidate {
-    /// Its name for tables: `geometric` or `geometric + ...`.
-    pub fn name(&self) -> String {
-        if self.families.is_empty() {
-            "geometric".into()
-        } else {
-            format!("geometric + {}", self.families.join(" + "))
-        }
-    }
-}
-
-/// The outcome of the automatic choice.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ModelSelection {
-    /// Folds of the cross-validation.
-    pub folds: usize,
-    /// Every candidate, simplest first.
-    pub candidates: Vec<Candidate>,
-    /// The chosen model (the robot to calibrate).
-    pub robot: Robot,
-}
-
-impl ModelSelection {
-    /// The chosen candidate.
-    pub fn chosen(&self) -> &Candidate {
-        self.candidates
-            .iter()
-            .find(|c| c.chosen)
-            .expect("one candidate is chosen")
-    }
+/// Runs a calibration of `nominal` (the library's entry point): the model the data support
+/// when `settings.model` is [`ModelChoice::Auto`] (the selection step, [`select`], then the
+/// chosen model's calibration), else the robot as given
+/// ([`crate::identification::pipeline::calibrate_model`]). `observer` hears the stages.
+pub fn calibrate(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    observer: &dyn Observer,
+) -> Result<Calibration> {
+    let ModelChoice::Auto(auto) = settings.model else {
+        return calibrate_model(nominal, data, settings, observer);
+    };
+    observer.progress(progress::Stage::ModelSelection, 0, 1);
+    let chosen = select(nominal, data, settings, auto)?;
+    let given = CalibrationSettings {
+        model: ModelChoice::Given,
+        ..settings.clone()
+    };
+    let mut cal = calibrate_model(&chosen.robot, data, &given, observer)?;
+    cal.settings.model = settings.model;
+    cal.model_selection = Some(chosen);
+    Ok(cal)
 }
 
 /// The non-geometric families of `robot`, as [`Candidate::families`] names them.
@@ -189,7 +141,7 @@ pub fn select(
             rejected: None,
             chosen: false,
         };
-        match calibrate(robot, data, &fit_settings, &()) {
+        match calibrate_model(robot, data, &fit_settings, &()) {
             // The robot as given is part of every candidate: its error is the calibration's.
             Err(e) if i == 0 => return Err(e),
             Err(e) => cand.rejected = Some(format!("the fit failed: {e}")),

@@ -1,8 +1,8 @@
 //! Several reflectors per pose, 6-DoF measurements, weighted fitting and unknown tools
 //! (DESIGN.md, "Measurement CSV additions"), end to end on simulated data.
 
-use super::pipeline::{calibrate, CalibrationData, CalibrationSettings};
 use super::Observations;
+use super::{calibrate, CalibrationData, CalibrationSettings};
 use crate::identification::objective::Objective;
 use crate::model::family::reflector;
 use crate::model::presets::preset;

@@ -1,0 +1,83 @@
+//! Which model a calibration fits (`--model`): the robot as given, or the families the data
+//! support, and the outcome of that choice ([`super::selection`] makes it).
+
+use crate::model::Robot;
+
+/// Which model a calibration fits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ModelChoice {
+    /// The robot as given, with the families it has (`--model geometric` and explicit flags).
+    #[default]
+    Given,
+    /// Choose the families the data support (see the module docs).
+    Auto(AutoFamilies),
+}
+
+/// The families the automatic choice selects; a family the user fixed is not selected (the
+/// given robot carries it, or not, in every candidate).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AutoFamilies {
+    /// Select the transmission harmonics (none, 1 or 2 per revolute joint).
+    pub harmonics: bool,
+    /// Select joint compliance under gravity (none, or every joint `compliance auto` takes).
+    pub compliance: bool,
+}
+
+impl Default for AutoFamilies {
+    fn default() -> Self {
+        AutoFamilies {
+            harmonics: true,
+            compliance: true,
+        }
+    }
+}
+
+/// One candidate model and its cross-validation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    /// Its non-geometric families, e.g. `["compliance", "harmonics 2"]` (empty: geometric).
+    pub families: Vec<String>,
+    /// Parameters its full fit identified.
+    pub identified: usize,
+    /// Cross-validated mean position error (mm); `None` when the candidate was rejected before
+    /// (its full fit failed, did not converge or failed the plausibility gate).
+    pub cv_mean_mm: Option<f64>,
+    /// Its standard error (mm).
+    pub cv_std_error_mm: Option<f64>,
+    /// Why it cannot be chosen (fit failed, did not converge, failed the plausibility gate).
+    pub rejected: Option<String>,
+    /// Whether it is the chosen model.
+    pub chosen: bool,
+}
+
+impl Candidate {
+    /// Its name for tables: `geometric` or `geometric + ...`.
+    pub fn name(&self) -> String {
+        if self.families.is_empty() {
+            "geometric".into()
+        } else {
+            format!("geometric + {}", self.families.join(" + "))
+        }
+    }
+}
+
+/// The outcome of the automatic choice.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelSelection {
+    /// Folds of the cross-validation.
+    pub folds: usize,
+    /// Every candidate, simplest first.
+    pub candidates: Vec<Candidate>,
+    /// The chosen model (the robot to calibrate).
+    pub robot: Robot,
+}
+
+impl ModelSelection {
+    /// The chosen candidate.
+    pub fn chosen(&self) -> &Candidate {
+        self.candidates
+            .iter()
+            .find(|c| c.chosen)
+            .expect("one candidate is chosen")
+    }
+}
