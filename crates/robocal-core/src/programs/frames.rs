@@ -259,6 +259,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::approx_constant)] // the manual's numbers
     fn pose_add_adds_positions_and_multiplies_rotations() {
         // The script manual's example: pose_add(p[.2,.5,.1,1.57,0,0], p[.2,.5,.6,1.57,0,0]) is
         // p[0.4,1.0,0.7,3.14,0,0].
