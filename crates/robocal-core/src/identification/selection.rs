@@ -24,7 +24,8 @@ pub use crate::identification::model_choice::{
     AutoFamilies, Candidate, ModelChoice, ModelSelection,
 };
 use crate::identification::pipeline::{
-    calibrate_model, Calibration, CalibrationData, CalibrationSettings,
+    calibrate_model, calibrate_model_for, Calibration, CalibrationData, CalibrationSettings,
+    Purpose,
 };
 use crate::model::family::{compliance, transmission};
 use crate::model::Robot;
@@ -148,7 +149,7 @@ pub fn select(
             chosen: false,
             reference: i >= selectable,
         };
-        match calibrate_model(robot, data, &fit_settings, &()) {
+        match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &()) {
             // The robot as given is part of every candidate: its error is the calibration's.
             Err(e) if i == 0 => return Err(e),
             Err(e) => cand.rejected = Some(format!("the fit failed: {e}")),

@@ -172,7 +172,37 @@ pub fn calibrate_model(
     settings: &CalibrationSettings,
     observer: &dyn Observer,
 ) -> Result<Calibration> {
-    let first = calibrate_once(nominal, data, settings, observer)?;
+    calibrate_model_for(nominal, data, settings, Purpose::Result, observer)
+}
+
+/// What a calibration is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Purpose {
+    /// The result: everything, the prediction's workspace map included.
+    Result,
+    /// A model selection's candidate: the prediction without its map.
+    Candidate,
+}
+
+/// One calibration's inputs, as the steps after the solve read them.
+#[derive(Clone, Copy)]
+pub(super) struct Job<'a> {
+    nominal: &'a Robot,
+    data: CalibrationData<'a>,
+    settings: &'a CalibrationSettings,
+    purpose: Purpose,
+    observer: &'a dyn Observer,
+}
+
+/// [`calibrate_model`] for a `purpose`.
+pub(crate) fn calibrate_model_for(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    purpose: Purpose,
+    observer: &dyn Observer,
+) -> Result<Calibration> {
+    let first = calibrate_once(nominal, data, settings, purpose, observer)?;
     let start = if first.tool_fit.applied {
         first.tool_fit.apply(nominal)
     } else {
@@ -187,7 +217,7 @@ pub fn calibrate_model(
         .identifiability
         .fix
         .extend(held.iter().map(|h| h.param));
-    let mut c = calibrate_once(nominal, data, &again, observer)?;
+    let mut c = calibrate_once(nominal, data, &again, purpose, observer)?;
     for f in &mut c.identifiability.fixed {
         if let Some(h) = held.iter().find(|h| h.param == f.param) {
             f.reason = FixReason::AtBound {
@@ -206,6 +236,7 @@ fn calibrate_once(
     nominal: &Robot,
     data: CalibrationData,
     settings: &CalibrationSettings,
+    purpose: Purpose,
     observer: &dyn Observer,
 ) -> Result<Calibration> {
     inputs::check(nominal, &data, settings)?;
@@ -226,9 +257,14 @@ fn calibrate_once(
             observer,
         )?
     };
-    outcome::assemble(
-        nominal, &data, settings, start, identified, solved, observer,
-    )
+    let job = Job {
+        nominal,
+        data,
+        settings,
+        purpose,
+        observer,
+    };
+    outcome::assemble(&job, start, identified, solved)
 }
 
 /// The stages of a solve as one report: the last stage's termination (a stage that does not

@@ -4,16 +4,19 @@
 use super::identify::Identified;
 use super::stages::Solved;
 use super::start::StartModel;
-use super::{check_same_station, whole_solve, Calibration, CalibrationData, CalibrationSettings};
+use super::{
+    check_same_station, whole_solve, Calibration, CalibrationData, CalibrationSettings, Job,
+    Purpose,
+};
 use crate::error::Result;
 use crate::identification::covariance::Covariance;
 use crate::identification::objective::{robust_sigma, ROBUST_SCALE_SIGMAS};
 use crate::identification::plausibility::{self, Plausibility};
-use crate::identification::prediction::{predict, Prediction};
+use crate::identification::prediction::{predict_with, Prediction};
 use crate::identification::set_errors::{DownWeighted, SetErrors};
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
-use crate::progress::{self, Observer};
+use crate::progress;
 
 /// The validation points' errors, and the frame fitted to them of their own when they come from
 /// another station.
@@ -30,14 +33,19 @@ struct Errors<'e> {
 
 /// Everything after the solve, into one [`Calibration`].
 pub(super) fn assemble(
-    nominal: &Robot,
-    data: &CalibrationData,
-    settings: &CalibrationSettings,
+    job: &Job,
     start: StartModel,
     identified: Identified,
     solved: Solved,
-    observer: &dyn Observer,
 ) -> Result<Calibration> {
+    let Job {
+        nominal,
+        data,
+        settings,
+        purpose,
+        observer,
+    } = *job;
+    let data = &data;
     let problem = Problem::new(
         &start.robot,
         &identified.identifiability.identified,
@@ -57,7 +65,14 @@ pub(super) fn assemble(
     let threshold = solved.robust_scale.unwrap_or_else(|| {
         ROBUST_SCALE_SIGMAS * robust_sigma(&calibration.after, problem.kind().rows())
     });
-    let prediction = predict(robot, &covariance, cal, &calibration.after, Some(threshold));
+    let prediction = predict_with(
+        robot,
+        &covariance,
+        cal,
+        &calibration.after,
+        Some(threshold),
+        purpose == Purpose::Result,
+    );
     let (validation, validation_frame) = validation_errors(nominal, data, settings, &start, robot)?;
     let downweighted = solved.robust_scale.map_or_else(Vec::new, |c| {
         DownWeighted::list(&problem, robot, &calibration, &solved.loss, c)
