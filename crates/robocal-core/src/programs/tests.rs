@@ -84,19 +84,36 @@ const ABB_AXES: [[f64; 6]; 3] = [
     [150.0, -30.0, 20.0, -45.0, 60.0, 95.0],
 ];
 
+/// The work object `table` of the RAPID fixture: its user frame (800, -300, 200) mm turned
+/// 0.5 rad about z, its object frame 50 mm above it.
+pub(crate) fn rapid_table() -> crate::frame::Frame {
+    crate::frame::pose(&[800.0, -300.0, 200.0, 0.5, 0.0, 0.0])
+        * crate::frame::pose(&[0.0, 0.0, 50.0, 0.0, 0.0, 0.0])
+}
+
 /// A RAPID module with declared and inline joint and Cartesian targets (the Cartesian ones from
-/// the nominal model, with their confdata), a tooldata and comments.
+/// the nominal model, with their confdata), a tooldata, a wobjdata (`p2` is given in the work
+/// object `table`, see [`rapid_table`]) and comments.
 pub(crate) fn rapid_program(nominal: &Robot) -> String {
     let js = nominal.joint_space();
     let ext = "[9E+09,9E+09,9E+09,9E+09,9E+09,9E+09]";
-    let mut s = String::from(
+    let (qw, qk) = (0.25f64.cos(), 0.25f64.sin());
+    let mut s = format!(
         "MODULE demo\n  ! robocal example: joint and Cartesian targets\n  \
-         PERS tooldata gun := [TRUE,[[0,0,250],[1,0,0,0]],[5,[0,0,100],[1,0,0,0],0,0,0]];\n",
+         PERS tooldata gun := [TRUE,[[0,0,250],[1,0,0,0]],[5,[0,0,100],[1,0,0,0],0,0,0]];\n  \
+         PERS wobjdata table := [FALSE,TRUE,\"\",[[800,-300,200],[{qw:.8},0,0,{qk:.8}]],\
+         [[0,0,50],[1,0,0,0]]];\n",
     );
     let mut moves = String::new();
     for (k, a) in ABB_AXES.iter().enumerate() {
         let q = js.joints_from_axes(a);
-        let v = rapid::pose_values(&nominal.tool_pose(&q), &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]);
+        let in_table = k == 2;
+        let x = if in_table {
+            rapid_table().inverse() * nominal.tool_pose(&q)
+        } else {
+            nominal.tool_pose(&q)
+        };
+        let v = rapid::pose_values(&x, &[0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]);
         let c = rapid_conf(nominal, &q);
         let rob = format!(
             "[[{:.3},{:.3}, {:.3}],[{:.8},{:.8},{:.8},{:.8}],[{},{},{},{}],{ext}]",
@@ -112,8 +129,9 @@ pub(crate) fn rapid_program(nominal: &Robot) -> String {
         } else {
             s += &format!("  CONST jointtarget j{k} := {joints};\n");
             s += &format!("  CONST robtarget p{k}:={rob};\n");
+            let wobj = if in_table { "\\WObj:=table" } else { "" };
             moves += &format!(
-                "    MoveAbsJ j{k}, v100, fine, tool0;\n    MoveJ p{k}, v100, z10, gun;\n"
+                "    MoveAbsJ j{k}, v100, fine, tool0;\n    MoveJ p{k}, v100, z10, gun{wobj};\n"
             );
         }
     }
@@ -280,14 +298,23 @@ fn check_program(format: Format, nom: &Robot, cal: &Robot, text: &str) -> Compen
             }
             TargetKind::Pose => {
                 // What the controller does with the written pose: its nominal inverse
-                // kinematics on the branch the written configuration data give.
+                // kinematics on the branch the written configuration data give, through the
+                // work object the motion names (the RAPID fixture's `p2`: `table`).
+                let wobj = if format == Format::Rapid && c.name == "p2" {
+                    rapid_table()
+                } else {
+                    crate::frame::Frame::identity()
+                };
                 let b = t.branch(previous.as_deref());
-                let BranchJoints::Found(q) =
-                    branch_joints(nom, &PoseNewton::default(), &format.pose_of(&written), &b)
-                else {
+                let BranchJoints::Found(q) = branch_joints(
+                    nom,
+                    &PoseNewton::default(),
+                    &(wobj * format.pose_of(&written)),
+                    &b,
+                ) else {
                     panic!("{}: the written pose is not on its branch", c.name)
                 };
-                (format.pose_of(&old), q)
+                (wobj * format.pose_of(&old), q)
             }
         };
         // RAPID: the tool `gun` (the robot description's tool) as given, on the calibrated flange.
