@@ -48,4 +48,5 @@ mod cli_trust_readers;
 mod cli_urdf;
 mod python_bindings;
 mod readme_commands;
+mod readme_figures;
 mod report_browser;
