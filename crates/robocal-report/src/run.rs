@@ -238,6 +238,13 @@ impl ReportData {
             run.with_paper,
         );
         let mut histogram = before_after_histogram(&sets, &[CALIBRATION], &[CALIBRATION]);
+        // The validation points after calibration beside the calibration points.
+        if let Some(v) = sets.iter().find(|s| s.name == VALIDATION) {
+            histogram.push(HistogramSeries::new(
+                "After calibration – validation points",
+                v.points.iter().map(|p| p.after_mm).collect(),
+            ));
+        }
         if let Some(v) = sets.iter().find(|s| s.name == VERIFICATION) {
             histogram[1].label = "After calibration, predicted – calibration points".into();
             histogram.push(HistogramSeries::new(
