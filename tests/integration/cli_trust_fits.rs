@@ -513,6 +513,54 @@ fn a_tiny_payload_leaves_no_absurd_compliance() {
     }
 }
 
+/// Issue 24: `--compliance auto --harmonics 1` on the example's 60 points validates worse than
+/// the geometric fit; the families given explicitly are compared with the geometric model by
+/// cross-validation and the overfitting is remarked, in the output and the result.
+#[test]
+fn explicit_families_that_overfit_are_remarked() {
+    let dir = Dir::new();
+    let out = dir.join("r.json");
+    let data = PathBuf::from(example("data/ur5-cell.csv"));
+    let printed = ok(&calibrate_args(
+        &example("ur5.toml"),
+        &data,
+        &out,
+        &["--compliance", "auto", "--harmonics", "1"],
+    ))
+    .stdout();
+    assert!(
+        printed.contains("remark: the families given (compliance + harmonics 1"),
+        "{printed}"
+    );
+    assert!(printed.contains("(overfitting)"), "{printed}");
+    let j: Value = read_json(&out);
+    let sel = &j["model_selection"];
+    let cands = sel["candidates"].as_array().unwrap();
+    let given = cands.iter().find(|c| c["chosen"] == true).unwrap();
+    let reference = cands.iter().find(|c| c["reference"] == true).unwrap();
+    assert_eq!(reference["families"].as_array().unwrap().len(), 0);
+    // The remark says what the numbers say: the geometric model is within one standard error.
+    let (m, se) = (
+        given["cv_mean_mm"].as_f64().unwrap(),
+        given["cv_std_error_mm"].as_f64().unwrap(),
+    );
+    assert!(reference["cv_mean_mm"].as_f64().unwrap() <= m + se);
+    assert!(sel["remark"].as_str().unwrap().contains("overfitting"));
+    // Families the data support are not remarked: the real UR5's harmonics.
+    let Some(d) = real_data() else { return };
+    let out = dir.join("h.json");
+    let printed = ok(&calibrate_args(
+        &example("ur5.toml"),
+        &d.join("jacobi_ur5_grid.csv"),
+        &out,
+        &["--harmonics", "2", "--compliance", "none"],
+    ))
+    .stdout();
+    assert!(!printed.contains("remark:"), "{printed}");
+    let j: Value = read_json(&out);
+    assert!(j["model_selection"]["remark"].is_null());
+}
+
 #[test]
 fn real_sets_with_every_family_pass_the_gate_and_every_reader() {
     let Some(d) = real_data() else { return };

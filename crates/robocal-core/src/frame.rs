@@ -83,8 +83,19 @@ pub fn rotation_vector(r: &Matrix3<f64>) -> Vector3<f64> {
     if c > -0.99 {
         return v * (s.atan2(c) / s);
     }
-    // Near a half turn the skew part vanishes: the axis from the symmetric part.
-    nalgebra::Rotation3::from_matrix_unchecked(*r).scaled_axis()
+    // Near a half turn the skew part vanishes (and nalgebra's `scaled_axis` returns zero at an
+    // exact half turn): the axis from the symmetric part, (R + R^T)/2 - c I = (1 - c) n n^T,
+    // its column of largest diagonal; the sign from the skew part, sin(theta) n.
+    let b = (r + r.transpose()) * 0.5 - Matrix3::identity() * c;
+    let k = (0..3)
+        .max_by(|&i, &j| b[(i, i)].total_cmp(&b[(j, j)]))
+        .expect("three columns");
+    let mut n = b.column(k).into_owned();
+    n /= n.norm();
+    if n.dot(&v) < 0.0 {
+        n = -n;
+    }
+    n * s.atan2(c)
 }
 
 /// Converts a frame vector from mm/degrees to mm/radians.
@@ -186,6 +197,32 @@ impl TrackerFrame {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Rotation vectors at, near and far from a half turn give their rotation back (an exact
+    /// half turn used to come back as no rotation at all).
+    #[test]
+    fn rotation_vectors_round_trip_through_a_half_turn() {
+        let axes = [
+            Vector3::new(0.0, 1.0, 0.0),
+            Vector3::new(1.0, 0.0, 0.0),
+            Vector3::new(0.3, -0.9, 0.2),
+            Vector3::new(-0.5, 0.1, -0.8),
+        ];
+        let pi = std::f64::consts::PI;
+        for a in axes {
+            let n = a.normalize();
+            for theta in [pi, pi - 1e-12, pi - 1e-7, pi - 1e-3, 3.0, 2.0, 1e-4, 0.7] {
+                let r = nalgebra::Rotation3::from_scaled_axis(n * theta);
+                let v = rotation_vector(r.matrix());
+                let back = nalgebra::Rotation3::from_scaled_axis(v);
+                // The matrices' difference (about sqrt(2) times the angle between them, which
+                // `angle_to` computes through an arc cosine, good to 1e-8 only).
+                let d = (r.matrix() - back.matrix()).norm();
+                assert!(d < 1e-12, "{n:?} {theta}: {v:?} is {d} off");
+                assert!(v.norm() <= pi + 1e-12);
+            }
+        }
+    }
 
     #[test]
     fn frame_vector_roundtrip() {

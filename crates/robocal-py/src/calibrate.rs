@@ -287,6 +287,9 @@ fn run(
             settings.identifiability.rank_tolerance
         ));
     }
+    if let Some(remark) = cal.model_selection.as_ref().and_then(|s| s.remark.as_ref()) {
+        warnings.push(remark.clone());
+    }
     let mut res = cal.to_result();
     if let Some(rs) = &mut res.settings {
         rs.robot_arg = nominal.source.clone();

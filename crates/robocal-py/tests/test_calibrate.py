@@ -174,3 +174,14 @@ def _timed(f):
     t = time.perf_counter()
     f()
     return time.perf_counter() - t
+
+
+def test_explicit_families_that_overfit_warn(ur5):
+    # As the CLI's remark: compliance and harmonics given explicitly on the example's 60 points
+    # do not beat the geometric model's cross-validated error.
+    with pytest.warns(RuntimeWarning, match="overfitting"):
+        res = robocal.calibrate_files(ur5, example("data/ur5-cell.csv"), compliance="auto", harmonics=1)
+    sel = res.model_selection
+    assert "overfitting" in sel["remark"]
+    ref = [c for c in sel["candidates"] if c.get("reference")]
+    assert len(ref) == 1 and ref[0]["families"] == []

@@ -33,10 +33,15 @@ pub(crate) fn print_selection(
             c.identified,
             f(c.cv_mean_mm),
             f(c.cv_std_error_mm),
-            c.rejected
-                .as_ref()
-                .map_or(String::new(), |r| format!("  not selectable: {r}"))
+            match (&c.rejected, c.reference) {
+                (Some(r), _) => format!("  not selectable: {r}"),
+                (None, true) => "  (reference: the families given are fixed)".into(),
+                (None, false) => String::new(),
+            }
         )?;
+    }
+    if let Some(r) = &sel.remark {
+        outln!("remark: {r}")?;
     }
     Ok(())
 }

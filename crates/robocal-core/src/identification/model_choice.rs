@@ -48,6 +48,9 @@ pub struct Candidate {
     pub rejected: Option<String>,
     /// Whether it is the chosen model.
     pub chosen: bool,
+    /// A model compared but never chosen: the geometric model, beside families the user gave
+    /// explicitly, to tell whether they lower the error at all ([`ModelSelection::remark`]).
+    pub reference: bool,
 }
 
 impl Candidate {
@@ -70,6 +73,10 @@ pub struct ModelSelection {
     pub candidates: Vec<Candidate>,
     /// The chosen model (the robot to calibrate).
     pub robot: Robot,
+    /// Set when the families the user gave explicitly do not lower the cross-validated error
+    /// below the geometric model's (the reference candidate) by more than their standard error:
+    /// they likely fit the noise.
+    pub remark: Option<String>,
 }
 
 impl ModelSelection {

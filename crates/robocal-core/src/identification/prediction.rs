@@ -323,7 +323,7 @@ impl<'a> Predictor<'a> {
 
     /// The prediction from the model-error covariances `J C J^T` of the poses averaged over (the
     /// calibration poses), and the workspace map.
-    fn predict_from(&self, models: &[Matrix3<f64>], floor_z_mm: f64) -> Prediction {
+    fn predict_from(&self, models: &[Matrix3<f64>], floor_z_mm: f64, map: bool) -> Prediction {
         let stride = models.len().div_ceil(MAX_POSES).max(1);
         let picked: Vec<&Matrix3<f64>> = models.iter().step_by(stride).collect();
         let means = map_poses(picked.len(), || (), |_, i| self.mean_norm(picked[i]));
@@ -343,7 +343,11 @@ impl<'a> Predictor<'a> {
             rms_mm: ms.sqrt(),
             noise_sigma_mm: self.sigma,
             model_rms_mm: (model_sq / nf).sqrt(),
-            map: self.map(floor_z_mm),
+            map: if map {
+                self.map(floor_z_mm)
+            } else {
+                Vec::new()
+            },
         }
     }
 
@@ -354,7 +358,7 @@ impl<'a> Predictor<'a> {
             || self.scratch(),
             |s, i| self.model_at(s, qs[i], 0).1,
         );
-        self.predict_from(&models, floor_z_mm)
+        self.predict_from(&models, floor_z_mm, true)
     }
 
     /// [`MAP_POSES`] random poses within the joint limits, tool no lower than `floor_z_mm`
@@ -500,6 +504,26 @@ pub fn predict(
     residual_norms: &[f64],
     threshold_mm: Option<f64>,
 ) -> Option<Prediction> {
+    predict_with(
+        calibrated,
+        covariance,
+        calibration,
+        residual_norms,
+        threshold_mm,
+        true,
+    )
+}
+
+/// [`predict`], with the workspace map only when `map` (a model selection's candidates need
+/// the figures, not the map: it is most of the prediction's cost).
+pub(crate) fn predict_with(
+    calibrated: &Robot,
+    covariance: &Covariance,
+    calibration: &Observations,
+    residual_norms: &[f64],
+    threshold_mm: Option<f64>,
+    map: bool,
+) -> Option<Prediction> {
     // The residual norms are of the points (3 rows), whatever else the kind measures.
     let rows = 3;
     // The noise is not known yet: a predictor of zero noise gives the Jacobians' model parts.
@@ -537,7 +561,7 @@ pub fn predict(
         return None;
     }
     let pred = Predictor { sigma, ..pred };
-    Some(pred.predict_from(&models, floor))
+    Some(pred.predict_from(&models, floor, map))
 }
 
 #[cfg(test)]

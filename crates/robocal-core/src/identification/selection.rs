@@ -24,7 +24,8 @@ pub use crate::identification::model_choice::{
     AutoFamilies, Candidate, ModelChoice, ModelSelection,
 };
 use crate::identification::pipeline::{
-    calibrate_model, Calibration, CalibrationData, CalibrationSettings,
+    calibrate_model, calibrate_model_for, Calibration, CalibrationData, CalibrationSettings,
+    Purpose,
 };
 use crate::model::family::{compliance, transmission};
 use crate::model::Robot;
@@ -122,7 +123,13 @@ pub fn select(
     settings: &CalibrationSettings,
     auto: AutoFamilies,
 ) -> Result<ModelSelection> {
-    let robots = candidates(nominal, auto)?;
+    let mut robots = candidates(nominal, auto)?;
+    let selectable = robots.len();
+    // Families the user fixed are in every candidate: the geometric model beside them tells
+    // whether they lower the error at all.
+    if !families(nominal).is_empty() {
+        robots.push(geometric(nominal)?);
+    }
     let mut fit_settings = settings.clone();
     fit_settings.model = ModelChoice::Given;
     fit_settings.solver.max_iterations =
@@ -140,8 +147,9 @@ pub fn select(
             cv_std_error_mm: None,
             rejected: None,
             chosen: false,
+            reference: i >= selectable,
         };
-        match calibrate_model(robot, data, &fit_settings, &()) {
+        match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &()) {
             // The robot as given is part of every candidate: its error is the calibration's.
             Err(e) if i == 0 => return Err(e),
             Err(e) => cand.rejected = Some(format!("the fit failed: {e}")),
@@ -189,8 +197,43 @@ pub fn select(
     candidates[chosen].chosen = true;
     Ok(ModelSelection {
         folds: FOLDS,
+        remark: overfitting(&candidates[chosen], candidates.iter().find(|c| c.reference)),
         candidates,
         robot: robots[chosen].clone(),
+    })
+}
+
+/// `robot` without its non-geometric families (compliance, transmission harmonics).
+pub fn geometric(robot: &Robot) -> Result<Robot> {
+    let mut r = robot.clone();
+    compliance::enable(&mut r, &[], None)?;
+    transmission::enable(&mut r, &[], 0)?;
+    Ok(r)
+}
+
+/// The remark on families given explicitly (`chosen`, which carries them) that do not lower the
+/// cross-validated error below the geometric `reference`'s by more than their standard error
+/// (the one-standard-error rule would not keep them).
+fn overfitting(chosen: &Candidate, reference: Option<&Candidate>) -> Option<String> {
+    let r = reference?;
+    let (Some(m), Some(se), Some(rm), Some(rse)) = (
+        chosen.cv_mean_mm,
+        chosen.cv_std_error_mm,
+        r.cv_mean_mm,
+        r.cv_std_error_mm,
+    ) else {
+        return None;
+    };
+    (rm <= m + se).then(|| {
+        format!(
+            "the families given ({}, {} parameters) do not lower the cross-validated error \
+             below the geometric model's ({} parameters) by more than its standard error: \
+             {m:.4} +- {se:.4} mm against {rm:.4} +- {rse:.4} mm. They likely fit the noise \
+             (overfitting): the automatic model choice would not keep them",
+            chosen.families.join(" + "),
+            chosen.identified,
+            r.identified
+        )
     })
 }
 
@@ -203,7 +246,7 @@ fn choose(c: &[Candidate]) -> usize {
     if c.first().map_or(true, |x| x.rejected.is_some()) {
         return 0;
     }
-    let ok = |x: &Candidate| x.rejected.is_none() && x.cv_mean_mm.is_some();
+    let ok = |x: &Candidate| !x.reference && x.rejected.is_none() && x.cv_mean_mm.is_some();
     let Some(best) = c
         .iter()
         .filter(|x| ok(x))
@@ -231,6 +274,7 @@ mod tests {
             cv_std_error_mm: Some(se),
             rejected: rejected.then(|| "no".into()),
             chosen: false,
+            reference: false,
         }
     }
 
@@ -251,5 +295,32 @@ mod tests {
         // The robot as given rejected: no family on top of it.
         let c = [cand(26, 0.100, 0.002, true), cand(36, 0.010, 0.001, false)];
         assert_eq!(choose(&c), 0);
+        // The reference (the geometric model beside explicit families) is never chosen.
+        let mut r = cand(20, 0.010, 0.001, false);
+        r.reference = true;
+        let c = [cand(26, 0.100, 0.002, false), r];
+        assert_eq!(choose(&c), 0);
+    }
+
+    #[test]
+    fn explicit_families_that_do_not_beat_the_geometric_model_are_remarked() {
+        let mut given = cand(43, 0.0318, 0.0010, false);
+        given.families = vec!["compliance".into(), "harmonics 1".into()];
+        let mut geo = cand(26, 0.0292, 0.0009, false);
+        geo.reference = true;
+        let r = overfitting(&given, Some(&geo)).expect("a remark");
+        assert!(r.contains("compliance + harmonics 1, 43 parameters"), "{r}");
+        assert!(
+            r.contains("0.0318 +- 0.0010 mm against 0.0292 +- 0.0009 mm"),
+            "{r}"
+        );
+        // Families that lower the error by more than the standard error: no remark.
+        let given = cand(43, 0.0250, 0.0010, false);
+        assert_eq!(overfitting(&given, Some(&geo)), None);
+        // Within the standard error: a tie goes to the simpler model, so remarked.
+        let given = cand(43, 0.0285, 0.0010, false);
+        assert!(overfitting(&given, Some(&geo)).is_some());
+        // No reference (no explicit family): nothing to remark.
+        assert_eq!(overfitting(&given, None), None);
     }
 }

@@ -22,6 +22,9 @@ pub struct CandidateEntry {
     pub rejected: Option<String>,
     /// Whether it is the chosen model.
     pub chosen: bool,
+    /// A model compared but never chosen (the geometric model beside explicit families).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub reference: bool,
 }
 
 /// `model_selection`: how the model was chosen.
@@ -33,6 +36,9 @@ pub struct ModelSelectionSection {
     pub folds: usize,
     /// Every candidate, simplest first.
     pub candidates: Vec<CandidateEntry>,
+    /// Why the families given explicitly look like overfitting, if they do.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub remark: Option<String>,
 }
 
 impl ModelSelectionSection {
@@ -51,8 +57,10 @@ impl ModelSelectionSection {
                     cv_std_error_mm: c.cv_std_error_mm,
                     rejected: c.rejected.clone(),
                     chosen: c.chosen,
+                    reference: c.reference,
                 })
                 .collect(),
+            remark: s.remark.clone(),
         }
     }
 }

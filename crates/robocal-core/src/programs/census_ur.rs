@@ -5,9 +5,14 @@
 //! counts as the pose it is given. `speedj` and `speedl` have no target position. The TCP is
 //! the robot description's until `set_tcp(p[...])` (a literal pose, or a variable assigned one);
 //! any other `set_tcp` makes it unknown. Poses are in the robot's base frame.
+//!
+//! A target combined with a literal pose counts as that target with an offset ([`Offset`]):
+//! `pose_trans(T, p[...])` (after T), `pose_trans(p[...], T)` with T a variable (T in the
+//! literal's frame), `pose_add(T, p[...])`; T is a literal pose or a variable. Any other
+//! combination (a variable offset, a nested call) is computed at run time.
 
-use super::census::{split_args, target_ref, Motion};
-use super::frames::{FrameSpec, Frames};
+use super::census::{split_args, target_ref, Motion, TargetRef};
+use super::frames::{FrameSpec, Frames, Offset};
 use super::lex::{line_end, past_string};
 use std::collections::HashMap;
 
@@ -29,8 +34,60 @@ fn literal_pose(s: &str) -> Option<crate::frame::Frame> {
     (v.len() == 6).then(|| super::urscript::pose_of(&v))
 }
 
+/// The first argument of the call whose arguments (and closing parenthesis) are `rest`.
+fn first_argument(rest: &str) -> &str {
+    let b = rest.as_bytes();
+    let first = split_args(b, 0, b.len())
+        .first()
+        .map_or(rest, |r| &rest[r.clone()]);
+    // The call's own `)` when it has one argument.
+    if first.matches(')').count() > first.matches('(').count() {
+        first.strip_suffix(')').unwrap_or(first).trim_end()
+    } else {
+        first
+    }
+}
+
+/// For a `pose_trans(..)` or `pose_add(..)` argument `a`: its target and offset when its
+/// operands are a target and a literal pose (see the module docs), `Some(None)` when they are
+/// not; `None` when `a` is not such a call.
+pub(crate) fn offset_call(a: &str) -> Option<Option<(&str, Offset)>> {
+    let (name, rest) = a.trim().split_once('(')?;
+    let add = match name.trim_end() {
+        "pose_trans" => false,
+        "pose_add" => true,
+        _ => return None,
+    };
+    let inner = rest.trim_end().strip_suffix(')')?;
+    let b = inner.as_bytes();
+    let ops: Vec<&str> = split_args(b, 0, b.len())
+        .into_iter()
+        .map(|r| &inner[r])
+        .collect();
+    let ident =
+        |s: &str| !s.is_empty() && s.bytes().all(is_ident) && !s.as_bytes()[0].is_ascii_digit();
+    let target = |s: &str| ident(s) || s.starts_with("p[");
+    Some(match ops[..] {
+        [t, o] if target(t) && literal_pose(o).is_some() => {
+            let o = literal_pose(o).expect("checked");
+            Some((
+                t,
+                if add {
+                    Offset::Add(o)
+                } else {
+                    Offset::After(o)
+                },
+            ))
+        }
+        [o, t] if !add && ident(t) && literal_pose(o).is_some() => {
+            Some((t, Offset::Before(literal_pose(o).expect("checked"))))
+        }
+        _ => None,
+    })
+}
+
 /// The end of the call whose `(` is at `open` (the index of its `)`, or of the line's end).
-fn call_end(b: &[u8], open: usize) -> usize {
+pub(crate) fn call_end(b: &[u8], open: usize) -> usize {
     let mut depth = 0usize;
     let mut i = open;
     while i < b.len() {
@@ -125,9 +182,22 @@ pub fn motions(text: &str) -> Vec<Motion> {
                         }
                     }
                     for a in picked {
-                        let a = a
-                            .strip_prefix("get_inverse_kin(")
-                            .map_or(a, str::trim_start);
+                        let a = a.strip_prefix("get_inverse_kin(").map_or(a, first_argument);
+                        // A target with an offset: one offset per motion (a movec whose two
+                        // targets have different offsets keeps the second as computed).
+                        let a = match offset_call(a) {
+                            Some(Some((t, o)))
+                                if m.refs.is_empty() || m.frames.offset == Some(o) =>
+                            {
+                                m.frames.offset = Some(o);
+                                t
+                            }
+                            None if m.frames.offset.is_none() => a,
+                            _ => {
+                                m.refs.push(TargetRef::Computed(a.trim().to_owned()));
+                                continue;
+                            }
+                        };
                         m.refs.push(target_ref(a, &["[", "p["]));
                     }
                 }
@@ -150,18 +220,23 @@ mod tests {
         let text = "def m():\n  tcp = p[0, 0, 0.2, 0, 0, 0]\n  movej(q=[0,-1.57,1.57,0,1.57,0], a=1.4, v=1.05)\n  \
             movej(get_inverse_kin(p[0.4, 0, 0.3, 0, 3.14, 0]))\n  set_tcp(tcp)\n  movel(pick, a=1)\n  \
             movel(pose_trans(pick, p[0,0,0.05,0,0,0]))\n  speedj([0.1,0,0,0,0,0], 0.5)\n  set_tcp(get_tcp())\n  \
-            movec(p[0.1,0,0.3,0,3.14,0], p[0.2,0,0.3,0,3.14,0], a=1)\n  # movej(x)\nend\n";
+            movec(p[0.1,0,0.3,0,3.14,0], p[0.2,0,0.3,0,3.14,0], a=1)\n  # movej(x)\n  \
+            movel(pose_trans(pick, off))\n  movel(pose_add(p[0,0,0,0,0,0], pick))\nend\n";
         let m = motions(text);
         let lines: Vec<usize> = m.iter().map(|m| m.line).collect();
-        assert_eq!(lines, [3, 4, 6, 7, 8, 10]);
+        assert_eq!(lines, [3, 4, 6, 7, 8, 10, 12, 13]);
         assert_eq!(m[0].refs, [TargetRef::Inline]);
         assert_eq!(m[1].refs, [TargetRef::Inline]);
         assert_eq!(m[0].frames.tool, FrameSpec::Default);
         assert_eq!(m[2].refs, [TargetRef::Named("pick".into())]);
         assert!(matches!(m[2].frames.tool, FrameSpec::Known(_)));
-        assert!(matches!(m[3].refs[0], TargetRef::Computed(_)));
+        // A target with a literal offset is that target; a variable offset is computed.
+        assert_eq!(m[3].refs, [TargetRef::Named("pick".into())]);
+        assert!(matches!(m[3].frames.offset, Some(Offset::After(_))));
         assert!(m[4].no_target.is_some());
         assert_eq!(m[5].refs, [TargetRef::Inline, TargetRef::Inline]);
         assert!(m[5].frames.tool.unknown().is_some());
+        assert!(matches!(&m[6].refs[0], TargetRef::Computed(e) if e == "pose_trans(pick, off)"));
+        assert!(matches!(m[7].refs[0], TargetRef::Computed(_)));
     }
 }

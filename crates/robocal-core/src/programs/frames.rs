@@ -43,13 +43,55 @@ impl FrameSpec {
     }
 }
 
-/// The tool and base in force at a motion.
+/// A literal pose a motion combines its target with (URScript `pose_trans`, `pose_add`), so
+/// that the robot goes to the combination, not to the target itself.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Offset {
+    /// `pose_trans(target, o)`: the target followed by `o`, in the target's frame.
+    After(Frame),
+    /// `pose_trans(o, target)`: `o` followed by the target (the target given in frame `o`).
+    Before(Frame),
+    /// `pose_add(target, o)`: positions added, rotations multiplied (`R_target R_o`).
+    Add(Frame),
+}
+
+impl Offset {
+    /// The pose the robot goes to for target `p`.
+    pub fn apply(&self, p: &Frame) -> Frame {
+        match self {
+            Offset::After(o) => p * o,
+            Offset::Before(o) => o * p,
+            Offset::Add(o) => {
+                Frame::from_parts(o.translation, nalgebra::Rotation3::identity())
+                    * p
+                    * Frame::from_parts(nalgebra::Translation3::identity(), o.rotation)
+            }
+        }
+    }
+
+    /// The target whose combination is `x` (the inverse of [`Offset::apply`]).
+    pub fn unapply(&self, x: &Frame) -> Frame {
+        match self {
+            Offset::After(o) => x * o.inverse(),
+            Offset::Before(o) => o.inverse() * x,
+            Offset::Add(o) => {
+                Frame::from_parts(o.translation.inverse(), nalgebra::Rotation3::identity())
+                    * x
+                    * Frame::from_parts(nalgebra::Translation3::identity(), o.rotation.inverse())
+            }
+        }
+    }
+}
+
+/// The tool and base in force at a motion, and the offset it combines its target with.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frames {
     /// The tool.
     pub tool: FrameSpec,
     /// The base (KRL base, RAPID work object).
     pub base: FrameSpec,
+    /// The literal pose the motion combines its target with, if any (URScript).
+    pub offset: Option<Offset>,
 }
 
 impl Default for Frames {
@@ -57,6 +99,7 @@ impl Default for Frames {
         Frames {
             tool: FrameSpec::Default,
             base: FrameSpec::Default,
+            offset: None,
         }
     }
 }
@@ -74,9 +117,10 @@ impl Frames {
     /// The model tool frame (base frame) for program pose `p`, with model tool `tm` (the
     /// calibrated one for the pose to reach, the nominal one for what the controller reads).
     pub fn to_model(&self, p: &Frame, tm: &Frame) -> Frame {
+        let p = self.offset.map_or(*p, |o| o.apply(p));
         let b = match &self.base {
             FrameSpec::Known(b) => *b * p,
-            _ => *p,
+            _ => p,
         };
         match &self.tool {
             FrameSpec::Known(t) => b * t.inverse() * tm,
@@ -90,10 +134,11 @@ impl Frames {
             FrameSpec::Known(t) => x * tm.inverse() * t,
             _ => *x,
         };
-        match &self.base {
+        let x = match &self.base {
             FrameSpec::Known(b) => b.inverse() * x,
             _ => x,
-        }
+        };
+        self.offset.map_or(x, |o| o.unapply(&x))
     }
 }
 
@@ -193,14 +238,42 @@ mod tests {
 
     #[test]
     fn model_and_program_frames_map_both_ways() {
-        let f = Frames {
-            tool: FrameSpec::Known(pose(&[0.0, 10.0, 200.0, 0.1, 0.2, 0.3])),
-            base: FrameSpec::Known(pose(&[1000.0, -50.0, 20.0, 0.5, 0.0, -0.2])),
-        };
-        let tm = pose(&[0.0, 0.0, 250.0, 0.0, 0.0, 0.0]);
-        let p = pose(&[400.0, 300.0, 200.0, 1.0, -0.5, 2.0]);
-        let back = f.from_model(&f.to_model(&p, &tm), &tm);
-        let (dp, dw) = super::super::pose_distance(&back, &p);
+        let o = pose(&[5.0, -20.0, 50.0, 0.3, -0.1, 0.7]);
+        for offset in [
+            None,
+            Some(Offset::After(o)),
+            Some(Offset::Before(o)),
+            Some(Offset::Add(o)),
+        ] {
+            let f = Frames {
+                tool: FrameSpec::Known(pose(&[0.0, 10.0, 200.0, 0.1, 0.2, 0.3])),
+                base: FrameSpec::Known(pose(&[1000.0, -50.0, 20.0, 0.5, 0.0, -0.2])),
+                offset,
+            };
+            let tm = pose(&[0.0, 0.0, 250.0, 0.0, 0.0, 0.0]);
+            let p = pose(&[400.0, 300.0, 200.0, 1.0, -0.5, 2.0]);
+            let back = f.from_model(&f.to_model(&p, &tm), &tm);
+            let (dp, dw) = super::super::pose_distance(&back, &p);
+            assert!(dp < 1e-9 && dw < 1e-9, "{offset:?}: {dp} {dw}");
+        }
+    }
+
+    #[test]
+    #[allow(clippy::approx_constant)] // the manual's numbers
+    fn pose_add_adds_positions_and_multiplies_rotations() {
+        // The script manual's example: pose_add(p[.2,.5,.1,1.57,0,0], p[.2,.5,.6,1.57,0,0]) is
+        // p[0.4,1.0,0.7,3.14,0,0].
+        let ur = |v: [f64; 6]| crate::programs::urscript::pose_of(&v);
+        let sum = Offset::Add(ur([0.2, 0.5, 0.6, 1.57, 0.0, 0.0]))
+            .apply(&ur([0.2, 0.5, 0.1, 1.57, 0.0, 0.0]));
+        let (dp, dw) = super::super::pose_distance(&sum, &ur([0.4, 1.0, 0.7, 3.14, 0.0, 0.0]));
         assert!(dp < 1e-9 && dw < 1e-9, "{dp} {dw}");
+        // pose_trans: the second in the first's frame (the manual's example gives
+        // p[0.4, -0.0996, 0.60048, 3.14, 0, 0]).
+        let t = Offset::After(ur([0.2, 0.5, 0.6, 1.57, 0.0, 0.0]))
+            .apply(&ur([0.2, 0.5, 0.1, 1.57, 0.0, 0.0]));
+        let (dp, dw) =
+            super::super::pose_distance(&t, &ur([0.4, -0.0996, 0.60048, 3.14, 0.0, 0.0]));
+        assert!(dp < 0.01 && dw < 1e-9, "{dp} {dw}");
     }
 }

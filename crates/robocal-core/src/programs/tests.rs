@@ -142,6 +142,11 @@ pub(crate) fn ur_program(nominal: &Robot) -> String {
         );
         let q = js.joints_from_axes(&j.map(f64::to_degrees));
         let v = urscript::pose_values(&nominal.tool_pose(&q), &[0.0; 6]);
+        // No `-0.000000` for a component within rounding of zero.
+        let v: Vec<f64> = v
+            .iter()
+            .map(|x| if x.abs() < 5e-7 { 0.0 } else { *x })
+            .collect();
         let p = format!(
             "p[{:.6}, {:.6}, {:.6}, {:.6}, {:.6}, {:.6}]",
             v[0], v[1], v[2], v[3], v[4], v[5]
@@ -545,4 +550,72 @@ fn rapid_targets_are_mapped_through_their_tool_and_work_object() {
         "{why}"
     );
     assert_eq!(out.unchanged_motions().count(), 1);
+}
+
+/// `pose_trans(T, p[...])`, `pose_trans(p[...], T)` and `pose_add(T, p[...])` with literal
+/// offsets: T is compensated so that the combination the controller computes lands on the
+/// nominal combination on the calibrated robot; a variable offset stays computed at run time.
+#[test]
+fn urscript_targets_combined_with_literal_poses_are_compensated_through_the_offset() {
+    use super::frames::Offset;
+    let nom = robot_file("ur5.toml");
+    let cal = perturbed(&nom, 5);
+    let q = nom
+        .joint_space()
+        .joints_from_axes(&[20.0, -100.0, 80.0, -70.0, -90.0, 10.0]);
+    let goal = nom.tool_pose(&q);
+    let lit = |f: &crate::frame::Frame| {
+        let v = urscript::pose_values(f, &[0.0; 6]);
+        format!(
+            "p[{:.9}, {:.9}, {:.9}, {:.9}, {:.9}, {:.9}]",
+            v[0], v[1], v[2], v[3], v[4], v[5]
+        )
+    };
+    let off = urscript::pose_of(&[0.01, -0.02, 0.05, 0.1, 0.0, -0.2]);
+    let frame = urscript::pose_of(&[0.3, -0.2, 0.1, 0.0, 0.0, 0.4]);
+    let offsets = [Offset::After(off), Offset::Before(frame), Offset::Add(off)];
+    // Each target chosen so that its combination is `goal`.
+    let t: Vec<String> = offsets.iter().map(|o| lit(&o.unapply(&goal))).collect();
+    let text = format!(
+        "def m():\n  a = {t0}\n  b = {t1}\n  movel(pose_trans(a, {o}), a=1.2, v=0.25)\n  \
+         movel(pose_trans({f}, b), a=1.2)\n  \
+         movej(get_inverse_kin(pose_add({t2}, {o}), qnear=[0,0,0,0,0,0]))\n  \
+         o = {o}\n  movel(pose_trans(a, o))\nend\n",
+        t0 = t[0],
+        t1 = t[1],
+        t2 = t[2],
+        o = lit(&off),
+        f = lit(&frame),
+    );
+    let comp = Compensator::new(&nom, &cal, DampedLeastSquares::default()).unwrap();
+    let s = ProgramSettings::default();
+    let path = Path::new("m.script");
+    let out = run(path, &text, Format::UrScript, &comp, &s);
+    let targets = Format::UrScript.targets(path, &out.texts[0]).unwrap();
+    let names: Vec<&str> = targets.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(names, ["a", "b", "movej"], "{text}");
+    // The last motion (a variable offset) is the only one left, named with its expression.
+    let left: Vec<_> = out.unchanged_motions().collect();
+    assert_eq!(left.len(), 1, "{:?}", out.motions);
+    assert_eq!(left[0].motion.line, text.lines().count() - 1);
+    // The offsets themselves keep their text.
+    assert_eq!(out.texts[0].matches(&lit(&off)).count(), 3);
+    assert!(out.texts[0].contains(&lit(&frame)));
+    for (k, o) in offsets.iter().enumerate() {
+        let c = &out.changes[k];
+        assert!(c.applied && c.correction_mm > 0.05, "{c:?}");
+        let v: Vec<f64> = targets[k].fields.iter().map(|f| f.value).collect();
+        // What the controller does: the combination, solved on the nominal model.
+        let x = o.apply(&urscript::pose_of(&v));
+        let BranchJoints::Found(qw) = branch_joints(
+            &nom,
+            &PoseNewton::default(),
+            &x,
+            &Branch::Nearest(q.clone()),
+        ) else {
+            panic!("{o:?}: the written pose is not reached")
+        };
+        let (dp, dw) = pose_distance(&cal.tool_pose(&qw), &goal);
+        assert!(dp < 1e-4 && dw < 1e-5, "{o:?}: {dp} mm {dw} deg");
+    }
 }

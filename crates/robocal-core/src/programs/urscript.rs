@@ -7,12 +7,15 @@
 //! (`movej`, `movel`, `movep`, `movec`, `servoj`: `movej([0, -1.57, ...], a=1.4, v=1.05)`,
 //! `movel(p[...], ...)`, `movej(p[...])`), and every assignment `name = p[...]` or `name = [...]`
 //! (optionally `global`/`local`) whose variable is later given directly to one of these motions
-//! (`movel(name, ...)`). Other lists and poses (`pose_trans(base, p[0, 0, 0.05, 0, 0, 0])`,
-//! `set_tcp(p[...])`, variables used only as offsets) are not targets and are left alone. A
+//! (`movel(name, ...)`), also as the target of `pose_trans(T, p[...])`, `pose_trans(p[...], T)`
+//! (T a variable) or `pose_add(T, p[...])` (the literal pose is the motion's offset, see
+//! [`super::frames::Offset`]). Other lists and poses (`pose_trans(base, offset)` with a variable
+//! offset, `set_tcp(p[...])`, variables used only as offsets) are not targets and are left alone. A
 //! target that is not six numbers is an error naming its line. Comments (`#` to the end of the
 //! line) and strings are skipped. A hand-written reader: there is no maintained Rust parser of
 //! URScript.
 
+use super::census_ur::{call_end, offset_call};
 use super::lex::{line_end, past_string};
 use super::{Field, ProgramTarget, TargetKind};
 use crate::error::{Error, Result};
@@ -181,11 +184,34 @@ fn motion_args(
         if e > k && b.get(after) == Some(&b'=') && b.get(after + 1) != Some(&b'=') {
             k = skip_ws(b, after + 1);
         }
+        // The end of a call the target is inside (its other arguments are not targets).
+        let mut inside: Option<usize> = None;
         // `get_inverse_kin(p[...], ...)`: the pose it is given.
         if b[k.min(b.len())..].starts_with(b"get_inverse_kin(") {
-            k = skip_ws(b, k + "get_inverse_kin(".len());
+            let open = k + "get_inverse_kin".len();
+            inside = Some(call_end(b, open));
+            k = skip_ws(b, open + 1);
         }
-        if let Some((end, l)) = value_list(b, k, line_of) {
+        // `pose_trans(T, p[...])`, `pose_trans(p[...], T)`, `pose_add(T, p[...])`: T (see
+        // census_ur); any other combination is no target.
+        let mut no_target = false;
+        for call in ["pose_trans", "pose_add"] {
+            let rest = &b[k.min(b.len())..];
+            if rest.starts_with(call.as_bytes()) && b.get(skip_ws(b, k + call.len())) == Some(&b'(')
+            {
+                let open = skip_ws(b, k + call.len());
+                let close = call_end(b, open);
+                inside = inside.or(Some(close));
+                let a = std::str::from_utf8(&b[k..(close + 1).min(b.len())]).unwrap_or("");
+                match offset_call(a) {
+                    Some(Some((t, _))) => k += t.as_ptr() as usize - a.as_ptr() as usize,
+                    _ => no_target = true,
+                }
+            }
+        }
+        if no_target {
+            i = k;
+        } else if let Some((end, l)) = value_list(b, k, line_of) {
             direct.push((word.to_owned(), k, l));
             i = end;
         } else {
@@ -195,6 +221,9 @@ fn motion_args(
                 used.push(String::from_utf8_lossy(&b[k..e]).into_owned());
             }
             i = k;
+        }
+        if let Some(close) = inside {
+            i = i.max((close + 1).min(b.len()));
         }
         // To the end of this argument (nested parentheses and brackets skipped).
         let mut depth = 0usize;

@@ -180,6 +180,14 @@ class Result:
         return None if v is None else json.loads(json.dumps(v))
 
     @property
+    def model_selection(self) -> Optional[Dict[str, Any]]:
+        """How the model was chosen (``model="auto"``): each candidate with its cross-validated
+        error, and a ``remark`` when families given explicitly look like overfitting (None when
+        no choice was made)."""
+        v = self._data.get("model_selection")
+        return None if v is None else json.loads(json.dumps(v))
+
+    @property
     def prediction(self) -> Optional[Dict[str, Any]]:
         """The predicted error at new poses spread like the calibration poses."""
         v = self._data.get("prediction")

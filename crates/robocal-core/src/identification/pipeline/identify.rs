@@ -1,0 +1,111 @@
+//! The pipeline's third step: which parameters these poses identify (paper, section II.B),
+//! including those independent in principle that the data cannot pin.
+
+use super::start::StartModel;
+use crate::error::{Error, Result};
+use crate::identification::identifiability::{
+    analyze_reduced, jacobian_r, FixReason, Identifiability, IdentifiabilityOptions,
+    MAX_CONDITION_NUMBER,
+};
+use crate::identification::plausibility;
+use crate::identification::precision;
+use crate::identification::system::Problem;
+use crate::model::Robot;
+use crate::progress::{self, Observer};
+
+/// The identifiable parameters, and why the covariance will be unavailable if it will.
+pub(super) struct Identified {
+    /// Which parameters are identified, which fixed and why.
+    pub identifiability: Identifiability,
+    /// Set when the identified parameters are too nearly dependent for the covariance to have
+    /// reliable digits (allowed only by `allow_ill_conditioned`).
+    pub ill_conditioned: Option<String>,
+}
+
+/// Analyzes identifiability at the start model: rank and conditioning of the scaled Jacobian,
+/// then the precision each parameter would have ([`precision::undetermined`]), fixing those the
+/// data cannot determine. Fails when the problem is too ill-conditioned (unless allowed) or has
+/// fewer points than parameters.
+pub(super) fn identifiable(
+    nominal: &Robot,
+    start: &StartModel,
+    opts: &IdentifiabilityOptions,
+    observer: &dyn Observer,
+) -> Result<Identified> {
+    observer.progress(progress::Stage::Identifiability, 0, 1);
+    let cal = &start.observations;
+    let reduced = jacobian_r(&start.robot, cal);
+    let mut ident = analyze_reduced(&start.robot, cal, opts, &reduced)?;
+    // Only with the tools fitted: otherwise the noise estimate, and the bound, mean nothing.
+    let sigma0 = if start.tool_fit.applied {
+        start.tool_fit.stats.rms_mm / 3f64.sqrt()
+    } else {
+        0.0
+    };
+    let undetermined = precision::undetermined(
+        &start.robot,
+        &Problem::new(&start.robot, &ident.identified, cal, &start.frame),
+        sigma0,
+        &opts.free,
+    );
+    if !undetermined.is_empty() {
+        let mut opts = opts.clone();
+        opts.fix.extend(undetermined.iter().map(|u| u.param));
+        ident = analyze_reduced(&start.robot, cal, &opts, &reduced)?;
+        for f in &mut ident.fixed {
+            if let Some(u) = undetermined.iter().find(|u| u.param == f.param) {
+                f.reason = FixReason::Undetermined {
+                    std: u.std,
+                    limit: u.limit,
+                };
+            }
+        }
+    }
+    let ill_conditioned = ill_conditioned(&ident);
+    if let Some(why) = &ill_conditioned {
+        if !ident.condition_number.is_finite() || !opts.allow_ill_conditioned {
+            let hint = if plausibility::joints_look_like_radians(nominal, cal) {
+                " (but first check the joint values: they all lie within ±2π while the joint \
+                 limits span far more, as if they were radians)"
+            } else {
+                ""
+            };
+            return Err(Error::Numerical(format!(
+                "{why}. Raise the rank tolerance above {:.1e} to fix it{hint}",
+                ident.least_independent().map_or(0.0, |(_, i)| i)
+            )));
+        }
+    }
+    let k = ident.identified.len();
+    if cal.len() < k {
+        return Err(Error::Numerical(format!(
+            "{} calibration points for {k} identifiable parameters: at least {k} points are \
+             needed (the paper uses 75)",
+            cal.len()
+        )));
+    }
+    Ok(Identified {
+        identifiability: ident,
+        ill_conditioned,
+    })
+}
+
+/// Why the identified parameters are too nearly dependent for double precision, if they are.
+fn ill_conditioned(ident: &Identifiability) -> Option<String> {
+    ident.ill_conditioned().then(|| {
+        let (p, ind) = ident
+            .least_independent()
+            .expect("analyze identifies at least one parameter");
+        format!(
+            "the identified parameters are too nearly dependent for double precision: the \
+             condition number of their scaled Jacobian is {:.3e}, above {MAX_CONDITION_NUMBER:e}, \
+             where the normal equations (condition {:.1e}) leave the estimates' uncertainty \
+             without reliable digits; the least independent is {} ({ind:.1e}, rank tolerance \
+             {:e})",
+            ident.condition_number,
+            ident.condition_number * ident.condition_number,
+            p.name(),
+            ident.rank_tolerance
+        )
+    })
+}

@@ -1,0 +1,306 @@
+//! The whole calibration of the paper's sections II.C and III: registration of the measurement
+//! frame, identifiability, identification (eq. 4), uncertainty, and the error tables before and
+//! after (Tables II and IV).
+//!
+//! The tracker frame F and the robot's base frame B are the same unknown seen twice. As in the
+//! paper, F is fitted once to the nominal model (registration) and then held, and B (six
+//! parameters) is identified with the rest, absorbing whatever rigid motion remains. The result's
+//! `tracker_frame` is that F, and the calibrated model includes B, so that
+//! `pose(tracker_frame) * m` compared with the calibrated model's tool point gives the "after"
+//! errors, for the calibration and for the validation points alike.
+
+//! Its steps, in order: [`inputs`] (checks), [`start`] (registration, tool fit, weights),
+//! [`identify`] (identifiability), [`stages`] (the solver runs), [`outcome`] (uncertainty,
+//! errors, prediction, validation, the gate).
+
+mod identify;
+mod inputs;
+mod outcome;
+mod stages;
+mod start;
+
+use crate::error::{Error, Result};
+use crate::identification::bounds;
+use crate::identification::covariance::Covariance;
+use crate::identification::identifiability::{FixReason, Identifiability, IdentifiabilityOptions};
+use crate::identification::model_choice::{ModelChoice, ModelSelection};
+use crate::identification::objective::{Loss, Objective};
+use crate::identification::param_vector::ParamVector;
+use crate::identification::plausibility::Plausibility;
+use crate::identification::prediction::Prediction;
+pub use crate::identification::set_errors::{DownWeighted, SetErrors};
+use crate::identification::solver::{SolverOptions, SolverReport};
+use crate::identification::system::Problem;
+use crate::model::Robot;
+use crate::observations::AppliedWeighting;
+use crate::observations::Observations;
+use crate::observations::Weighting;
+use crate::progress::Observer;
+use crate::registration::{Registration, ToolFit};
+
+/// Everything that steers a calibration.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CalibrationSettings {
+    /// The objective (default: [`Objective::Adaptive`]; the paper's is
+    /// [`Objective::SumOfNorms`]).
+    pub objective: Objective,
+    /// Scale of the robust loss (mm); `None`: from the residuals (see [`RobustLoss`]).
+    pub robust_scale_mm: Option<f64>,
+    /// Also fit and report the paper's affine Tr (eq. 8-11).
+    pub affine_registration: bool,
+    /// Identifiability threshold and `--fix`/`--free`.
+    pub identifiability: IdentifiabilityOptions,
+    /// Solver settings.
+    pub solver: SolverOptions,
+    /// How observations are weighted (uncertainties, tracker model, orientation rows).
+    pub weighting: Weighting,
+    /// The validation points were measured from another tracker station: fit them a frame of
+    /// their own (the errors then show the model's shape, not where the tracker stood).
+    pub validation_refit_frame: bool,
+    /// Which model to fit: the robot as given, or the families the data support
+    /// ([`super::selection`]).
+    pub model: ModelChoice,
+}
+
+/// The measured points of a calibration.
+#[derive(Debug, Clone, Copy)]
+pub struct CalibrationData<'a> {
+    /// Points the parameters are identified from (the paper's 75).
+    pub calibration: &'a Observations,
+    /// The paper's plane points for the initial frame (3), if measured.
+    pub plane: Option<&'a Observations>,
+    /// Points held out to validate the calibrated model (the paper's 73), if any.
+    pub validation: Option<&'a Observations>,
+}
+
+/// One solver run of the identification.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stage {
+    /// The loss minimized.
+    pub loss: Loss,
+    /// What the solver did.
+    pub report: SolverReport,
+}
+
+/// The outcome of [`calibrate_model`].
+#[derive(Debug, Clone)]
+pub struct Calibration {
+    /// The nominal model (as given, beta parameters included).
+    pub nominal: Robot,
+    /// The calibrated model.
+    pub calibrated: Robot,
+    /// The fitted measurement frame and Table II.
+    pub registration: Registration,
+    /// The frame and tool points fitted to the nominal geometry before identification (Table
+    /// II with the fitted tool); its frame is the one the identification holds, the result's
+    /// tracker frame.
+    pub tool_fit: ToolFit,
+    /// The frame the identification held (the tool fit's when it was applied, else the
+    /// registration's): the result's `tracker_frame`.
+    pub frame: crate::frame::TrackerFrame,
+    /// Which parameters were identified, which fixed and why.
+    pub identifiability: Identifiability,
+    /// The solver runs, in order (robust and adaptive objectives start from a least-squares fit, or
+    /// a sum-of-norms fit where the nominal geometry misses the data).
+    pub stages: Vec<Stage>,
+    /// Uncertainty of the identified parameters.
+    pub covariance: Covariance,
+    /// The predicted accuracy at new poses spread like the calibration poses (`None` when the
+    /// standard deviations are unavailable).
+    pub prediction: Option<Prediction>,
+    /// Errors on the calibration points.
+    pub calibration: SetErrors,
+    /// Errors on the validation points.
+    pub validation: Option<SetErrors>,
+    /// The frame fitted to the validation points of their own, when they come from another
+    /// tracker station ([`CalibrationSettings::validation_refit_frame`]).
+    pub validation_frame: Option<crate::frame::TrackerFrame>,
+    /// The robust loss's scale (mm), for robust objectives.
+    pub robust_scale_mm: Option<f64>,
+    /// Points whose error exceeds the robust scale (Cauchy weight below 1/2, Huber weight below
+    /// 1), largest error first.
+    pub downweighted: Vec<DownWeighted>,
+    /// The plausibility gate's outcome (see [`plausibility`]): a converged fit that fails it is
+    /// not a calibration.
+    pub plausibility: Plausibility,
+    /// The settings used.
+    pub settings: CalibrationSettings,
+    /// The weighting the fit used (with an automatic tracker model, which).
+    pub weighting: AppliedWeighting,
+    /// The automatic model choice, when the settings asked for it.
+    pub model_selection: Option<ModelSelection>,
+}
+
+impl Calibration {
+    /// The tracker frame of the calibrated model (the frame the identification held): a
+    /// measured point m maps to `tracker_frame().to_base(m)`.
+    pub fn tracker_frame(&self) -> &crate::frame::TrackerFrame {
+        &self.frame
+    }
+
+    /// The last solver run.
+    pub fn solver(&self) -> &SolverReport {
+        &self.stages.last().expect("at least one stage").report
+    }
+
+    /// The whole solve, every stage together (see [`whole_solve`]).
+    pub fn whole_solve(&self) -> SolverReport {
+        whole_solve(&self.stages)
+    }
+
+    /// Every parameter with its values and verdicts (see [`ParamVector`]).
+    pub fn param_vector(&self) -> ParamVector {
+        ParamVector::of_calibration(
+            &self.nominal,
+            &self.calibrated,
+            &self.identifiability,
+            &self.covariance,
+        )
+    }
+}
+
+/// Runs a calibration of `nominal` as given, whatever `settings.model` says (see the module
+/// docs; [`crate::identification::calibrate`] chooses the model first). `observer` hears the
+/// stages (registration, identifiability, the solver's iterations per objective, uncertainty,
+/// plausibility) as the work advances.
+///
+/// A bounded parameter (a physical compliance) that the fit puts just beyond its bound is held
+/// at it and the calibration repeated ([`bounds`]).
+pub fn calibrate_model(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    observer: &dyn Observer,
+) -> Result<Calibration> {
+    calibrate_model_for(nominal, data, settings, Purpose::Result, observer)
+}
+
+/// What a calibration is for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Purpose {
+    /// The result: everything, the prediction's workspace map included.
+    Result,
+    /// A model selection's candidate: the prediction without its map.
+    Candidate,
+}
+
+/// One calibration's inputs, as the steps after the solve read them.
+#[derive(Clone, Copy)]
+pub(super) struct Job<'a> {
+    nominal: &'a Robot,
+    data: CalibrationData<'a>,
+    settings: &'a CalibrationSettings,
+    purpose: Purpose,
+    observer: &'a dyn Observer,
+}
+
+/// [`calibrate_model`] for a `purpose`.
+pub(crate) fn calibrate_model_for(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    purpose: Purpose,
+    observer: &dyn Observer,
+) -> Result<Calibration> {
+    let first = calibrate_once(nominal, data, settings, purpose, observer)?;
+    let start = if first.tool_fit.applied {
+        first.tool_fit.apply(nominal)
+    } else {
+        nominal.clone()
+    };
+    let held = bounds::to_hold(&start, &first.calibrated, &first.covariance);
+    if held.is_empty() {
+        return Ok(first);
+    }
+    let mut again = settings.clone();
+    again
+        .identifiability
+        .fix
+        .extend(held.iter().map(|h| h.param));
+    let mut c = calibrate_once(nominal, data, &again, purpose, observer)?;
+    for f in &mut c.identifiability.fixed {
+        if let Some(h) = held.iter().find(|h| h.param == f.param) {
+            f.reason = FixReason::AtBound {
+                value: h.value,
+                std: h.std,
+                bound: h.bound,
+            };
+        }
+    }
+    c.settings = settings.clone();
+    Ok(c)
+}
+
+/// One calibration of the model as given: its steps, each a function of its own.
+fn calibrate_once(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    purpose: Purpose,
+    observer: &dyn Observer,
+) -> Result<Calibration> {
+    inputs::check(nominal, &data, settings)?;
+    let start = start::prepare(nominal, &data, settings, observer)?;
+    let identified = identify::identifiable(nominal, &start, &settings.identifiability, observer)?;
+    let solved = {
+        let problem = Problem::new(
+            &start.robot,
+            &identified.identifiability.identified,
+            &start.observations,
+            &start.frame,
+        );
+        stages::solve_stages(
+            &problem,
+            &start.robot,
+            start.tool_fit.applied,
+            settings,
+            observer,
+        )?
+    };
+    let job = Job {
+        nominal,
+        data,
+        settings,
+        purpose,
+        observer,
+    };
+    outcome::assemble(&job, start, identified, solved)
+}
+
+/// The stages of a solve as one report: the last stage's termination (a stage that does not
+/// converge ends the solve), the iterations and evaluations of all stages, the first stage's
+/// initial objective and the last one's final values.
+pub fn whole_solve(stages: &[Stage]) -> SolverReport {
+    let last = &stages.last().expect("at least one stage").report;
+    SolverReport {
+        termination: last.termination.clone(),
+        iterations: stages.iter().map(|s| s.report.iterations).sum(),
+        evaluations: stages.iter().map(|s| s.report.evaluations).sum(),
+        initial_objective: stages[0].report.initial_objective,
+        ..last.clone()
+    }
+}
+
+pub use crate::registration::{STATION_FACTOR, STATION_MIN_MM};
+
+/// Fails when the validation points `v` were clearly measured from another tracker station: a
+/// rigid frame of their own brings the calibrated model's mean error down by [`STATION_FACTOR`]
+/// and by more than [`STATION_MIN_MM`]. Their errors in the calibration's frame would then be the
+/// tracker's move, not the robot's accuracy.
+fn check_same_station(v: &Observations, e: &SetErrors, cal: &Robot) -> Result<()> {
+    let here = e.after_stats().mean_mm;
+    if let Some(there) = crate::registration::another_station(cal, v, here) {
+        return Err(Error::invalid(
+            v.source()
+                .map_or("validation data".into(), |p| p.display().to_string()),
+            format!(
+                "the validation points look measured from another tracker station: in the \
+                 calibration's tracker frame the calibrated model is off by {here:.3} mm on \
+                 average, with a frame of their own by {there:.3} mm. If the tracker moved, \
+                 let the validation fit its own frame (`validation_refit_frame`); otherwise \
+                 check that the file belongs to this calibration"
+            ),
+        ));
+    }
+    Ok(())
+}
