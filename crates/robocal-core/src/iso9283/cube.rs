@@ -129,6 +129,11 @@ impl<'a> Reach<'a> {
         &self.rotation
     }
 
+    /// The reference configuration (rad) P1 is solved from first.
+    pub fn reference(&self) -> &[f64] {
+        &self.reference
+    }
+
     fn margin_ok(&self, robot: &Robot, q: &[f64]) -> bool {
         configuration::configuration(robot, q).map_or(true, |c| c.margin() >= self.singular_margin)
     }

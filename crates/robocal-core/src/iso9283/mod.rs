@@ -33,4 +33,6 @@ pub use spec::{Spec, TrackerMpe};
 #[cfg(test)]
 mod plan_tests;
 #[cfg(test)]
+mod sim_tests;
+#[cfg(test)]
 mod tests;

@@ -179,16 +179,27 @@ pub fn make_plan(
         }
         None => nominal.tool_pose(&reference).rotation,
     };
+    let rotation = Rotation3::from_matrix_unchecked(*rotation.matrix());
+    // The cube is searched on the nominal model (the same cube before and after calibration);
+    // the compensated joints on the calibrated model are then checked, and a searched cube
+    // shrunk in 1 % steps in the rare case that they leave the limits at its boundary.
+    let search = Reach::new(
+        nominal,
+        None,
+        rotation,
+        reference.clone(),
+        settings.singular_margin,
+    );
     let reach = Reach::new(
         nominal,
         calibrated,
-        Rotation3::from_matrix_unchecked(*rotation.matrix()),
-        reference.clone(),
+        rotation,
+        reference,
         settings.singular_margin,
     );
     let max_edge = nominal.reach_mm();
     let res = settings.resolution_mm;
-    let cube = match (settings.centre_mm, settings.edge_mm) {
+    let mut cube = match (settings.centre_mm, settings.edge_mm) {
         (Some(c), Some(e)) => Cube {
             centre: Vector3::from(c),
             edge_mm: e,
@@ -197,12 +208,12 @@ pub fn make_plan(
             let centre = Vector3::from(c);
             Cube {
                 centre,
-                edge_mm: reach.largest_edge(&centre, max_edge, res),
+                edge_mm: search.largest_edge(&centre, max_edge, res),
             }
         }
         (None, e) => {
-            let start = nominal.tool_position(&reference);
-            let best = reach.largest_cube(&start, max_edge, res);
+            let start = nominal.tool_position(search.reference());
+            let best = search.largest_cube(&start, max_edge, res);
             match e {
                 Some(edge_mm) if edge_mm <= best.edge_mm => Cube {
                     centre: best.centre,
@@ -228,6 +239,14 @@ pub fn make_plan(
             "no cube fits there: the robot does not reach the centre with the tool orientation \
              (within the joint limits, away from singularities)",
         ));
+    }
+    if calibrated.is_some() && settings.edge_mm.is_none() {
+        for _ in 0..100 {
+            if reach.fits(&cube) {
+                break;
+            }
+            cube.edge_mm *= 0.99;
+        }
     }
     let sol = reach.solve(&cube).map_err(|m| {
         Error::invalid(
@@ -255,7 +274,7 @@ pub fn make_plan(
     let compensated = sol.compensated.is_some();
     Ok(Plan {
         cube,
-        poses: cube.test_poses(reach.rotation()).to_vec(),
+        poses: cube.test_poses(&rotation).to_vec(),
         joints: sol.compensated.unwrap_or_else(|| sol.nominal.clone()),
         nominal_joints: sol.nominal,
         compensated,

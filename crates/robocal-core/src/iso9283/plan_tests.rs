@@ -147,6 +147,10 @@ fn compensated_plan_and_csv_round_trip() {
     check_reached(&robot, &plan, &plan.nominal_joints);
     check_reached(&cal, &plan, &plan.joints);
     assert!(plan.joints != plan.nominal_joints);
+    // The same cube as the plan before calibration: the same test, other joints.
+    let before = make_plan(&robot, None, &s).unwrap();
+    assert_eq!(before.cube, plan.cube);
+    assert_eq!(before.nominal_joints, plan.nominal_joints);
 
     let dir = std::env::temp_dir().join(format!("robocal-iso-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
