@@ -127,6 +127,43 @@ fn plan_simulate_evaluate_before_and_after_calibration() {
     assert!(text.contains("FAIL") && text.contains("MPE"), "{text}");
     let text = eval("after-plan.csv", "after-meas.csv");
     assert!(text.contains("PASS") && !text.contains("FAIL"), "{text}");
+
+    // The report shows both tests: the cube and poses, a table each.
+    let out = d.join("report");
+    let arg = |a: &str, b: &str| format!("{},{}", p(&d.join(a)), p(&d.join(b)));
+    ok(&[
+        "report",
+        p(&c.result),
+        "--iso9283",
+        &arg("before-plan.csv", "before-meas.csv"),
+        "--iso9283",
+        &arg("after-plan.csv", "after-meas.csv"),
+        "--out",
+        p(&out),
+    ]);
+    let html = std::fs::read_to_string(out.join("report.html")).unwrap();
+    assert!(html.contains("ISO 9283 pose accuracy and repeatability"));
+    assert!(
+        html.contains("before-meas.csv (nominal joints"),
+        "nominal plan label"
+    );
+    assert!(
+        html.contains("after-meas.csv (compensated joints"),
+        "compensated plan label"
+    );
+    assert!(html.contains(&format!("{:.4}", max_of(&before, "ap_mm"))));
+    assert!(html.matches("<h3>").count() >= 2);
+    // A bad pair is refused before anything is written.
+    let o = robocal(&[
+        "report",
+        p(&c.result),
+        "--iso9283",
+        p(&d.join("before-plan.csv")),
+        "--out",
+        p(&d.join("report2")),
+    ]);
+    o.assert_code(2);
+    assert!(!d.join("report2").join("report.html").exists());
 }
 
 fn evaluate_code(plan: &Path, data: &Path) -> Outcome {
@@ -285,4 +322,106 @@ fn bad_inputs_exit_3() {
     ]);
     o.assert_code(3);
     assert!(o.stderr().contains("--spec"), "{}", o.stderr());
+}
+
+/// The README's "ISO 9283 acceptance test": its commands (the UR5 of the quick start), and the
+/// figures it quotes.
+#[test]
+fn readme_figures() {
+    let d = Dir::new();
+    let ex = |name: &str| example(name);
+    let result = d.join("ur5-result.json");
+    ok(&[
+        "calibrate",
+        "--robot",
+        &ex("ur5.toml"),
+        "--data",
+        &ex("data/ur5-cell.csv"),
+        "--validate",
+        &ex("data/ur5-validation.csv"),
+        "--out",
+        p(&result),
+    ]);
+    let test = |params: bool, plan: &str, meas: &str| -> Value {
+        let plan = d.join(plan);
+        let meas = d.join(meas);
+        let mut args = vec!["iso9283".to_owned(), "plan".to_owned()];
+        if params {
+            args.extend(["--params".to_owned(), p(&result).to_owned()]);
+        } else {
+            args.extend(["--robot".to_owned(), ex("ur5.toml")]);
+        }
+        args.extend(["--out".to_owned(), p(&plan).to_owned()]);
+        ok(&args);
+        ok(&[
+            "simulate",
+            "--robot",
+            &ex("ur5.toml"),
+            "--truth",
+            &ex("data/ur5-cell.truth.json"),
+            "--joints",
+            p(&plan),
+            "--repeatability-deg",
+            "0.001",
+            "--seed",
+            "4",
+            "--out",
+            p(&meas),
+        ]);
+        let o = ok(&[
+            "iso9283",
+            "evaluate",
+            "--plan",
+            p(&plan),
+            "--data",
+            p(&meas),
+            "--params",
+            p(&result),
+            "--json",
+        ]);
+        serde_json::from_str(&o.stdout()).expect("JSON")
+    };
+    let before = test(false, "iso-plan.csv", "iso-before.csv");
+    let after = test(true, "iso-plan-cal.csv", "iso-after.csv");
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let quoted = format!(
+        "AP {:.3} mm before calibration, {:.3} mm after; RP {:.3} mm before, {:.3} mm after",
+        max_of(&before, "ap_mm"),
+        max_of(&after, "ap_mm"),
+        max_of(&before, "rp_mm"),
+        max_of(&after, "rp_mm")
+    );
+    assert!(
+        readme.contains(&quoted),
+        "README.md should quote the figures as: {quoted}"
+    );
+}
+
+/// The demo ends with the ISO 9283 test of the KR 480 before and after calibration; the README
+/// quotes its figures (seed 1).
+#[test]
+fn demo_iso9283_table_in_the_readme() {
+    let d = Dir::new();
+    let out = ok(&["demo", "--seed", "1", "--out", p(&d.join("demo"))]).stdout();
+    let from = out
+        .find("ISO 9283 pose accuracy")
+        .expect("the ISO 9283 table");
+    let line = out[from..]
+        .lines()
+        .find(|l| l.starts_with("AP (worst pose)"))
+        .expect("the summary line");
+    let nums: Vec<f64> = line
+        .split_whitespace()
+        .filter_map(|w| w.parse::<f64>().ok())
+        .collect();
+    assert_eq!(nums.len(), 4, "{line}");
+    let (ap0, ap1, rp0, rp1) = (nums[0], nums[1], nums[2], nums[3]);
+    assert!(ap1 < ap0 / 3.0, "{line}");
+    assert!(rp1 < 2.0 * rp0 && rp0 < 2.0 * rp1, "{line}");
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    assert!(
+        readme.contains(line.trim()),
+        "README.md should quote the demo's line: {}",
+        line.trim()
+    );
 }

@@ -10,9 +10,10 @@
 //! P5 face each other across the centre.
 //!
 //! A cube *fits* when every test point is reached by the robot at the tool orientation with all
-//! joints within their limits, on one configuration (P2..P5 solved from P1's joints and on its
-//! branch), every solution at least [`Reach::singular_margin`] away from a singularity; with a
-//! calibrated model, the compensated joints must do the same on it. The largest cube: for a
+//! joints within their limits (by [`Reach::limit_margin`]), on one configuration (P2..P5 solved
+//! from P1's joints and on its branch), every solution at least [`Reach::singular_margin`] away
+//! from a singularity; with a calibrated model, the compensated joints must reach the poses on
+//! it within the limits and half that margin from a singularity. The largest cube: for a
 //! centre, the largest edge that fits (bisection, then grown in 1 % steps while it still fits);
 //! without a given centre, a pattern search over centres (from the tool point of the reference
 //! configuration) for the largest such edge.
@@ -101,8 +102,13 @@ pub struct Reach<'a> {
     calibrated: Option<&'a Robot>,
     rotation: Rotation3<f64>,
     reference: Vec<f64>,
-    /// Smallest configuration margin accepted ([`configuration::Configuration::margin`]).
+    /// Smallest configuration margin accepted ([`configuration::Configuration::margin`]) on
+    /// the nominal model (half of it for the compensated joints, which move by little).
     pub singular_margin: f64,
+    /// How far inside its limits every joint of a nominal solution must stay (rad for a
+    /// revolute joint, mm for a prismatic one), so that the compensated joints, which differ by
+    /// a calibration's corrections, stay inside too. Default 1 degree (1 mm).
+    pub limit_margin: f64,
 }
 
 impl<'a> Reach<'a> {
@@ -121,6 +127,7 @@ impl<'a> Reach<'a> {
             rotation,
             reference,
             singular_margin,
+            limit_margin: 1f64.to_radians(),
         }
     }
 
@@ -134,8 +141,21 @@ impl<'a> Reach<'a> {
         &self.reference
     }
 
-    fn margin_ok(&self, robot: &Robot, q: &[f64]) -> bool {
-        configuration::configuration(robot, q).map_or(true, |c| c.margin() >= self.singular_margin)
+    fn margin_ok(&self, robot: &Robot, q: &[f64], margin: f64) -> bool {
+        configuration::configuration(robot, q).map_or(true, |c| c.margin() >= margin)
+    }
+
+    fn inside_limits(&self, q: &[f64]) -> bool {
+        q.iter()
+            .zip(self.nominal.limits())
+            .enumerate()
+            .all(|(i, (v, l))| {
+                let m = match self.nominal.joint_type(i) {
+                    crate::model::JointType::Revolute => self.limit_margin,
+                    crate::model::JointType::Prismatic => self.limit_margin.to_degrees(),
+                };
+                *v >= l.min + m && *v <= l.max - m
+            })
     }
 
     /// Solves the test poses of `cube`, or says which pose fails first.
@@ -157,8 +177,11 @@ impl<'a> Reach<'a> {
         if !rep.status.is_converged() {
             return Err(miss(1, rep.status, false));
         }
-        if !self.margin_ok(self.nominal, &q1) {
+        if !self.margin_ok(self.nominal, &q1, self.singular_margin) {
             return Err(miss(1, IkStatus::Singular, false));
+        }
+        if !self.inside_limits(&q1) {
+            return Err(miss(1, IkStatus::JointLimit, false));
         }
         let mut nominal = vec![q1.clone()];
         for (k, target) in poses.iter().enumerate().skip(1) {
@@ -167,8 +190,11 @@ impl<'a> Reach<'a> {
             if !rep.status.is_converged() {
                 return Err(miss(k + 1, rep.status, false));
             }
-            if !self.margin_ok(self.nominal, &q) {
+            if !self.margin_ok(self.nominal, &q, self.singular_margin) {
                 return Err(miss(k + 1, IkStatus::Singular, false));
+            }
+            if !self.inside_limits(&q) {
+                return Err(miss(k + 1, IkStatus::JointLimit, false));
             }
             nominal.push(q);
         }
@@ -184,7 +210,7 @@ impl<'a> Reach<'a> {
                     if !rep.status.is_converged() {
                         return Err(miss(k + 1, rep.status, true));
                     }
-                    if !self.margin_ok(cal, &q) {
+                    if !self.margin_ok(cal, &q, 0.5 * self.singular_margin) {
                         return Err(miss(k + 1, IkStatus::Singular, true));
                     }
                     out.push(q);

@@ -9,11 +9,13 @@
 //! - [`read_plan`] and [`read_test_data`] read the plan back and match the measured rows to it.
 //! - [`evaluate`]: AP, RP, orientation AP/RP, AD/RD, drift ([`metrics`] states the formulas),
 //!   the tracker's uncertainty beside RP ([`TrackerMpe`]) and pass/fail against a [`Spec`].
+//! - [`simulate_test`]: a plan run in the virtual cell (with its repeatability) and evaluated.
 
 pub mod cube;
 mod files;
 pub mod metrics;
 mod plan;
+mod simulated;
 mod spec;
 
 pub use cube::{Cube, Reach, CORNER_FRACTION};
@@ -28,6 +30,7 @@ pub use metrics::{
 pub use plan::{
     make_plan, reference_configuration, Plan, PlanRow, PlanSettings, CYCLE_ORDER, DEFAULT_CYCLES,
 };
+pub use simulated::{plan_rows, simulate_test};
 pub use spec::{Spec, TrackerMpe};
 
 #[cfg(test)]
