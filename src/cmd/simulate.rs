@@ -470,6 +470,13 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         cfg.noise_mm,
         cfg.noise_per_m
     )?;
+    if let Some(r) = &cfg.repeatability {
+        let v: Vec<String> = r.std_deg.iter().map(|v| format!("{v:.6}")).collect();
+        outln!(
+            "repeatability: {} deg (mm for a prismatic joint), 1 sigma per joint and move",
+            v.join(",")
+        )?;
+    }
     if let Some(g) = &truth_file.gravity_effect {
         outln!(
             "gravity deflection moved the tool by {:.3} mm on average (max {:.3} mm)",

@@ -22,7 +22,7 @@ fn run_test(d: &Dir, name: &str, params: Option<&Path>, cycles: &str) -> (PathBu
     let o = ok(&args);
     assert!(o.stdout().contains("cube: edge"), "{}", o.stdout());
     let meas = d.join(format!("{name}-meas.csv"));
-    ok(&[
+    let o = ok(&[
         "simulate",
         "--robot",
         KUKA,
@@ -37,6 +37,11 @@ fn run_test(d: &Dir, name: &str, params: Option<&Path>, cycles: &str) -> (PathBu
         "--out",
         p(&meas),
     ]);
+    assert!(
+        o.stdout().contains("repeatability: 0.000500,"),
+        "{}",
+        o.stdout()
+    );
     let o = ok(&[
         "iso9283",
         "evaluate",
@@ -307,6 +312,30 @@ fn bad_inputs_exit_3() {
     o.assert_code(3);
     assert!(o.stderr().contains("--cycles"), "{}", o.stderr());
     assert!(!none.exists());
+    // A repeatability that is no standard deviation, or not a number.
+    let out = d.join("rep.csv");
+    for (v, code) in [("2", 3), ("-0.1", 3), ("x", 2), ("0.1,0.1", 2)] {
+        let o = robocal(&[
+            "simulate",
+            "--robot",
+            KUKA,
+            "--truth",
+            KUKA,
+            "--joints",
+            p(&plan),
+            "--repeatability-deg",
+            v,
+            "--out",
+            p(&out),
+        ]);
+        o.assert_code(code);
+        assert!(
+            o.stderr().contains("--repeatability-deg"),
+            "{v}: {}",
+            o.stderr()
+        );
+        assert!(!out.exists());
+    }
     // A bad spec.
     let o = robocal(&[
         "iso9283",
