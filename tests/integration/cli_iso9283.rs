@@ -454,3 +454,55 @@ fn demo_iso9283_table_in_the_readme() {
         line.trim()
     );
 }
+
+/// Data in the base frame (`--frame base`, the robot from `--robot`): the nominal robot measured
+/// by a tracker standing at the base origin has no bias, so AP is the mean of the noise alone.
+#[test]
+fn data_in_the_base_frame() {
+    let d = Dir::new();
+    let (plan, _, _) = run_test(&d, "b", None, "5");
+    let base = d.join("base.csv");
+    ok(&[
+        "simulate",
+        "--robot",
+        KUKA,
+        "--truth",
+        KUKA,
+        "--tracker",
+        "0,0,0,0,0,0",
+        "--joints",
+        p(&plan),
+        "--repeatability-deg",
+        "0.0005",
+        "--out",
+        p(&base),
+    ]);
+    let o = ok(&[
+        "iso9283",
+        "evaluate",
+        "--plan",
+        p(&plan),
+        "--data",
+        p(&base),
+        "--frame",
+        "base",
+        "--robot",
+        KUKA,
+        "--json",
+    ]);
+    let v: Value = serde_json::from_str(&o.stdout()).unwrap();
+    let (ap, rp) = (max_of(&v, "ap_mm"), max_of(&v, "rp_mm"));
+    assert!(ap < 0.5 * rp, "AP {ap} mm of an unbiased robot, RP {rp} mm");
+    let o = robocal(&[
+        "iso9283",
+        "evaluate",
+        "--plan",
+        p(&plan),
+        "--data",
+        p(&base),
+        "--frame",
+        "base",
+    ]);
+    o.assert_code(2);
+    assert!(o.stderr().contains("--robot"), "{}", o.stderr());
+}
