@@ -285,3 +285,69 @@ pub(crate) fn section(page: &Page, h: &mut String) -> Result<bool> {
     h.push_str("</section>\n");
     Ok(true)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Rotation3, Translation3, Vector3};
+    use robocal_core::frame::Frame;
+    use robocal_core::iso9283::{evaluate, Cube, PoseSamples, Sample, Spec, TrackerMpe};
+
+    /// A test on a known cube whose attained points sit 0.1 mm above the commanded ones and
+    /// 1, 2, 3 um aside in cycles 1, 2, 3.
+    fn test_of(cube: &Cube) -> IsoTest {
+        let poses: Vec<PoseSamples> = cube
+            .test_points()
+            .iter()
+            .enumerate()
+            .map(|(k, p)| PoseSamples {
+                pose: k + 1,
+                commanded: Frame::from_parts(Translation3::from(*p), Rotation3::identity()),
+                samples: (1..=3)
+                    .map(|c| Sample {
+                        cycle: c,
+                        position: p + Vector3::new(0.0, 0.001 * c as f64, 0.1),
+                        rotation: None,
+                        time_s: None,
+                    })
+                    .collect(),
+            })
+            .collect();
+        let spec = Spec::parse("ap=0.05").unwrap();
+        let ev = evaluate(
+            &poses,
+            &TrackerMpe::default(),
+            &Vector3::zeros(),
+            Some(&spec),
+        )
+        .unwrap();
+        IsoTest::from_evaluation("Before <calibration>", &ev)
+    }
+
+    #[test]
+    fn cube_recovered_and_section_rendered() {
+        let cube = Cube {
+            centre: Vector3::new(1500.0, -200.0, 900.0),
+            edge_mm: 640.0,
+        };
+        let t = test_of(&cube);
+        assert!((t.cube_edge_mm - 640.0).abs() < 1e-9, "{}", t.cube_edge_mm);
+        assert_eq!(t.cube_centre_mm, [1500.0, -200.0, 900.0]);
+        // G is 0.1 mm above and 0.002 mm (the mean of 1, 2, 3 um) aside.
+        let ap = (0.01f64 + 4e-6).sqrt();
+        assert!(t.poses.iter().all(|p| (p.ap_mm - ap).abs() < 1e-9));
+        assert_eq!(t.pass, Some(false));
+        let data = crate::ReportData {
+            iso9283: vec![t],
+            ..crate::ReportData::default()
+        };
+        let html = crate::render(&data).unwrap().html;
+        assert!(html.contains("<section id=\"iso9283\">"));
+        assert!(html.contains("Before &lt;calibration&gt;"), "escaped label");
+        assert!(html.contains(">P5</text>") && html.contains("FAIL"));
+        assert!(html.contains("0.1000"));
+        // Without tests, no section.
+        let html = crate::render(&crate::ReportData::default()).unwrap().html;
+        assert!(!html.contains("id=\"iso9283\""));
+    }
+}
