@@ -125,6 +125,8 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         print_elasto(&exp, e, dir)?;
     }
     print_files(&exp, dir)?;
+    outln!()?;
+    super::iso9283::demo_table(&exp)?;
     outln!("report: {}", path(HTML_FILE).display())?;
     Ok(())
 }

@@ -26,6 +26,14 @@ const FLAGS: &[(&str, &str)] = &[
     ("outliers.fraction", "--outlier-fraction"),
     ("outliers.min_mm", "--outlier-min-mm"),
     ("outliers.max_mm", "--outlier-max-mm"),
+    ("repeatability.std_deg", "--repeatability-deg"),
+    // iso9283::PlanSettings, Spec, TrackerMpe
+    ("cycles", "--cycles"),
+    ("edge_mm", "--cube-mm"),
+    ("centre_mm", "--center"),
+    ("orientation_deg", "--orientation"),
+    ("spec", "--spec"),
+    ("tracker_mpe", "--tracker-mpe"),
     // identification::CalibrationSettings
     ("identifiability.fix", "--fix"),
     ("identifiability.free", "--free"),

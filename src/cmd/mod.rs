@@ -9,6 +9,7 @@ mod export;
 mod fk;
 pub(crate) mod flags;
 mod io_plan;
+mod iso9283;
 mod limits;
 mod paper_tables;
 mod plan;
@@ -57,6 +58,9 @@ enum Command {
     /// D-optimal) from random candidates within the joint limits (and the tracker's range),
     /// compared with random poses.
     Plan(plan::PlanArgs),
+    /// ISO 9283 acceptance test: pose accuracy and repeatability (plan the test, evaluate it).
+    #[command(subcommand)]
+    Iso9283(iso9283::Iso9283Cmd),
     /// The HTML report of a calibration result (tables, histogram, per-point errors, parameters).
     Report(report::ReportArgs),
     /// The calibrated robot of a result as a file for other tools: a URDF (ROS, MoveIt) or a
@@ -80,6 +84,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Compensate(a) => compensate::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Plan(a) => plan::run(a),
+        Command::Iso9283(c) => iso9283::run(c),
         Command::Report(a) => report::run(a),
         Command::Export(a) => export::run(a),
         Command::Completions(a) => shell::completions(a),

@@ -10,7 +10,7 @@ use robocal_core::io::result::FrameVec;
 use robocal_core::io::write_all_atomic;
 use robocal_core::simulation::{
     check_truth_matches, simulate, simulate_joints, GeometricErrors, GravityModel, OutlierModel,
-    SimulationConfig, TargetMeasurement, TruthFile, TruthSpec, SET_VALIDATION,
+    RepeatabilityModel, SimulationConfig, TargetMeasurement, TruthFile, TruthSpec, SET_VALIDATION,
 };
 use robocal_core::Robot;
 use std::path::{Path, PathBuf};
@@ -115,6 +115,12 @@ pub struct SimulateArgs {
     /// frame) beside x,y,z, with this 1-sigma noise per axis (deg, e.g. 0.001).
     #[arg(long, allow_hyphen_values = true, conflicts_with = "outlier_fraction")]
     orientation_sigma_deg: Option<f64>,
+    /// The robot's repeatability: a random error per joint and per move, 1-sigma in degrees (mm
+    /// for a prismatic joint), one value for all joints or one per joint; `default`: the class
+    /// default (each joint's error turns the tool by 0.01 mm at the arm's reach). Repeated poses
+    /// (e.g. an ISO 9283 plan given to --joints) then scatter as on a real robot.
+    #[arg(long, allow_hyphen_values = true, value_name = "V|V1,..,Vn|default")]
+    repeatability_deg: Option<String>,
 }
 
 /// A list of numbers: one value for every joint, or one per joint.
@@ -212,6 +218,13 @@ fn config(
         Some(s) => tracker_arg(s)?,
         None => truth_tracker.unwrap_or(d.tracker_frame),
     };
+    let repeatability = match a.repeatability_deg.as_deref() {
+        None => None,
+        Some("default") => Some(RepeatabilityModel::default_for(nominal)),
+        Some(v) => Some(RepeatabilityModel {
+            std_deg: per_joint("--repeatability-deg", v, nominal.dof())?,
+        }),
+    };
     let joints = a.joints.is_some();
     Ok(SimulationConfig {
         seed: a.seed,
@@ -226,6 +239,7 @@ fn config(
         noise_per_m: a.noise_per_m,
         gravity,
         outliers,
+        repeatability,
     })
 }
 
@@ -456,6 +470,13 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         cfg.noise_mm,
         cfg.noise_per_m
     )?;
+    if let Some(r) = &cfg.repeatability {
+        let v: Vec<String> = r.std_deg.iter().map(|v| format!("{v:.6}")).collect();
+        outln!(
+            "repeatability: {} deg (mm for a prismatic joint), 1 sigma per joint and move",
+            v.join(",")
+        )?;
+    }
     if let Some(g) = &truth_file.gravity_effect {
         outln!(
             "gravity deflection moved the tool by {:.3} mm on average (max {:.3} mm)",

@@ -29,6 +29,7 @@ mod cli_compliance;
 mod cli_demo;
 mod cli_evaluate;
 mod cli_interrupted;
+mod cli_iso9283;
 mod cli_joints;
 mod cli_plan;
 mod cli_programs;

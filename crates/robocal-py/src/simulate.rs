@@ -266,6 +266,7 @@ pub fn simulate_session(
         noise_per_m,
         gravity,
         outliers,
+        repeatability: None,
     };
     cfg.validate(nominal).py_err()?;
     if let TruthSpec::Robot(t) = &truth {

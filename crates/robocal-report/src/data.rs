@@ -48,6 +48,8 @@ pub struct ReportData {
     /// Orientation errors of 6-DoF measurements (the angle of `R_measured R_model^T`, deg): one
     /// row per point set and model; empty for point data.
     pub orientation: Vec<AngleRow>,
+    /// ISO 9283 acceptance tests (e.g. before and after calibration); empty: no section.
+    pub iso9283: Vec<crate::iso9283::IsoTest>,
 }
 
 /// One row of the orientation-error table.

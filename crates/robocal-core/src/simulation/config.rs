@@ -3,6 +3,7 @@
 use super::gravity::GravityModel;
 use super::outliers::OutlierModel;
 use super::poses::PoseSampler;
+use super::repeatability::RepeatabilityModel;
 use crate::error::{Error, Result};
 use crate::io::result::FrameVec;
 use crate::model::Robot;
@@ -60,6 +61,9 @@ pub struct SimulationConfig {
     pub gravity: Option<GravityModel>,
     /// Gross outliers (off when `None`).
     pub outliers: Option<OutlierModel>,
+    /// The robot's repeatability: a random error per joint and per move (off when `None`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repeatability: Option<RepeatabilityModel>,
 }
 
 impl Default for SimulationConfig {
@@ -87,6 +91,7 @@ impl Default for SimulationConfig {
             noise_per_m: DEFAULT_NOISE_PER_M,
             gravity: None,
             outliers: None,
+            repeatability: None,
         }
     }
 }
@@ -125,6 +130,9 @@ impl SimulationConfig {
         }
         if let Some(o) = &self.outliers {
             o.validate()?;
+        }
+        if let Some(r) = &self.repeatability {
+            r.validate(nominal.dof())?;
         }
         Ok(())
     }

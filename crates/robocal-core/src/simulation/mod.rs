@@ -43,6 +43,7 @@ mod monte_carlo;
 mod outliers;
 mod plane;
 mod poses;
+mod repeatability;
 mod session;
 mod targets;
 mod tracker;
@@ -59,6 +60,7 @@ pub use monte_carlo::{run_trials, simulate_trials, trial_seed};
 pub use outliers::{Outlier, OutlierModel};
 pub use plane::{plane_poses, quantize_joints, reach_position};
 pub use poses::{random_poses, random_poses_within, PoseSampler, TrackerRange};
+pub use repeatability::{RepeatabilityModel, DEFAULT_TOOL_MM};
 pub use session::{
     simulate, simulate_joints, Simulation, SET_CALIBRATION, SET_PLANE, SET_VALIDATION,
 };

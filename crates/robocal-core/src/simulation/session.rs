@@ -127,7 +127,7 @@ pub fn simulate(
     all.extend(plane.iter().cloned());
     all.extend(cal.iter().cloned());
     all.extend(val.iter().cloned());
-    let readings = measure(&mut cell, &all, &mut done, total, observer)?;
+    let readings = measure(&mut cell, &all, config, &mut done, total, observer)?;
     let pts = &readings.points;
     let (a, b) = (plane.len(), plane.len() + cal.len());
     let mut rows = Vec::with_capacity(all.len());
@@ -194,7 +194,7 @@ pub fn simulate_joints(
     let qs: Vec<Vec<f64>> = joints.rows.iter().map(|r| r.q.clone()).collect();
     let mut done = qs.len();
     let total = 2 * qs.len();
-    let readings = measure(&mut cell, &qs, &mut done, total, observer)?;
+    let readings = measure(&mut cell, &qs, config, &mut done, total, observer)?;
     let rows = joints
         .rows
         .iter()
@@ -226,15 +226,21 @@ pub fn simulate_joints(
     ))
 }
 
-/// Measures all poses in one batch (outliers are drawn per batch) and reports progress.
+/// Measures all poses in one batch (outliers are drawn per batch) and reports progress. With a
+/// repeatability model the robot stops at the commanded joints plus its random error per move
+/// (the rows keep the commanded joints).
 fn measure(
     cell: &mut VirtualCell,
     qs: &[Vec<f64>],
+    config: &SimulationConfig,
     done: &mut usize,
     total: usize,
     observer: &dyn Observer,
 ) -> Result<Readings> {
-    let r = cell.measure(qs)?;
+    let r = match &config.repeatability {
+        Some(m) => cell.measure(&m.attained(cell.truth(), qs, config.seed))?,
+        None => cell.measure(qs)?,
+    };
     *done += qs.len();
     observer.progress(Stage::Measurement, *done, total);
     Ok(r)
