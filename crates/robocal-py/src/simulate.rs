@@ -266,6 +266,9 @@ pub fn simulate_session(
         noise_per_m,
         gravity,
         outliers,
+        backlash: None,
+        thermal: None,
+        station: 0,
     };
     cfg.validate(nominal).py_err()?;
     if let TruthSpec::Robot(t) = &truth {

@@ -3,6 +3,7 @@
 //! measured (the verification phase), with the truth file that goes beside the data.
 
 use super::cell::{Readings, VirtualCell};
+use super::conditions::write_conditions;
 use super::config::SimulationConfig;
 use super::truth::{GeometricErrors, TruthSpec};
 use super::truth_file::{OutlierRecord, SetInfo, TruthFile};
@@ -134,13 +135,14 @@ pub fn simulate(
     rows.extend(rows_of(plane, &pts[..a], "P", SET_PLANE, 2));
     rows.extend(rows_of(cal, &pts[a..b], "C", SET_CALIBRATION, 2 + a));
     rows.extend(rows_of(val, &pts[b..], "V", SET_VALIDATION, 2 + b));
-    let measurements = MeasurementSet {
+    let mut measurements = MeasurementSet {
         path: PathBuf::from("<simulated>"),
         joints: nominal.joint_space().clone(),
         extra_columns: vec!["id".into(), "set".into()],
         rows,
         warnings: Vec::new(),
     };
+    write_conditions(&mut measurements, &readings);
     Ok(finish(
         cell,
         measurements,
@@ -207,13 +209,14 @@ pub fn simulate_joints(
             extra: r.extra.clone(),
         })
         .collect();
-    let measurements = MeasurementSet {
+    let mut measurements = MeasurementSet {
         path: PathBuf::from("<simulated>"),
         joints: nominal.joint_space().clone(),
         extra_columns: joints.extra_columns.clone(),
         rows,
         warnings: Vec::new(),
     };
+    write_conditions(&mut measurements, &readings);
     Ok(finish(
         cell,
         measurements,
@@ -349,7 +352,7 @@ impl Simulation {
             nominal: nominal.name().to_owned(),
             truth: self.truth_label.clone(),
             parameters: TruthFile::parameter_entries(nominal, truth),
-            tracker_frame: self.config.tracker_frame,
+            tracker_frame: self.config.station_tracker_frame(),
             settings: self.config.clone(),
             geometric_errors: self.geometric_errors,
             joints_file: self.joints_file.clone(),
