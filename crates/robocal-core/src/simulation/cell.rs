@@ -308,6 +308,25 @@ impl VirtualCell {
     /// order: with backlash, each joint stops short on the side it came from (from the robot's
     /// home); with thermal growth, row r is measured `r` poses into the warm-up.
     pub fn measure(&mut self, qs: &[Vec<f64>]) -> Result<Readings> {
+        self.measure_approached(qs, None)
+    }
+
+    /// [`VirtualCell::measure`] with each pose's approach directions given (+1 or -1 per joint,
+    /// one list per pose): the program approaches every pose from those sides (an approach
+    /// move before it), instead of from wherever the previous pose left the joints.
+    pub fn measure_approached(
+        &mut self,
+        qs: &[Vec<f64>],
+        given: Option<&[Vec<i8>]>,
+    ) -> Result<Readings> {
+        if let Some(g) = given {
+            if g.len() != qs.len() {
+                return Err(Error::invalid(
+                    "directions",
+                    format!("{} direction lists for {} poses", g.len(), qs.len()),
+                ));
+            }
+        }
         for (i, q) in qs.iter().enumerate() {
             self.truth
                 .check_joints(q, &format!("joint vector {}", i + 1))?;
@@ -315,10 +334,10 @@ impl VirtualCell {
         let mut points = Vec::with_capacity(qs.len());
         let mut exact = Vec::with_capacity(qs.len());
         let mut deflection_mm = Vec::with_capacity(qs.len());
-        let directions = self
-            .backlash
-            .as_ref()
-            .map(|_| approach_directions(&home(&self.truth), qs));
+        let directions = self.backlash.as_ref().map(|_| match given {
+            Some(g) => g.to_vec(),
+            None => approach_directions(&home(&self.truth), qs),
+        });
         let thermal = self.thermal.as_ref().map(|t| {
             (0..qs.len())
                 .map(|r| (t.time_s(r), t.temperature_c(t.time_s(r))))

@@ -3,17 +3,11 @@
 //! (each joint's approach direction) with backlash.
 
 use super::cell::Readings;
+use crate::error::Result;
 use crate::io::measurements::MeasurementSet;
+use crate::io::row_conditions::ConditionsLayout;
 
-/// The temperature column.
-pub const TEMPERATURE_COLUMN: &str = "temperature_c";
-/// The session time column.
-pub const TIME_COLUMN: &str = "time_s";
-
-/// The approach direction column of joint `j` (0-based): `dir1..dirN`.
-pub fn direction_column(j: usize) -> String {
-    format!("dir{}", j + 1)
-}
+pub use crate::io::row_conditions::{direction_column, TEMPERATURE_COLUMN, TIME_COLUMN};
 
 /// Writes the session's conditions of `readings` (one per row of `set`, in order) into `set`'s
 /// extra columns, replacing columns of the same names.
@@ -43,4 +37,24 @@ fn put(set: &mut MeasurementSet, name: &str, value: impl Fn(usize) -> String) {
     for (i, r) in set.rows.iter_mut().enumerate() {
         r.extra[k] = value(i);
     }
+}
+
+/// The approach directions a joint file gives (`dir1..dirN`, every cell +1 or -1), if it does.
+pub(super) fn given_directions(set: &MeasurementSet) -> Result<Option<Vec<Vec<i8>>>> {
+    let layout = ConditionsLayout::of(set)?;
+    if !layout.has_directions() {
+        return Ok(None);
+    }
+    let n = set.dof();
+    let mut out = Vec::with_capacity(set.rows.len());
+    for r in &set.rows {
+        let Some(c) = layout.read(set, r)? else {
+            return Ok(None);
+        };
+        if c.dir[..n].contains(&0) {
+            return Ok(None);
+        }
+        out.push(c.dir[..n].to_vec());
+    }
+    Ok(Some(out))
 }

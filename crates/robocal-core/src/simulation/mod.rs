@@ -70,7 +70,7 @@ pub use session::{
 };
 pub use station::{station_frame, MAX_STATION};
 pub use targets::TargetMeasurement;
-pub use thermal::{grows, scaled_lengths, ThermalModel, TEMPERATURE_STEP_C};
+pub use thermal::{ThermalModel, TEMPERATURE_STEP_C};
 pub use tracker::Tracker;
 pub use truth::{check_truth_matches, parameter_differences, GeometricErrors, TruthSpec};
 pub use truth_file::{OutlierRecord, SetInfo, TruthFile};

@@ -40,7 +40,7 @@ fn backlash_moves_each_pose_against_its_approach_and_writes_the_directions() {
     let plain = simulate(&kr480(), &truth, &quiet(20), &()).unwrap();
     let qs: Vec<Vec<f64>> = s.measurements.rows.iter().map(|r| r.q.clone()).collect();
     let dirs = approach_directions(&home(&table3()), &qs);
-    let frame = s.cell.tracker().frame.clone();
+    let frame = s.cell.tracker().frame;
     let mut moved = 0.0_f64;
     for (i, r) in s.measurements.rows.iter().enumerate() {
         for (j, d) in dirs[i].iter().enumerate() {
@@ -89,7 +89,7 @@ fn thermal_growth_follows_the_warm_up_and_writes_temperature_and_time() {
     // 208 poses of 20 s: more than an hour, most of the 8 K rise.
     let last = *temps.last().unwrap();
     assert!(last > 25.0 && last < 28.0, "{last}");
-    let frame = s.cell.tracker().frame.clone();
+    let frame = s.cell.tracker().frame;
     for (i, r) in s.measurements.rows.iter().enumerate() {
         assert_eq!(times[i], 20.0 * i as f64);
         let grown = t.grown(&table3(), temps[i]);

@@ -159,7 +159,8 @@ pub fn simulate(
 /// and `config` (the poses settings of `config` are not used): how the verification phase
 /// measures commanded joints. The rows keep the file's order and extra columns; any `x,y,z` in
 /// the file are replaced by the new readings. Joint values outside the limits are measured and
-/// reported in [`Simulation::warnings`].
+/// reported in [`Simulation::warnings`]. With backlash, a file with `dir1..dirN` (every cell
+/// given) is approached from those sides; otherwise the directions follow the row order.
 pub fn simulate_joints(
     nominal: &Robot,
     truth: &TruthSpec,
@@ -194,9 +195,10 @@ pub fn simulate_joints(
         }
     }
     let qs: Vec<Vec<f64>> = joints.rows.iter().map(|r| r.q.clone()).collect();
-    let mut done = qs.len();
     let total = 2 * qs.len();
-    let readings = measure(&mut cell, &qs, &mut done, total, observer)?;
+    let given = super::conditions::given_directions(joints)?;
+    let readings = cell.measure_approached(&qs, given.as_deref())?;
+    observer.progress(Stage::Measurement, total, total);
     let rows = joints
         .rows
         .iter()

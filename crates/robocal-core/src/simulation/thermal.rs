@@ -9,8 +9,8 @@
 //!   [`TEMPERATURE_STEP_C`] (what the measurement file holds is what was applied). `start_s`
 //!   places the session on the curve: 0 starts cold, a later session of the same day starts
 //!   warm.
-//! - Every length of the chain (each link's `d` and `a`) and the base column (`base_z`) scales
-//!   by `exp(k (T - ambient_c))`, `k` the linear expansion coefficient (1/K): to first order the
+//! - Every length of the chain (each link's `d` and `a`; the base column of a floor robot is
+//!   `d1`) scales by `exp(k (T - ambient_c))`, `k` the linear expansion coefficient (1/K): to first order the
 //!   textbook `1 + k dT` (the two differ by less than 1e-8 of a length for 100 K), and exactly
 //!   what the calibration family `thermal` models, so that a reference temperature can be chosen
 //!   freely. The true robot's geometry holds at `ambient_c`.
@@ -20,8 +20,12 @@
 //! robot class.
 
 use crate::error::{Error, Result};
-use crate::model::family::{base, link};
-use crate::model::{Param, Robot};
+#[cfg(test)]
+use crate::model::family::thermal::grows;
+use crate::model::family::thermal::scaled_lengths;
+#[cfg(test)]
+use crate::model::Param;
+use crate::model::Robot;
 use serde::{Deserialize, Serialize};
 
 /// The resolution of a simulated temperature (deg C).
@@ -122,27 +126,12 @@ impl ThermalModel {
         format!("{q:.4}").parse().unwrap_or(q)
     }
 
-    /// `robot` at temperature `temperature_c`: every link's `d` and `a` and the base's `z`
-    /// scaled by `exp(k (T - ambient_c))`.
+    /// `robot` at temperature `temperature_c`: every link's `d` and `a` scaled by
+    /// `exp(k (T - ambient_c))`.
     pub fn grown(&self, robot: &Robot, temperature_c: f64) -> Robot {
         let s = (self.expansion_per_k * (temperature_c - self.ambient_c)).exp();
         scaled_lengths(robot, s)
     }
-}
-
-/// Whether `p` is one of the lengths thermal growth scales: a link's `d` or `a`, or `base_z`.
-pub fn grows(p: Param) -> bool {
-    (p.family_id() == link::ID && (p.template() == 1 || p.template() == 2))
-        || (p.family_id() == base::ID && p.template() == 0 && p.index() == 2)
-}
-
-/// `robot` with every length that thermal growth scales ([`grows`]) multiplied by `s`.
-pub fn scaled_lengths(robot: &Robot, s: f64) -> Robot {
-    let mut r = robot.clone();
-    for p in robot.params().into_iter().filter(|p| grows(*p)) {
-        r.set(p, robot.get(p) * s);
-    }
-    r
 }
 
 #[cfg(test)]
@@ -163,7 +152,8 @@ mod tests {
         // At +8 K every grown length is longer by k * 8 to first order.
         let g = m.grown(&kr, 28.0);
         let ps: Vec<Param> = kr.params().into_iter().filter(|p| grows(*p)).collect();
-        assert!(ps.iter().any(|p| p.name() == "base_z"));
+        assert!(!ps.iter().any(|p| p.name() == "base_z"));
+        assert!(ps.iter().any(|p| p.name() == "d1"));
         assert!(ps.iter().any(|p| p.name() == "a2"));
         for p in kr.params() {
             let (a, b) = (kr.get(p), g.get(p));

@@ -15,7 +15,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 const KEY: &str = "qoffset";
-const ID: FamilyId = FamilyId::new(7);
+const ID: FamilyId = FamilyId::new(9);
 
 /// Constant offsets added to the joint values (a test family).
 pub struct JointOffsets;
