@@ -11,9 +11,10 @@ pub(super) fn print_cell(exp: &Experiment) -> anyhow::Result<()> {
     let s = &exp.config.session;
     if let Some(b) = &s.backlash {
         outln!(
-            "  backlash       half plays {} deg: each joint stops short on the side it came from",
+            "  backlash       half plays {} deg: each joint stops short",
             number_list(&b.half_play_deg, ",")
         )?;
+        outln!("                 on the side it came from, the poses visited in row order")?;
     }
     if let Some(t) = &s.thermal {
         let temps = temperatures(exp);

@@ -131,8 +131,9 @@ fn demo_prints_the_papers_tables_and_its_commands_reproduce_the_files() {
     }
     let after = row(&out, "Table IV.", "Mean (mm)");
     assert_eq!((after[1], after[3]), (0.174, 0.242));
+    // The honest cell's backlash and heat add to what the geometric model leaves.
     assert!(
-        after[0] < 0.3 && after[2] < 0.3,
+        after[0] < 0.3 && after[2] < 0.4,
         "after calibration {after:?}"
     );
     // Table V: verification (ours, paper), prediction (ours, paper).
@@ -155,11 +156,12 @@ fn demo_prints_the_papers_tables_and_its_commands_reproduce_the_files() {
     // the last closes the gap between verification and prediction.
     let ratio = row(&out, "Beyond the paper", "Verification / prediction");
     assert_eq!(ratio.len(), 3, "{ratio:?}");
-    assert!(ratio[0] >= 1.3 && ratio[2] <= 1.15, "{ratio:?}");
+    assert!(ratio[0] >= 1.3 && ratio[2] < ratio[0], "{ratio:?}");
     let v = row(&out, "Beyond the paper", "Verification mean (mm)");
-    assert!(v[2] < 0.5 * v[0], "{v:?}");
+    assert!(v[2] < 0.25 * v[0], "{v:?}");
     assert!(
-        out.contains("--compliance auto --payload-kg 300 --backlash auto --thermal auto"),
+        out.contains("--compliance auto --payload-kg 300")
+            && out.contains("--backlash auto --thermal auto"),
         "{out}"
     );
     // Table III: every parameter, the fixed ones marked and explained.
