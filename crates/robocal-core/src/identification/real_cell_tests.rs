@@ -362,3 +362,80 @@ fn the_selection_tries_the_families_only_with_their_columns_and_does_no_harm() {
     assert!(chosen.contains(&"thermal".to_string()), "{chosen:?}");
     assert!(with < without);
 }
+
+/// The bidirectional test: the same poses approached from both sides. The backlash family
+/// brings the mean error to the tracker's noise floor; the geometric model cannot follow the
+/// play.
+#[test]
+fn a_bidirectional_test_reaches_the_floor_with_the_backlash_family_only() {
+    use crate::io::measurements::{Measurement, MeasurementSet};
+    use crate::simulation::{direction_column, simulate_joints};
+    let kr = preset("kuka-kr480-r3330").unwrap();
+    let truth = TruthSpec::Robot(table3());
+    let play = BacklashModel::for_robot(&kr);
+    let cfg = SimulationConfig {
+        seed: 11,
+        poses: 75,
+        backlash: Some(play.clone()),
+        ..SimulationConfig::default()
+    };
+    let sim = simulate(&kr, &truth, &cfg, &()).unwrap();
+    let split = split_measurements(&sim.measurements).unwrap();
+    let data = CalibrationData {
+        calibration: &split.calibration,
+        plane: Some(&split.plane),
+        validation: None,
+    };
+    let settings = CalibrationSettings {
+        objective: Objective::LeastSquares,
+        ..Default::default()
+    };
+    let geometric = calibrate(&kr, data, &settings, &()).unwrap();
+    let mut with = kr.clone();
+    backlash::enable(&mut with, &[0, 1, 2, 3, 4, 5]).unwrap();
+    let family = calibrate(&with, data, &settings, &()).unwrap();
+    // 40 poses of the calibration's set, each approached from below, then from above.
+    let poses: Vec<Vec<f64>> = (0..40).map(|i| split.calibration.q(i).to_vec()).collect();
+    let mut rows = Vec::new();
+    for (k, side) in ["1", "-1"].iter().enumerate() {
+        for (i, q) in poses.iter().enumerate() {
+            rows.push(Measurement {
+                line: 2 + k * poses.len() + i,
+                q: q.clone(),
+                p: None,
+                extra: vec![side.to_string(); 6],
+            });
+        }
+    }
+    let joints = MeasurementSet {
+        path: "bidirectional.csv".into(),
+        joints: kr.joint_space().clone(),
+        extra_columns: (0..6).map(direction_column).collect(),
+        rows,
+        warnings: Vec::new(),
+    };
+    let vcfg = SimulationConfig {
+        seed: 12,
+        ..cfg.clone()
+    };
+    let measured = simulate_joints(&kr, &truth, &vcfg, &joints, &()).unwrap();
+    let obs = crate::evaluation::observations_of(&measured.measurements).unwrap();
+    assert!(obs.has_directions());
+    let mean = |c: &super::pipeline::Calibration| {
+        let model = obs.model_positions(&c.calibrated);
+        let d: f64 = (0..obs.len())
+            .map(|i| (c.frame.to_tracker(&model[i]) - obs.m(i)).norm())
+            .sum();
+        d / obs.len() as f64
+    };
+    let floor = {
+        let d: f64 = (0..obs.len())
+            .map(|i| (measured.measurements.rows[i].p.unwrap() - measured.exact[i]).norm())
+            .sum();
+        d / obs.len() as f64
+    };
+    let (g, f) = (mean(&geometric), mean(&family));
+    eprintln!("bidirectional: geometric {g:.4} mm, with backlash {f:.4} mm, floor {floor:.4} mm");
+    assert!(f <= 1.3 * floor, "with backlash {f} vs floor {floor}");
+    assert!(g > 2.0 * floor, "geometric {g} vs floor {floor}");
+}
