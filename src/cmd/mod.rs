@@ -4,6 +4,7 @@ mod calibrate;
 mod common;
 mod compensate;
 mod demo;
+mod demo_real_cell;
 mod evaluate;
 mod export;
 mod fk;

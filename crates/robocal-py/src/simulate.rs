@@ -267,6 +267,9 @@ pub fn simulate_session(
         gravity,
         outliers,
         repeatability: None,
+        backlash: None,
+        thermal: None,
+        station: 0,
     };
     cfg.validate(nominal).py_err()?;
     if let TruthSpec::Robot(t) = &truth {

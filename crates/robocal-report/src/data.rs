@@ -302,7 +302,7 @@ impl ParamRow {
     pub fn difference(&self) -> f64 {
         let d = self.calibrated - self.nominal;
         match self.unit {
-            Unit::Mm | Unit::MicroradPerNm | Unit::MicroradPerM => d,
+            Unit::Mm | Unit::MicroradPerNm | Unit::MicroradPerM | Unit::PpmPerK => d,
             Unit::Deg => {
                 let w = d.rem_euclid(360.0);
                 if w > 180.0 {

@@ -1,9 +1,11 @@
 //! The settings of a simulated measurement session, validated before any work is done.
 
+use super::backlash::BacklashModel;
 use super::gravity::GravityModel;
 use super::outliers::OutlierModel;
 use super::poses::PoseSampler;
 use super::repeatability::RepeatabilityModel;
+use super::thermal::ThermalModel;
 use crate::error::{Error, Result};
 use crate::io::result::FrameVec;
 use crate::model::Robot;
@@ -64,6 +66,22 @@ pub struct SimulationConfig {
     /// The robot's repeatability: a random error per joint and per move (off when `None`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub repeatability: Option<RepeatabilityModel>,
+    /// Gear play: joints stop short on the side they came from, the poses visited in row
+    /// order (off when `None`; see [`BacklashModel`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub backlash: Option<BacklashModel>,
+    /// Thermal growth of the arm warming up over the session (off when `None`; see
+    /// [`ThermalModel`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<ThermalModel>,
+    /// The tracker set-up: 0 measures from `tracker_frame`, k >= 1 from a fresh station
+    /// elsewhere (see [`super::station_frame`]).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub station: u32,
+}
+
+fn is_zero(v: &u32) -> bool {
+    *v == 0
 }
 
 impl Default for SimulationConfig {
@@ -92,6 +110,9 @@ impl Default for SimulationConfig {
             gravity: None,
             outliers: None,
             repeatability: None,
+            backlash: None,
+            thermal: None,
+            station: 0,
         }
     }
 }
@@ -134,6 +155,7 @@ impl SimulationConfig {
         if let Some(r) = &self.repeatability {
             r.validate(nominal.dof())?;
         }
+        self.validate_real_cell(nominal.dof())?;
         Ok(())
     }
 
