@@ -372,6 +372,9 @@ pub(super) fn demo_table(exp: &robocal_core::experiment::Experiment) -> anyhow::
     let nominal = exp.session.cell.nominal();
     let truth = TruthSpec::Robot(exp.session.cell.truth().clone());
     let mut cfg = exp.config.verification_session();
+    // Measured from the calibration's tracker set-up: its fitted frame maps the points to the
+    // base frame (a verification from another station would need registering again).
+    cfg.station = 0;
     let repeat = RepeatabilityModel::default_for(nominal);
     cfg.repeatability = Some(repeat.clone());
     let frame = exp.result.tracker_frame.to_tracker_frame();
