@@ -250,6 +250,16 @@ fn measure(
         .repeatability
         .as_ref()
         .map(|m| m.attained(cell.truth(), qs, config.seed));
+    // The approach directions are the commanded path's: a joint the program does not move
+    // stays on its side of the gear play, whatever scatter the repeatability adds.
+    let commanded = match (given, &attained, &config.backlash) {
+        (None, Some(_), Some(_)) => Some(super::backlash::approach_directions(
+            &super::backlash::home(cell.truth()),
+            qs,
+        )),
+        _ => None,
+    };
+    let given = given.or(commanded.as_deref());
     let r = cell.measure_approached(attained.as_deref().unwrap_or(qs), given)?;
     *done += qs.len();
     observer.progress(Stage::Measurement, *done, total);
