@@ -59,8 +59,15 @@ pub fn negate(v: &str) -> String {
     }
 }
 
+/// A length in mm (6 decimals) in another unit: metres with 9 decimals (exact), inches as the
+/// shortest text that reads back as the same number.
 fn scaled(v: &str, per_unit_mm: f64) -> String {
-    format!("{}", crate::util::num(v) / per_unit_mm)
+    let x = crate::util::num(v) / per_unit_mm;
+    if per_unit_mm == 1000.0 {
+        format!("{x:.9}")
+    } else {
+        format!("{x}")
+    }
 }
 
 /// `dd.mm.yyyy HH:MM:SS.fff` of seconds after 11.10.2022 00:00:00 (less than a day).
@@ -198,7 +205,7 @@ pub fn rtde(
     let dt = 1.0 / hz;
     let mut n: u64 = 0;
     let mut mids = Vec::new();
-    let mut row = |out: &mut String, q: &[f64], n: &mut u64| {
+    let row = |out: &mut String, q: &[f64], n: &mut u64| {
         let t = t0 + *n as f64 * dt;
         let rad: Vec<String> = q.iter().map(|v| v.to_radians().to_string()).collect();
         out.push_str(&format!("{t:.6} {} {} 7\n", rad[0], rad.join(" ")));

@@ -52,7 +52,9 @@ pub struct Dwell {
     pub first_line: usize,
     /// Line of the last still row.
     pub last_line: usize,
-    /// Mean joint values over the dwell (deg; exactly the logged values when they are constant).
+    /// Each joint's median over the dwell (deg): the value the robot rests at, unmoved by the
+    /// slow last and first samples of the motions before and after (still within `still_deg`)
+    /// and by encoder noise; exactly the logged value when most rows hold it.
     pub q_deg: Vec<f64>,
 }
 
@@ -68,7 +70,9 @@ impl Dwell {
 pub struct DwellFinder {
     settings: DwellSettings,
     anchor: Vec<f64>,
-    sum: Vec<f64>,
+    /// The run's joint values, row after row.
+    samples: Vec<f64>,
+    scratch: Vec<f64>,
     count: usize,
     start: (f64, usize),
     last: (f64, usize),
@@ -81,7 +85,8 @@ impl DwellFinder {
         DwellFinder {
             settings,
             anchor: Vec::new(),
-            sum: Vec::new(),
+            samples: Vec::new(),
+            scratch: Vec::new(),
             count: 0,
             start: (0.0, 0),
             last: (0.0, 0),
@@ -96,16 +101,14 @@ impl DwellFinder {
                 .zip(&self.anchor)
                 .all(|(a, b)| (a - b).abs() <= self.settings.still_deg);
         if still {
-            for ((s, a), b) in self.sum.iter_mut().zip(q).zip(&self.anchor) {
-                *s += a - b;
-            }
+            self.samples.extend_from_slice(q);
             self.count += 1;
         } else {
             self.close();
             self.anchor.clear();
             self.anchor.extend_from_slice(q);
-            self.sum.clear();
-            self.sum.resize(q.len(), 0.0);
+            self.samples.clear();
+            self.samples.extend_from_slice(q);
             self.count = 1;
             self.start = (t, line);
         }
@@ -114,18 +117,20 @@ impl DwellFinder {
 
     fn close(&mut self) {
         if self.count > 1 && self.last.0 - self.start.0 >= self.settings.min_s {
-            let n = self.count as f64;
+            let dof = self.anchor.len();
+            let mut q_deg = Vec::with_capacity(dof);
+            for j in 0..dof {
+                self.scratch.clear();
+                self.scratch
+                    .extend(self.samples.iter().skip(j).step_by(dof.max(1)));
+                q_deg.push(median(&mut self.scratch));
+            }
             self.dwells.push(Dwell {
                 start_s: self.start.0,
                 end_s: self.last.0,
                 first_line: self.start.1,
                 last_line: self.last.1,
-                q_deg: self
-                    .anchor
-                    .iter()
-                    .zip(&self.sum)
-                    .map(|(a, s)| a + s / n)
-                    .collect(),
+                q_deg,
             });
         }
         self.count = 0;
@@ -136,6 +141,18 @@ impl DwellFinder {
         self.close();
         self.dwells
     }
+}
+
+/// The median of `v` (the mean of the two middle values for an even count).
+fn median(v: &mut [f64]) -> f64 {
+    let n = v.len();
+    let (_, hi, _) = v.select_nth_unstable_by(n / 2, f64::total_cmp);
+    let hi = *hi;
+    if n % 2 == 1 {
+        return hi;
+    }
+    let lo = v[..n / 2].iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    0.5 * (lo + hi)
 }
 
 #[cfg(test)]
@@ -174,6 +191,17 @@ mod tests {
         assert_eq!(d[0].first_line, 2);
         assert!((d[0].end_s - d[0].start_s - 1.0).abs() < 0.011);
         assert_eq!(d[1].q_deg, vec![0.1 + 0.2, -(0.1 + 0.2)]);
+        // Slow first and last samples within the tolerance do not move the resting value.
+        let mut f = DwellFinder::new(DwellSettings::default());
+        for (k, q) in [
+            5.0, 5.004, 5.006, 5.007, 5.0071, 5.0071, 5.0071, 5.0071, 5.0071, 5.009,
+        ]
+        .iter()
+        .enumerate()
+        {
+            f.push(k + 1, k as f64 * 0.1, &[*q]);
+        }
+        assert_eq!(f.finish()[0].q_deg, vec![5.0071]);
         assert!((d[1].end_s - d[1].start_s - 2.0).abs() < 0.011);
     }
 }
