@@ -182,7 +182,7 @@ pub fn headerless(path: &Path, first: &str, config: &ImportConfig) -> Result<Joi
             },
             header_line: None,
         },
-        joint_names: (1..=n).map(|k| format!("field {k}")).collect(),
+        joint_names: (1..=n).map(|k| format!("column {k}")).collect(),
         joint_fields: (0..n).collect(),
         kind: JointKind::Model,
         angle_unit,

@@ -150,7 +150,7 @@ impl ImportReport {
         let how = |d: bool| if d { "detected" } else { "given" };
         let mut v = vec![
             format!(
-                "points: {} read as {} ({}; {}), {} points, lengths in {} ({})",
+                "points: {} read as {} ({}; {}), {} points, length unit {} ({})",
                 self.points_path.display(),
                 self.points_format,
                 how(self.points_detected),
@@ -160,7 +160,8 @@ impl ImportReport {
                 self.length_unit_source
             ),
             format!(
-                "joints: {} read as {} ({}; {}), {} rows, columns {} as {} in {} ({})",
+                "joints: {} read as {} ({}; {}), {} rows, joint columns {} ({}, written as {}), \
+                 angle unit {} ({})",
                 self.joints_path.display(),
                 self.joints_format,
                 how(self.joints_detected),
@@ -168,8 +169,12 @@ impl ImportReport {
                 self.joint_rows,
                 self.joint_columns.join(","),
                 match self.joint_kind {
-                    JointKind::Model => "model joint values q",
-                    JointKind::Axis => "controller values axis",
+                    JointKind::Model => "model joint values",
+                    JointKind::Axis => "controller values",
+                },
+                match self.joint_kind {
+                    JointKind::Model => format!("q1..q{}", self.joint_columns.len()),
+                    JointKind::Axis => format!("axis1..axis{}", self.joint_columns.len()),
                 },
                 self.angle_unit,
                 self.angle_unit_source
