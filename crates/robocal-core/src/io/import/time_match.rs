@@ -147,7 +147,14 @@ fn find_offset(
     let width = durations[durations.len() / 2] + 2.0 * tol;
     let step = times.len().div_ceil(VOTERS).max(1);
     let mut votes: HashMap<i64, Vec<f64>> = HashMap::new();
-    for t in times.iter().step_by(step) {
+    // The last point votes too: with evenly spaced dwells, shifting the pairs by whole dwells
+    // then loses the first or the last voter, and the true offset has the most votes.
+    let last = (times.len() - 1) % step != 0;
+    let voters = times
+        .iter()
+        .step_by(step)
+        .chain(times.last().filter(|_| last));
+    for t in voters {
         for d in dwells {
             let o = t - d.mid_s();
             votes.entry((o / width).floor() as i64).or_default().push(o);
@@ -242,6 +249,22 @@ mod tests {
         assert!(m.found);
         assert_eq!(m.unmatched_dwells, vec![3, 7]);
         assert!(m.dwell_of.iter().all(Option::is_some));
+    }
+
+    #[test]
+    fn evenly_spaced_dwells_all_measured_give_one_offset() {
+        let dwells: Vec<Dwell> = (0..3600)
+            .map(|k| dwell(k as f64 * 10.0 + 7.0, k as f64 * 10.0 + 10.0))
+            .collect();
+        let off = 3.0 * 3600.0;
+        let points: Vec<(usize, f64)> = dwells
+            .iter()
+            .enumerate()
+            .map(|(k, d)| (k + 2, d.mid_s() + off))
+            .collect();
+        let m = match_times(Path::new("p"), &points, &dwells, None, 0.2).unwrap();
+        assert!((m.offset_s - off).abs() < 1e-6, "{}", m.offset_s);
+        assert!(m.unmatched_dwells.is_empty());
     }
 
     #[test]
