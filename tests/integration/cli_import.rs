@@ -131,11 +131,7 @@ fn every_layout_round_trips_to_the_simulators_calibration() {
         let o = import(&a, &out);
         o.assert_ok();
         assert!(o.stdout().contains("paired by"), "{}", o.stdout());
-        assert!(
-            o.stdout().contains(&format!("40 of 40 points")),
-            "{}",
-            o.stdout()
-        );
+        assert!(o.stdout().contains("40 of 40 points"), "{}", o.stdout());
         assert_same_parameters(ext, &calibrated(&dir, &out), &base);
     }
 
