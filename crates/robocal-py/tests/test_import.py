@@ -20,7 +20,10 @@ def test_same_csv_and_report_as_the_cli(cli, tmp_path):
                   "--out", str(cli_out))
     assert cli_out.read_text() == got.csv
     assert got.csv.splitlines()[0].startswith("axis1,axis2,axis3,axis4,axis5,axis6,x,y,z")
-    assert all(line in printed for line in got.report)
+    # The same report; the CLI names the settings by its flags (`--length-unit`).
+    assert len(printed.splitlines()) == len(got.report) + 1
+    assert all(line in printed for line in got.report if "setting" not in line)
+    assert any("the `length_unit` setting" in line for line in got.report)
 
 
 def test_time_matching_finds_the_clock_offset():
