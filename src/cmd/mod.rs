@@ -9,6 +9,7 @@ mod evaluate;
 mod export;
 mod fk;
 pub(crate) mod flags;
+mod import;
 mod io_plan;
 mod iso9283;
 mod limits;
@@ -45,6 +46,9 @@ enum Command {
     Fk(fk::FkArgs),
     /// Simulate a measurement: a true robot measured by a virtual laser tracker.
     Simulate(Box<simulate::SimulateArgs>),
+    /// A tracker export and a joint log (as trackers and controllers write them) into a
+    /// measurement CSV: formats and units read, points paired with joints by name, order or time.
+    Import(import::ImportArgs),
     /// Fit the measurement frame and identify the calibrated parameters (writes a result JSON).
     Calibrate(calibrate::CalibrateArgs),
     /// Error statistics of measured data under the nominal and calibrated models (validation),
@@ -80,6 +84,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Robot(c) => robot::run(c),
         Command::Fk(a) => fk::run(a),
         Command::Simulate(a) => simulate::run(*a),
+        Command::Import(a) => import::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Evaluate(a) => evaluate::run(a),
         Command::Compensate(a) => compensate::run(a),

@@ -28,6 +28,7 @@ mod cli_compensate_pose;
 mod cli_compliance;
 mod cli_demo;
 mod cli_evaluate;
+mod cli_import;
 mod cli_interrupted;
 mod cli_iso9283;
 mod cli_joints;

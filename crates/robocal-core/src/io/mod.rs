@@ -5,6 +5,7 @@ pub mod claims;
 pub(crate) mod columns;
 pub(crate) mod csv_lines;
 pub mod export;
+pub mod import;
 pub mod input;
 pub mod inputs;
 pub mod joint_limits;
