@@ -10,8 +10,8 @@ use robocal_core::io::result::FrameVec;
 use robocal_core::io::write_all_atomic;
 use robocal_core::simulation::{
     check_truth_matches, simulate, simulate_joints, BacklashModel, GeometricErrors, GravityModel,
-    OutlierModel, RepeatabilityModel, SimulationConfig, TargetMeasurement, ThermalModel,
-    TruthFile, TruthSpec, SET_VALIDATION,
+    OutlierModel, RepeatabilityModel, SimulationConfig, TargetMeasurement, ThermalModel, TruthFile,
+    TruthSpec, SET_VALIDATION,
 };
 use robocal_core::Robot;
 use std::path::{Path, PathBuf};

@@ -198,7 +198,15 @@ pub fn simulate_joints(
     let total = 2 * qs.len();
     let given = super::conditions::given_directions(joints)?;
     let mut done = qs.len();
-    let readings = measure(&mut cell, &qs, given.as_deref(), config, &mut done, total, observer)?;
+    let readings = measure(
+        &mut cell,
+        &qs,
+        given.as_deref(),
+        config,
+        &mut done,
+        total,
+        observer,
+    )?;
     let rows = joints
         .rows
         .iter()
