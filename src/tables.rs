@@ -39,6 +39,8 @@ pub fn layout(robot: &Robot, cell: &dyn Fn(Param) -> String) -> String {
     // Per-joint columns: (family, template) with a `{j}` template that some joint has.
     let mut joint_cols: Vec<(FamilyId, u8, String)> = Vec::new();
     let mut frame_cols: Vec<(FamilyId, u8, &'static str)> = Vec::new();
+    // Single parameters (a template without placeholder, e.g. `thermal_k`): a line each.
+    let mut singles: Vec<Param> = Vec::new();
     for (id, span) in robot.family_spans() {
         let fam = family::get(*id);
         for (t, tpl) in fam.templates().iter().enumerate() {
@@ -47,6 +49,8 @@ pub fn layout(robot: &Robot, cell: &dyn Fn(Param) -> String) -> String {
             if tpl.contains("{j}") {
                 let title = format!("{} ({})", tpl.replace("{j}", ""), first.unit().as_str());
                 joint_cols.push((*id, t as u8, title));
+            } else if !tpl.contains("{axis}") {
+                singles.push(*first);
             } else {
                 frame_cols.push((*id, t as u8, fam.symbol()));
             }
@@ -97,6 +101,15 @@ pub fn layout(robot: &Robot, cell: &dyn Fn(Param) -> String) -> String {
             let _ = write!(s, "  ({})", unit.as_str());
         }
         s.push('\n');
+    }
+    for p in singles {
+        let _ = writeln!(
+            s,
+            "{:<8} {:>13}  ({})",
+            p.name(),
+            cell(p),
+            p.unit().as_str()
+        );
     }
     s
 }

@@ -19,6 +19,7 @@ use robocal_core::{Param, Robot};
 use std::path::{Path, PathBuf};
 
 mod print;
+mod real_cell;
 pub(crate) use print::print_selection;
 use print::{print_plausibility, print_report};
 
@@ -65,8 +66,9 @@ pub struct CalibrateArgs {
     /// cross-validation over the calibration data (5 folds by pose) among the geometric model and
     /// the geometric model plus transmission harmonics (1, 2), joint compliance and their
     /// combinations; a family stays only when it lowers the cross-validated error by more than
-    /// its standard error. `geometric`: the paper's model. An explicit --compliance or
-    /// --harmonics fixes that family and skips its selection.
+    /// its standard error; backlash when the data have dir1..dirN, thermal expansion when they
+    /// have temperature_c. `geometric`: the paper's model. An explicit --compliance,
+    /// --harmonics, --backlash or --thermal fixes that family and skips its selection.
     #[arg(long, value_enum, default_value_t = ModelArg::Auto)]
     model: ModelArg,
     /// Hayati tilt parameters: `parallel` (every joint whose axis is parallel to the previous
@@ -89,6 +91,18 @@ pub struct CalibrateArgs {
     /// (0 to 8) [default: 0, or chosen by --model auto].
     #[arg(long, value_name = "N")]
     harmonics: Option<usize>,
+    /// Backlash: half the gear play of each joint, against the approach direction of each row
+    /// (`dir1..dirN`, or derived from the row order): `auto` (every revolute joint), a list of
+    /// joint numbers (e.g. `1,2,3`), or `none` [default: none, or chosen by --model auto when
+    /// the data have dir1..dirN].
+    #[arg(long, value_name = "auto|none|J,..")]
+    backlash: Option<String>,
+    /// Thermal expansion: `auto` fits one coefficient (`thermal_k`, ppm/K) by which the links'
+    /// lengths and the base column grow with the data's `temperature_c`, referred to the
+    /// calibration rows' mean temperature (the result's `reference_temperature_c`), or `none`
+    /// [default: none, or chosen by --model auto when the data have temperature_c].
+    #[arg(long, value_parser = ["auto", "none"])]
+    thermal: Option<String>,
     /// Also fit the paper's 12-parameter affine Tr (eq. 8-11) and report it (the tracker frame
     /// stays rigid).
     #[arg(long)]
@@ -378,6 +392,7 @@ impl TryFrom<&CalibrateArgs> for Settings {
         let mut robot = common::robot(&a.robot)?;
         let betas = apply_beta(&mut robot, &a.beta)?;
         let compliant = apply_joint_families(&mut robot, a)?;
+        real_cell::apply(&mut robot, a.backlash.as_deref(), a.thermal.as_deref())?;
         if compliant.is_empty() && a.compliance.as_deref().map(str::trim) == Some("auto") {
             errln!(
                 "note: --compliance auto: no joint of robot `{}` turns under gravity (every axis                  is parallel to its `gravity`); no compliance added",
@@ -468,6 +483,8 @@ impl TryFrom<&CalibrateArgs> for Settings {
                 ModelArg::Auto => ModelChoice::Auto(AutoFamilies {
                     harmonics: a.harmonics.is_none(),
                     compliance: a.compliance.is_none(),
+                    backlash: a.backlash.is_none(),
+                    thermal: a.thermal.is_none(),
                 }),
             },
         };
@@ -491,7 +508,8 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let Settings { robot, betas, .. } = &s;
     let rank_tolerance = s.calibration.identifiability.rank_tolerance;
     let mut outside = Vec::new();
-    let data = read(&s.data, robot, s.nominal_limits, &mut outside)?;
+    let mut data = read(&s.data, robot, s.nominal_limits, &mut outside)?;
+    let robot = &real_cell::fit_to_data(robot, &mut data, &s.data)?;
     let mut validation = data.validation.clone();
     if let Some(v) = &s.validate {
         let vd = read(v, robot, s.nominal_limits, &mut outside)?;
@@ -650,7 +668,7 @@ fn merge(mut a: Observations, b: &Observations) -> anyhow::Result<Observations> 
         return Ok(b.clone());
     }
     for i in 0..b.len() {
-        a.push(b.q(i), *b.m(i), b.line(i))?;
+        a.push_with(b.q(i), *b.m(i), b.extras(i), b.line(i))?;
     }
     Ok(a)
 }

@@ -3,6 +3,7 @@
 //! (position and orientation, on the desired configuration), the tool position with
 //! `--position-only`; or for the targets of a robot program (`--program`, see [`program`]).
 
+mod conditions;
 mod program;
 
 use super::evaluate::calibrated_model;
@@ -33,6 +34,11 @@ pub struct CompensateArgs {
     /// calibration's payload].
     #[arg(long, value_name = "KG")]
     payload_kg: Option<f64>,
+    /// The arm's temperature (deg C) when the commanded poses will run, for a calibration with
+    /// thermal expansion (`calibrate --thermal auto`) [default: the calibration's reference
+    /// temperature].
+    #[arg(long, value_name = "DEG_C", allow_hyphen_values = true)]
+    temperature_c: Option<f64>,
     /// Desired joint values: CSV with q1..qn (model joint values: degrees, mm for a prismatic
     /// joint) or axis1..axisN (controller values, through the robot's [controller]). Each row's
     /// target is its nominal tool position (eq. 13); the solve starts from the row's joints.
@@ -200,6 +206,7 @@ impl TryFrom<&CompensateArgs> for Settings {
         let outputs = plan.check()?;
         let (nominal, mut calibrated, res) = calibrated_model(a.robot.as_deref(), &a.params)?;
         super::common::apply_payload(&mut calibrated, a.payload_kg)?;
+        let calibrated = conditions::fold(&calibrated, a.temperature_c)?;
         if let Some(why) = res.partial_reason() {
             return Err(exit::input(format!(
                 "--params {}: a partial result, not a calibration ({why}); compensation refuses \

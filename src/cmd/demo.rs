@@ -25,6 +25,12 @@ pub struct DemoArgs {
     /// same names in it are replaced).
     #[arg(long, default_value = "robocal-report")]
     out: PathBuf,
+    /// Today's ideal cell: no backlash, no thermal growth, the verification measured in the
+    /// same cell right after the calibration. By default the cell is honest: the KR 480's class
+    /// defaults of backlash and thermal growth, the verification measured later, warm, from
+    /// another tracker station.
+    #[arg(long)]
+    ideal: bool,
 }
 
 /// Every file the demo writes into its directory.
@@ -41,7 +47,7 @@ const OUTPUT_FILES: [&str; 9] = [
 ];
 
 /// A path as the user would type it in a POSIX shell (quoted when needed).
-fn sh(p: &Path) -> String {
+pub(super) fn sh(p: &Path) -> String {
     let s = p.display().to_string();
     if !s.is_empty()
         && s.chars()
@@ -67,7 +73,11 @@ impl TryFrom<&DemoArgs> for Settings {
         IoPlan::new()
             .output_dir("--out", &a.out, &OUTPUT_FILES)
             .check()?;
-        let mut experiment = ExperimentConfig::paper(a.seed)?;
+        let mut experiment = if a.ideal {
+            ExperimentConfig::paper(a.seed)?
+        } else {
+            ExperimentConfig::honest(a.seed)?
+        };
         // Record the files as `robocal calibrate` run by hand on them would.
         let path = |name: &str| a.out.join(name).display().to_string();
         experiment
@@ -101,6 +111,14 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
         }
         None => None,
     };
+    let families = match (&elasto, exp.config.real_cell) {
+        (Some(e), Some(_)) => {
+            bar.note("the calibration with the real cell's families");
+            let c = e.config.with_real_cell_families()?;
+            Some(run_experiment(c, &()).context("running the real cell's calibration")?)
+        }
+        _ => None,
+    };
     bar.note("writing the report");
     let report = ReportData::from_experiment(&exp, &dir.display().to_string())?;
     let rendered = robocal_report::render(&report)?;
@@ -122,15 +140,17 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     print_run(&exp)?;
     print_model_choice(&exp)?;
     if let Some(e) = &elasto {
-        print_elasto(&exp, e, dir)?;
+        print_elasto(&exp, e, families.as_ref(), dir)?;
     }
     print_files(&exp, dir)?;
+    outln!()?;
+    super::iso9283::demo_table(&exp)?;
     outln!("report: {}", path(HTML_FILE).display())?;
     Ok(())
 }
 
 /// Prints `text` wrapped at 100 columns.
-fn para(text: &str) -> anyhow::Result<()> {
+pub(super) fn para(text: &str) -> anyhow::Result<()> {
     let mut line = String::new();
     for w in text.split_whitespace() {
         if !line.is_empty() && line.len() + 1 + w.len() > 100 {
@@ -214,6 +234,7 @@ fn print_run(exp: &Experiment) -> anyhow::Result<()> {
         s.poses,
         s.validation_poses
     )?;
+    super::demo_real_cell::print_cell(exp)?;
     outln!()?;
     match cal.registration.initial {
         InitialFrame::Plane { n, tilt_deg, .. } => para(&format!(
@@ -381,7 +402,15 @@ fn print_model_choice(exp: &Experiment) -> anyhow::Result<()> {
 }
 
 /// The geometric calibration beside the elasto-geometric one, and the verification of both.
-fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) -> anyhow::Result<()> {
+fn print_elasto(
+    geo: &Experiment,
+    el: &Experiment,
+    families: Option<&Experiment>,
+    dir: &Path,
+) -> anyhow::Result<()> {
+    if let Some(f) = families {
+        return super::demo_real_cell::print_families(geo, el, f, dir);
+    }
     let payload = geo
         .config
         .session
@@ -420,7 +449,7 @@ fn print_elasto(geo: &Experiment, el: &Experiment, dir: &Path) -> anyhow::Result
         el.calibration.identifiability.identified.len()
     )?;
     para("By hand, on the files below:")?;
-    command(&[
+    command_line(&[
         "robocal calibrate".to_owned(),
         format!("--robot {PAPER_NOMINAL}"),
         format!("--data {}", sh(&dir.join(files::CELL))),
@@ -498,10 +527,11 @@ fn print_files(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
         format!("--seed {}", s.seed),
     ];
     simulate.extend(gravity.iter().cloned());
+    simulate.extend(super::demo_real_cell::simulate_flags(exp, false));
     simulate.push(format!("--out {}", p(files::CELL)));
     simulate.push(format!("--validation-out {}", p(files::VALIDATION)));
-    command(&simulate)?;
-    command(&[
+    command_line(&simulate)?;
+    command_line(&[
         "robocal calibrate".to_owned(),
         robot.clone(),
         // The paper's model and objective (eq. 4); calibrate's defaults are the model the
@@ -512,7 +542,7 @@ fn print_files(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
         format!("--validate {}", p(files::VALIDATION)),
         format!("--out {}", p(files::RESULT)),
     ])?;
-    command(&[
+    command_line(&[
         "robocal compensate".to_owned(),
         robot.clone(),
         format!("--params {}", p(files::RESULT)),
@@ -528,15 +558,20 @@ fn print_files(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
         format!("--seed {}", cfg.verification_seed),
     ];
     verify.extend(gravity.iter().cloned());
+    verify.extend(super::demo_real_cell::simulate_flags(exp, true));
     verify.push(format!("--out {}", p(files::VERIFY)));
-    command(&verify)?;
-    command(&[
+    command_line(&verify)?;
+    let mut evaluate = vec![
         "robocal evaluate".to_owned(),
         robot,
         format!("--params {}", p(files::RESULT)),
         format!("--data {}", p(files::VERIFY)),
-    ])?;
-    command(&[
+    ];
+    if cfg.real_cell.is_some_and(|r| r.verification_station != 0) {
+        evaluate.push("--refit-frame".to_owned());
+    }
+    command_line(&evaluate)?;
+    command_line(&[
         "robocal report".to_owned(),
         p(files::RESULT),
         format!("--verify {}", p(files::VERIFY)),
@@ -547,7 +582,7 @@ fn print_files(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
 }
 
 /// Prints a shell command made of `parts`, continued with `\` on new lines before 100 columns.
-fn command(parts: &[String]) -> anyhow::Result<()> {
+pub(super) fn command_line(parts: &[String]) -> anyhow::Result<()> {
     let mut line = String::from("  ");
     let mut out = String::new();
     for (i, part) in parts.iter().enumerate() {

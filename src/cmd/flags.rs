@@ -26,6 +26,14 @@ const FLAGS: &[(&str, &str)] = &[
     ("outliers.fraction", "--outlier-fraction"),
     ("outliers.min_mm", "--outlier-min-mm"),
     ("outliers.max_mm", "--outlier-max-mm"),
+    ("repeatability.std_deg", "--repeatability-deg"),
+    // iso9283::PlanSettings, Spec, TrackerMpe
+    ("cycles", "--cycles"),
+    ("edge_mm", "--cube-mm"),
+    ("centre_mm", "--center"),
+    ("orientation_deg", "--orientation"),
+    ("spec", "--spec"),
+    ("tracker_mpe", "--tracker-mpe"),
     // identification::CalibrationSettings
     ("identifiability.fix", "--fix"),
     ("identifiability.free", "--free"),
@@ -53,6 +61,12 @@ const FLAGS: &[(&str, &str)] = &[
     ("tolerance_deg", "--tolerance-deg"),
     // programs (compensate --program)
     ("program", "--program"),
+    // io::import::ImportConfig
+    ("time_offset_s", "--time-offset"),
+    ("time_tolerance_s", "--time-tolerance"),
+    ("dwell.still_deg", "--still-deg"),
+    ("dwell.min_s", "--dwell-min-s"),
+    ("joint_columns", "--joint-columns"),
 ];
 
 /// The flag that sets a library setting, if there is one.
@@ -68,6 +82,16 @@ const PHRASES: &[(&str, &str)] = &[
     ("the `base_link` setting", "--base-link"),
     ("the `tip_link` setting", "--tip-link"),
     ("`base_link` and `tip_link`", "--base-link and --tip-link"),
+    // io::import: errors about files (Parse) name the settings that resolve them.
+    ("the `length_unit` setting", "--length-unit"),
+    ("the `angle_unit` setting", "--angle-unit"),
+    ("the `joint_columns` setting", "--joint-columns"),
+    ("the `name_column` setting", "--name-column"),
+    ("the `match_by` setting", "--match"),
+    ("the `time_offset_s` setting", "--time-offset"),
+    ("`time_tolerance_s` setting", "--time-tolerance"),
+    ("the `dwell.min_s` setting", "--dwell-min-s"),
+    ("the `dwell.still_deg` setting", "--still-deg"),
 ];
 
 /// `text` with every setting named in backticks (`` `noise_mm` ``) replaced by its flag.
@@ -80,6 +104,14 @@ pub fn with_flags(text: &str) -> String {
         }
     }
     out
+}
+
+/// `text` (e.g. a library report's line) with the library's phrases for settings ([`PHRASES`])
+/// replaced by the flags.
+pub fn with_phrases(text: &str) -> String {
+    PHRASES
+        .iter()
+        .fold(text.to_owned(), |t, (phrase, flag)| t.replace(phrase, flag))
 }
 
 /// The text of one error as the user of this program should read it. A library error about

@@ -4,11 +4,14 @@ mod calibrate;
 mod common;
 mod compensate;
 mod demo;
+mod demo_real_cell;
 mod evaluate;
 mod export;
 mod fk;
 pub(crate) mod flags;
+mod import;
 mod io_plan;
+mod iso9283;
 mod limits;
 mod paper_tables;
 mod plan;
@@ -43,6 +46,9 @@ enum Command {
     Fk(fk::FkArgs),
     /// Simulate a measurement: a true robot measured by a virtual laser tracker.
     Simulate(Box<simulate::SimulateArgs>),
+    /// A tracker export and a joint log (as trackers and controllers write them) into a
+    /// measurement CSV: formats and units read, points paired with joints by name, order or time.
+    Import(import::ImportArgs),
     /// Fit the measurement frame and identify the calibrated parameters (writes a result JSON).
     Calibrate(calibrate::CalibrateArgs),
     /// Error statistics of measured data under the nominal and calibrated models (validation),
@@ -57,6 +63,9 @@ enum Command {
     /// D-optimal) from random candidates within the joint limits (and the tracker's range),
     /// compared with random poses.
     Plan(plan::PlanArgs),
+    /// ISO 9283 acceptance test: pose accuracy and repeatability (plan the test, evaluate it).
+    #[command(subcommand)]
+    Iso9283(iso9283::Iso9283Cmd),
     /// The HTML report of a calibration result (tables, histogram, per-point errors, parameters).
     Report(report::ReportArgs),
     /// The calibrated robot of a result as a file for other tools: a URDF (ROS, MoveIt) or a
@@ -75,11 +84,13 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Robot(c) => robot::run(c),
         Command::Fk(a) => fk::run(a),
         Command::Simulate(a) => simulate::run(*a),
+        Command::Import(a) => import::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Evaluate(a) => evaluate::run(a),
         Command::Compensate(a) => compensate::run(a),
         Command::Demo(a) => demo::run(a),
         Command::Plan(a) => plan::run(a),
+        Command::Iso9283(c) => iso9283::run(c),
         Command::Report(a) => report::run(a),
         Command::Export(a) => export::run(a),
         Command::Completions(a) => shell::completions(a),

@@ -1,4 +1,4 @@
-//! `robocal plan`: the poses worth measuring (D-optimal selection from random candidates).
+//! `robocal plan`: the poses worth measuring (I- or D-optimal selection from random candidates).
 
 use super::io_plan::IoPlan;
 use super::{common, limits};
@@ -8,7 +8,7 @@ use robocal_core::io::{
     read_measurements, write_measurements, Measurement, MeasurementSet, Positions,
 };
 use robocal_core::planning::{
-    plan, tracker_range, Criterion, Plan, PlanSettings, DEFAULT_CANDIDATES,
+    plan_observed, tracker_range, Criterion, Plan, PlanSettings, DEFAULT_CANDIDATES,
 };
 use robocal_core::simulation::{SimulationConfig, DEFAULT_NOISE_MM, DEFAULT_NOISE_PER_M};
 use robocal_core::{Robot, TrackerFrame};
@@ -201,7 +201,10 @@ pub fn run(a: PlanArgs) -> anyhow::Result<()> {
         }
         s.plan.include = set.rows.into_iter().map(|r| r.q).collect();
     }
-    let p = plan(&s.robot, &s.plan)?;
+    let bar = crate::progress::Bar::new("planning");
+    let p = plan_observed(&s.robot, &s.plan, &bar);
+    bar.finish();
+    let p = p?;
     print_plan(&s, &p)?;
     let set = MeasurementSet {
         path: s.out.clone(),

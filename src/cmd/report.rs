@@ -41,6 +41,10 @@ pub struct ReportArgs {
     /// Add a table of every point's errors (collapsed until opened; long for large sets).
     #[arg(long)]
     point_table: bool,
+    /// An ISO 9283 test to show: its plan and measured data (`robocal iso9283`), in the result's
+    /// tracker frame; repeat for several (e.g. before and after calibration).
+    #[arg(long, value_name = "PLAN.csv,DATA.csv")]
+    iso9283: Vec<String>,
     #[command(flatten)]
     meta: super::report_meta::MetaArgs,
     /// Directory for report.html and histogram.svg (created if needed).
@@ -253,6 +257,7 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         super::report_meta::now_utc(),
     ));
     report.point_table = point_table;
+    report.iso9283 = super::iso9283::report_tests(&a.iso9283, &nominal, &calibrated, &result)?;
     report.settings.insert(
         0,
         robocal_report::Setting::new("Result file", name(&result_path)),

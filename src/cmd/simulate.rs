@@ -9,8 +9,9 @@ use robocal_core::io::measurements::{measurements_csv, read_measurements, Positi
 use robocal_core::io::result::FrameVec;
 use robocal_core::io::write_all_atomic;
 use robocal_core::simulation::{
-    check_truth_matches, simulate, simulate_joints, GeometricErrors, GravityModel, OutlierModel,
-    SimulationConfig, TargetMeasurement, TruthFile, TruthSpec, SET_VALIDATION,
+    check_truth_matches, simulate, simulate_joints, BacklashModel, GeometricErrors, GravityModel,
+    OutlierModel, RepeatabilityModel, SimulationConfig, TargetMeasurement, ThermalModel, TruthFile,
+    TruthSpec, SET_VALIDATION,
 };
 use robocal_core::Robot;
 use std::path::{Path, PathBuf};
@@ -115,6 +116,38 @@ pub struct SimulateArgs {
     /// frame) beside x,y,z, with this 1-sigma noise per axis (deg, e.g. 0.001).
     #[arg(long, allow_hyphen_values = true, conflicts_with = "outlier_fraction")]
     orientation_sigma_deg: Option<f64>,
+    /// The robot's repeatability: a random error per joint and per move, 1-sigma in degrees (mm
+    /// for a prismatic joint), one value for all joints or one per joint; `default`: the class
+    /// default (each joint's error turns the tool by 0.01 mm at the arm's reach). Repeated poses
+    /// (e.g. an ISO 9283 plan given to --joints) then scatter as on a real robot.
+    #[arg(long, allow_hyphen_values = true, value_name = "V|V1,..,Vn|default")]
+    repeatability_deg: Option<String>,
+    /// Backlash: half the gear play of each joint (deg; mm for a prismatic joint), one value for
+    /// all joints or one per joint, or `auto` for the robot class's default (about half an arc
+    /// minute on a heavy arm). Each joint stops short on the side it came from, the poses
+    /// visited in row order from home; writes `dir1..dirN`.
+    #[arg(long, allow_hyphen_values = true)]
+    backlash_deg: Option<String>,
+    /// Thermal growth: `auto` warms the arm up over the session with the robot class's default
+    /// (a KR 480: 8 K with a one-hour time constant, 20 s per pose, steel); its links and base
+    /// column grow with the temperature; writes `temperature_c` and `time_s`.
+    #[arg(long, value_parser = ["auto", "none"])]
+    thermal: Option<String>,
+    /// Thermal growth: the rise at steady work (K) [default: the class's].
+    #[arg(long, allow_hyphen_values = true, requires = "thermal")]
+    thermal_rise_c: Option<f64>,
+    /// Thermal growth: where on the warm-up curve the session starts (s since the arm started
+    /// working; 0 starts cold) [default: 0].
+    #[arg(long, allow_hyphen_values = true, requires = "thermal")]
+    thermal_start_s: Option<f64>,
+    /// Thermal growth: seconds between two measured poses [default: the class's].
+    #[arg(long, allow_hyphen_values = true, requires = "thermal")]
+    seconds_per_pose: Option<f64>,
+    /// Measure from a fresh tracker set-up: station K (1, 2, ..) is the tracker carried
+    /// elsewhere around the robot (turned 15 to 45 degrees about the base axis) and set up
+    /// again; evaluate such data with --refit-frame [default: 0, the --tracker pose].
+    #[arg(long, default_value_t = 0)]
+    station: u32,
 }
 
 /// A list of numbers: one value for every joint, or one per joint.
@@ -212,7 +245,15 @@ fn config(
         Some(s) => tracker_arg(s)?,
         None => truth_tracker.unwrap_or(d.tracker_frame),
     };
+    let repeatability = match a.repeatability_deg.as_deref() {
+        None => None,
+        Some("default") => Some(RepeatabilityModel::default_for(nominal)),
+        Some(v) => Some(RepeatabilityModel {
+            std_deg: per_joint("--repeatability-deg", v, nominal.dof())?,
+        }),
+    };
     let joints = a.joints.is_some();
+    let (backlash, thermal) = real_cell_args(a, nominal)?;
     Ok(SimulationConfig {
         seed: a.seed,
         poses: a.poses.unwrap_or(0),
@@ -226,7 +267,38 @@ fn config(
         noise_per_m: a.noise_per_m,
         gravity,
         outliers,
+        repeatability,
+        backlash,
+        thermal,
+        station: a.station,
     })
+}
+
+/// The backlash and thermal growth of the flags (checked by the library with the rest).
+fn real_cell_args(
+    a: &SimulateArgs,
+    nominal: &Robot,
+) -> anyhow::Result<(Option<BacklashModel>, Option<ThermalModel>)> {
+    let backlash = match a.backlash_deg.as_deref() {
+        None => None,
+        Some("auto") => Some(BacklashModel::for_robot(nominal)),
+        Some(s) => Some(BacklashModel {
+            half_play_deg: per_joint("--backlash-deg", s, nominal.dof())?,
+        }),
+    };
+    let thermal = match a.thermal.as_deref() {
+        Some("auto") => {
+            let d = ThermalModel::for_robot(nominal);
+            Some(ThermalModel {
+                rise_c: a.thermal_rise_c.unwrap_or(d.rise_c),
+                start_s: a.thermal_start_s.unwrap_or(d.start_s),
+                seconds_per_pose: a.seconds_per_pose.unwrap_or(d.seconds_per_pose),
+                ..d
+            })
+        }
+        _ => None,
+    };
+    Ok((backlash, thermal))
 }
 
 /// The pose counts within [`limits::MAX_POSES`].
@@ -456,6 +528,13 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         cfg.noise_mm,
         cfg.noise_per_m
     )?;
+    if let Some(r) = &cfg.repeatability {
+        let v: Vec<String> = r.std_deg.iter().map(|v| format!("{v:.6}")).collect();
+        outln!(
+            "repeatability: {} deg (mm for a prismatic joint), 1 sigma per joint and move",
+            v.join(",")
+        )?;
+    }
     if let Some(g) = &truth_file.gravity_effect {
         outln!(
             "gravity deflection moved the tool by {:.3} mm on average (max {:.3} mm)",

@@ -253,7 +253,8 @@ fn real_ur5_after_calibration_spreads_over_at_least_8_bins() {
     .unwrap();
     let fig = histogram_svg(&report.histogram, HISTOGRAM_TITLE).unwrap();
     let b = fig.binning.unwrap();
-    assert_eq!(b.n, vec![1000, 1000]);
+    // Before and after on the calibration points, after on the validation points.
+    assert_eq!(b.n, vec![1000, 1000, val.rows.len()]);
     let after = b.occupied(1);
     let biggest = b.counts[1].iter().max().unwrap();
     eprintln!("UR5 after calibration: {after} non-empty bins, largest bar {biggest} points");

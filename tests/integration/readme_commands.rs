@@ -148,6 +148,7 @@ fn every_command_and_flag_is_documented() {
         &["robot", "show"],
         &["fk"],
         &["simulate"],
+        &["import"],
         &["calibrate"],
         &["evaluate"],
         &["compensate"],

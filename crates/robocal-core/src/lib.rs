@@ -38,6 +38,7 @@ pub mod experiment;
 pub mod frame;
 pub mod identification;
 pub mod io;
+pub mod iso9283;
 pub mod kinematics;
 pub mod model;
 pub mod observations;

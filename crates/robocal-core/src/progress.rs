@@ -36,6 +36,12 @@ pub enum Stage {
     TruthComparison,
     /// Monte Carlo trials finished.
     Trials,
+    /// Drawing candidate poses and their Jacobians for a plan.
+    Candidates,
+    /// Choosing a plan's poses greedily (`done` of `total` poses chosen).
+    PoseSelection,
+    /// A plan's exchange passes (`done` of `total` chosen poses reconsidered in this pass).
+    Exchange,
 }
 
 impl Stage {
@@ -54,6 +60,9 @@ impl Stage {
             Stage::Verification => "verifying",
             Stage::TruthComparison => "comparing with the truth",
             Stage::Trials => "trials",
+            Stage::Candidates => "candidates",
+            Stage::PoseSelection => "choosing poses",
+            Stage::Exchange => "exchanging poses",
         }
     }
 }

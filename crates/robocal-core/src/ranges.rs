@@ -137,6 +137,16 @@ pub const MASS: Range = Range {
     why: "1000 t",
 };
 
+/// Thermal expansion coefficients (display ppm/K): ±1e6 ppm/K, a length doubling per kelvin;
+/// real structures have -1 to 25 ppm/K.
+pub const EXPANSION: Range = Range {
+    min: -1e6,
+    max: 1e6,
+    unit: "ppm/K",
+    what: "an expansion coefficient",
+    why: "a length doubling per kelvin",
+};
+
 /// Joint compliances: up to 1 rad per N·m (a spring a 1 N·m torque turns by 57 degrees); real
 /// joints have 1e-8 to 1e-5 rad/(N·m).
 pub const COMPLIANCE: Range = Range {
@@ -161,6 +171,7 @@ impl Range {
             Unit::Deg => &ANGLE,
             Unit::MicroradPerNm => &COMPLIANCE_UNITS,
             Unit::MicroradPerM => &LUMPED_GRAVITY,
+            Unit::PpmPerK => &EXPANSION,
         }
     }
 
@@ -172,6 +183,7 @@ impl Range {
             Unit::Deg => &SIZE_DEG,
             Unit::MicroradPerNm => &COMPLIANCE_UNITS,
             Unit::MicroradPerM => &LUMPED_GRAVITY,
+            Unit::PpmPerK => &EXPANSION,
         }
     }
 

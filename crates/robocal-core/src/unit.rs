@@ -19,6 +19,9 @@ pub enum Unit {
     /// mass's weight, microradians per metre (stored as rad/mm).
     #[serde(rename = "urad/m")]
     MicroradPerM,
+    /// A thermal expansion coefficient, parts per million per kelvin (stored as 1/K).
+    #[serde(rename = "ppm/K")]
+    PpmPerK,
 }
 
 impl Unit {
@@ -29,6 +32,7 @@ impl Unit {
             Unit::Deg => v.to_degrees(),
             Unit::MicroradPerNm => v * 1e6,
             Unit::MicroradPerM => v * 1e9,
+            Unit::PpmPerK => v * 1e6,
         }
     }
 
@@ -39,6 +43,7 @@ impl Unit {
             Unit::Deg => v.to_radians(),
             Unit::MicroradPerNm => v * 1e-6,
             Unit::MicroradPerM => v * 1e-9,
+            Unit::PpmPerK => v * 1e-6,
         }
     }
 
@@ -49,6 +54,7 @@ impl Unit {
             Unit::Deg => "deg",
             Unit::MicroradPerNm => "urad/Nm",
             Unit::MicroradPerM => "urad/m",
+            Unit::PpmPerK => "ppm/K",
         }
     }
 

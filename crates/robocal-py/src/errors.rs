@@ -79,6 +79,11 @@ const KEYWORDS: &[(&str, &str)] = &[
     ("targets", "all_targets"),
     // planning::PlanSettings (robocal.plan)
     ("tracker_range", "range_mm"),
+    // io::import::ImportConfig (robocal.import_measurements)
+    ("time_offset_s", "time_offset"),
+    ("time_tolerance_s", "time_tolerance"),
+    ("dwell.still_deg", "still_deg"),
+    ("dwell.min_s", "dwell_min_s"),
 ];
 
 /// Phrases the library uses for a setting that is no field of its settings structs.

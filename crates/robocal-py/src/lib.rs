@@ -12,6 +12,7 @@ mod calibrate;
 mod compensate;
 mod errors;
 mod evaluate;
+mod import;
 mod options;
 mod plan;
 mod result;
@@ -40,6 +41,7 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(result::read_result, m)?)?;
     m.add_function(wrap_pyfunction!(result::write_result, m)?)?;
     m.add_function(wrap_pyfunction!(result::result_robots, m)?)?;
+    m.add_function(wrap_pyfunction!(import::import_measurements, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

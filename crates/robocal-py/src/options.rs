@@ -360,6 +360,8 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
         "auto" => ModelChoice::Auto(AutoFamilies {
             harmonics: !given("harmonics")?,
             compliance: !given("compliance")?,
+            backlash: true,
+            thermal: true,
         }),
         "geometric" => ModelChoice::Given,
         other => {

@@ -266,6 +266,10 @@ pub fn simulate_session(
         noise_per_m,
         gravity,
         outliers,
+        repeatability: None,
+        backlash: None,
+        thermal: None,
+        station: 0,
     };
     cfg.validate(nominal).py_err()?;
     if let TruthSpec::Robot(t) = &truth {

@@ -26,6 +26,10 @@ pub const MAX_LINEAR_BINS: usize = 60;
 pub const MAX_LOG_BINS: usize = 60;
 /// Ratio of the largest to the smallest series median from which the bins are log-spaced.
 pub const LOG_RATIO: f64 = 10.0;
+/// Log bins start no lower than the smallest series median divided by this: a point a fit
+/// passes through exactly (a sum-of-norms fit does so at some points, 1e-6 mm) does not stretch
+/// the axis over decades where no other point lies; it is counted in the first bin.
+pub const LOG_FLOOR: f64 = 100.0;
 
 /// How the bin edges are spaced.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -55,6 +59,9 @@ pub struct Binning {
     pub skipped: Vec<usize>,
     /// Mean of the finite values per series (NaN for an empty series).
     pub mean: Vec<f64>,
+    /// Values per series below the first edge of log bins (exact fits far below the data's
+    /// spread, see [`LOG_FLOOR`]), counted in the first bin.
+    pub under: Vec<usize>,
 }
 
 impl Binning {
@@ -226,7 +233,13 @@ pub fn bin_series(series: &[&[f64]]) -> Option<Binning> {
     let mut n = Vec::with_capacity(cleaned.len());
     let mut skipped = Vec::with_capacity(cleaned.len());
     let mut mean = Vec::with_capacity(cleaned.len());
+    let mut under = Vec::with_capacity(cleaned.len());
     for (values, k) in &cleaned {
+        under.push(if scale == Scale::Log {
+            values.iter().filter(|&&x| x < edges[0]).count()
+        } else {
+            0
+        });
         let mut c = vec![0usize; total_bins];
         for &x in values {
             c[index(x)] += 1;
@@ -248,6 +261,7 @@ pub fn bin_series(series: &[&[f64]]) -> Option<Binning> {
         n,
         skipped,
         mean,
+        under,
     })
 }
 
@@ -296,6 +310,15 @@ fn log_edges(cleaned: &[(Vec<f64>, usize)], hi: f64) -> Option<Vec<f64>> {
         .flat_map(|(v, _)| v.iter().copied())
         .filter(|&x| x > 0.0)
         .fold(f64::INFINITY, f64::min);
+    // The data's meaningful spread: no lower than the smallest median over LOG_FLOOR.
+    let floor = cleaned
+        .iter()
+        .filter_map(|(v, _)| {
+            let pos: Vec<f64> = v.iter().copied().filter(|&x| x > 0.0).collect();
+            (!pos.is_empty()).then(|| median(&pos) / LOG_FLOOR)
+        })
+        .fold(f64::INFINITY, f64::min);
+    let smallest = smallest.max(if floor.is_finite() { floor } else { 0.0 });
     if !smallest.is_finite() || hi <= smallest {
         return None;
     }
@@ -530,6 +553,33 @@ mod tests {
         for pair in b.edges.windows(2) {
             assert!(((pair[1] / pair[0]).log10() - w).abs() < 1e-9);
         }
+    }
+
+    /// A few exact-fit points (1e-6 mm) among errors of 0.01-0.1 mm do not start the log axis
+    /// five decades low: it starts within two decades of the smallest median, and they are
+    /// counted in the first bin.
+    #[test]
+    fn exact_fit_points_do_not_set_the_log_axis() {
+        let before: Vec<f64> = (0..75).map(|i| 1.0 + 0.02 * i as f64).collect();
+        let mut after: Vec<f64> = (0..75).map(|i| 0.05 + 0.002 * i as f64).collect();
+        for v in after.iter_mut().take(8) {
+            *v = 1e-6;
+        }
+        let b = bin_series(&[&before, &after]).unwrap();
+        assert_eq!(b.scale, Scale::Log);
+        let med = median(&{
+            let mut a = after.clone();
+            a.sort_by(f64::total_cmp);
+            a
+        });
+        assert!(b.edges[0] >= med / LOG_FLOOR / 10.0, "{:?}", b.edges);
+        assert!(b.edges[0] > 1e-4, "{:?}", b.edges);
+        assert_eq!(b.under, [0, 8]);
+        assert_eq!(b.counts[1].iter().sum::<usize>(), 75);
+        assert!(b.counts[1][0] >= 8);
+        // Without them the axis starts at the data.
+        let b = bin_series(&[&before, &after[8..]]).unwrap();
+        assert_eq!(b.under, [0, 0]);
     }
 
     #[test]

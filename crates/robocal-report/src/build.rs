@@ -101,11 +101,13 @@ pub fn paper_tables(
     if let Some(v) = verification {
         tables.push(ErrorTable {
             title: "Verification, measured after compensation (Table V)".into(),
-            caption: Some(
-                "Calibration poses commanded with compensated joint values (eq. 12–14) and \
-                 measured again."
-                    .into(),
-            ),
+            // The verified poses are whichever the verification file holds (the paper's and the
+            // demo's are the calibration poses; the quick start's the validation poses).
+            caption: Some(format!(
+                "The {} poses of the verification file, commanded with compensated joint values \
+                 (eq. 12–14), measured again and compared with their desired positions.",
+                v.n
+            )),
             rows: vec![row("Verification points", v, paper::table5_verification)],
         });
     }

@@ -48,6 +48,8 @@ pub struct ReportData {
     /// Orientation errors of 6-DoF measurements (the angle of `R_measured R_model^T`, deg): one
     /// row per point set and model; empty for point data.
     pub orientation: Vec<AngleRow>,
+    /// ISO 9283 acceptance tests (e.g. before and after calibration); empty: no section.
+    pub iso9283: Vec<crate::iso9283::IsoTest>,
 }
 
 /// One row of the orientation-error table.
@@ -300,7 +302,7 @@ impl ParamRow {
     pub fn difference(&self) -> f64 {
         let d = self.calibrated - self.nominal;
         match self.unit {
-            Unit::Mm | Unit::MicroradPerNm | Unit::MicroradPerM => d,
+            Unit::Mm | Unit::MicroradPerNm | Unit::MicroradPerM | Unit::PpmPerK => d,
             Unit::Deg => {
                 let w = d.rem_euclid(360.0);
                 if w > 180.0 {

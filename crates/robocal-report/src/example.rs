@@ -187,6 +187,7 @@ impl ReportData {
             reach: ReachKind::Radial,
             parameters,
             orientation: Vec::new(),
+            iso9283: Vec::new(),
             identifiability: Some(Identifiability {
                 condition_number: Some(412.7),
                 identified: Some(26),

@@ -45,6 +45,19 @@ impl HistogramFigure {
                 if beyond == 1 { "is" } else { "are" }
             ));
         }
+        let under: usize = b.under.iter().sum();
+        if under > 0 {
+            notes.push(format!(
+                "{under} value{} below {} mm (points the fit passes through almost exactly) {} \
+                 counted in the first bin.",
+                plural(under),
+                axis_number(
+                    b.edges[0],
+                    (1.0 - b.edges[0].log10().floor()).max(1.0) as usize
+                ),
+                if under == 1 { "is" } else { "are" }
+            ));
+        }
         for (s, k) in series.iter().zip(&b.skipped) {
             if *k > 0 {
                 notes.push(format!(

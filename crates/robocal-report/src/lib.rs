@@ -42,6 +42,7 @@ pub mod histogram;
 mod histogram_section;
 mod html;
 mod identification;
+pub mod iso9283;
 mod joints;
 mod map;
 mod markup;
@@ -67,6 +68,7 @@ pub use data::{
     Setting, SolverSummary,
 };
 pub use histogram::{histogram_svg, HistogramFigure};
+pub use iso9283::{IsoPoseRow, IsoTest};
 pub use numfmt::number_list;
 pub use run::RunData;
 pub use scatter::{scatter_svg, ScatterFigure};

@@ -68,15 +68,32 @@ fn reach_of(v: nalgebra::Vector3<f64>) -> f64 {
 /// Per-point errors of `set` against the models (validation) or the desired positions
 /// (verification: `before` is not available and left NaN).
 fn evaluated(run: &RunData, set: &MeasurementSet, against: Against) -> Result<Evaluated> {
-    let frame = run.result.tracker_frame();
-    let nominal_frame = run.result.nominal_frame();
-    let ev: Evaluation = evaluate_framed(
+    let mut frame = run.result.tracker_frame();
+    let mut nominal_frame = run.result.nominal_frame();
+    let mut ev: Evaluation = evaluate_framed(
         run.nominal,
         run.calibrated,
         [&nominal_frame, &frame],
         set,
         against,
     )?;
+    // A verification measured from another tracker station (set up anew): registered again,
+    // under the calibrated model, as `evaluate --refit-frame` does.
+    let mean = ev.series[1].stats.mean_mm;
+    if against == Against::Desired && mean > robocal_core::registration::STATION_MIN_MM {
+        let obs = robocal_core::evaluation::observations_of(set)?;
+        if robocal_core::registration::another_station(run.calibrated, &obs, mean).is_some() {
+            (nominal_frame, frame) =
+                robocal_core::evaluation::station_frames(run.nominal, run.calibrated, set)?;
+            ev = evaluate_framed(
+                run.nominal,
+                run.calibrated,
+                [&nominal_frame, &frame],
+                set,
+                against,
+            )?;
+        }
+    }
     let desired = against == Against::Desired;
     let joints = run.nominal.joint_space();
     let arr = |v: nalgebra::Vector3<f64>| [v.x, v.y, v.z];
@@ -238,6 +255,13 @@ impl ReportData {
             run.with_paper,
         );
         let mut histogram = before_after_histogram(&sets, &[CALIBRATION], &[CALIBRATION]);
+        // The validation points after calibration beside the calibration points.
+        if let Some(v) = sets.iter().find(|s| s.name == VALIDATION) {
+            histogram.push(HistogramSeries::new(
+                "After calibration – validation points",
+                v.points.iter().map(|p| p.after_mm).collect(),
+            ));
+        }
         if let Some(v) = sets.iter().find(|s| s.name == VERIFICATION) {
             histogram[1].label = "After calibration, predicted – calibration points".into();
             histogram.push(HistogramSeries::new(

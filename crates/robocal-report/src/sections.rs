@@ -62,6 +62,11 @@ pub const SECTIONS: &[Section] = &[
         render: crate::map::section,
     },
     Section {
+        id: "iso9283",
+        nav: "ISO 9283",
+        render: crate::iso9283::section,
+    },
+    Section {
         id: "parameters",
         nav: "Parameters",
         render: crate::tables::parameters_section,

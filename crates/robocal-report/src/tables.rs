@@ -106,6 +106,7 @@ fn unit_str(u: Unit) -> &'static str {
         Unit::Deg => "°",
         Unit::MicroradPerNm => "µrad/(N·m)",
         Unit::MicroradPerM => "µrad/m",
+        Unit::PpmPerK => "ppm/K",
     }
 }
 

@@ -431,5 +431,25 @@ mod runs {
             .notes
             .iter()
             .any(|n| n.text.starts_with("No validation set")));
+        // The histogram shows the validation points after calibration beside the calibration
+        // points, all of them.
+        let v = data
+            .histogram
+            .iter()
+            .find(|h| h.label.contains("validation points"))
+            .expect("a validation series");
+        assert_eq!(v.values_mm.len(), e.validation.rows.len());
+        assert!(v.label.starts_with("After calibration"));
+    }
+
+    /// Table V's caption names the poses the verification file holds, not the calibration's.
+    #[test]
+    fn table_v_caption_is_true_to_the_poses_verified() {
+        let e = experiment();
+        let s = e.result.errors.calibration.after;
+        let tables = paper_tables(e.result.errors.calibration, None, Some(s), false);
+        let caption = tables[2].caption.as_deref().unwrap();
+        assert!(caption.contains(&format!("The {} poses of the verification file", s.n)));
+        assert!(!caption.contains("Calibration poses"), "{caption}");
     }
 }

@@ -121,7 +121,10 @@ impl<'a> Evaluator<'a> {
                 "no measured position (x,y,z)",
             ));
         };
-        let t = self.extras.read(self.header, r)?.target;
+        let extras = self.extras.read(self.header, r)?;
+        let t = extras.target;
+        // The row's temperature and approach directions, for models that read them.
+        let c = extras.conditions.unwrap_or_default();
         let targets = self
             .nominal
             .target_count()
@@ -136,10 +139,13 @@ impl<'a> Evaluator<'a> {
         }
         let actual = self.tracker_frame.to_base(&m);
         let first = match &self.desired {
-            None => self.nominal_frame.to_base(&m) - self.nominal.target_position(&r.q, t),
+            None => self.nominal_frame.to_base(&m) - self.nominal.target_position_in(&r.q, t, &c),
             Some(source) => actual - source.position(self.header, r, self.nominal)?,
         };
-        Ok([first, actual - self.calibrated.target_position(&r.q, t)])
+        Ok([
+            first,
+            actual - self.calibrated.target_position_in(&r.q, t, &c),
+        ])
     }
 }
 

@@ -22,6 +22,7 @@
 //! `calibrate`, `compensate`, `simulate --joints` and `evaluate` by hand on those files gives the
 //! same numbers. The library writes nothing; the caller writes [`Experiment::files`].
 
+mod real_cell;
 mod truth_compare;
 
 #[cfg(test)]
@@ -29,6 +30,7 @@ mod elasto_tests;
 #[cfg(test)]
 mod tests;
 
+pub use real_cell::{RealCell, VERIFICATION_START_S};
 pub use truth_compare::{compare_with_truth, TruthComparison};
 
 use crate::compensation::commanded::commanded_csv;
@@ -119,6 +121,10 @@ pub struct ExperimentConfig {
     /// robot's name (a preset name in the paper's experiment; give the file for a robot file),
     /// `data` = `cell.csv`, `validate` = `validation.csv` and `nominal_limits` = false.
     pub result_settings: serde_json::Map<String, serde_json::Value>,
+    /// The real cell's verification (another station, later and warmer), when the session
+    /// simulates one ([`ExperimentConfig::honest`]); `None`: the verification is measured in
+    /// the same cell as the session.
+    pub real_cell: Option<RealCell>,
 }
 
 impl ExperimentConfig {
@@ -146,6 +152,7 @@ impl ExperimentConfig {
             },
             ik: DampedLeastSquares::default(),
             result_settings: serde_json::Map::new(),
+            real_cell: None,
         })
     }
 
@@ -153,14 +160,17 @@ impl ExperimentConfig {
     /// gravity) with the verification seed, measuring given joints (as `robocal simulate
     /// --joints` configures it).
     pub fn verification_session(&self) -> SimulationConfig {
-        SimulationConfig {
-            seed: self.verification_seed,
-            poses: 0,
-            validation_poses: 0,
-            plane_points: false,
-            plane_z_mm: None,
-            ..self.session.clone()
-        }
+        real_cell::verification_session(
+            self,
+            SimulationConfig {
+                seed: self.verification_seed,
+                poses: 0,
+                validation_poses: 0,
+                plane_points: false,
+                plane_z_mm: None,
+                ..self.session.clone()
+            },
+        )
     }
 }
 
@@ -294,6 +304,18 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
     for r in &mut desired_set.rows {
         r.p = None;
     }
+    // Keep only the joints, id and set: not the session's conditions.
+    let keep: Vec<usize> = (0..desired_set.extra_columns.len())
+        .filter(|&k| matches!(desired_set.extra_columns[k].as_str(), "id" | "set"))
+        .collect();
+    desired_set.extra_columns = keep
+        .iter()
+        .map(|&k| desired_set.extra_columns[k].clone())
+        .collect();
+    for r in &mut desired_set.rows {
+        r.extra = keep.iter().map(|&k| r.extra[k].clone()).collect();
+    }
+    real_cell::approach_from_below(&config, &mut desired_set);
     let desired_csv = csv_bytes(&desired_set, files::DESIRED)?;
     let desired = parse_csv(&desired_csv, files::DESIRED, joints, Positions::Optional)?;
     observer.progress(Stage::Measurement, 1, 1);
@@ -302,6 +324,7 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
     //    validation.csv` reads them.
     let split = split_measurements(&data)?;
     let split_val = split_measurements(&validation)?;
+    let nominal = &real_cell::refer_to_data(nominal, &split)?;
     let calibration = calibrate(
         nominal,
         CalibrationData {
@@ -367,7 +390,10 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
     observer.progress(Stage::Calibration, 1, 1);
 
     // 3. Compensation of the calibration poses (eq. 12-14).
-    let comp = Compensator::new(nominal, &calibrated, config.ik)?;
+    //    In a real cell: at the arm's temperature, every pose approached from below.
+    let at = calibrated.at_conditions(&real_cell::compensation_conditions(&config))?;
+    let plain = nominal.at_conditions(&Default::default())?;
+    let comp = Compensator::new(&plain, &at, config.ik)?;
     let qs: Vec<Vec<f64>> = desired.rows.iter().map(|r| r.q.clone()).collect();
     let compensation = comp.compensate_all(&qs, observer)?;
     let extra_rows: Vec<&[String]> = desired.rows.iter().map(|r| r.extra.as_slice()).collect();
@@ -406,13 +432,15 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
     )?;
     let verify_csv = csv_bytes(&verification.measurements, files::VERIFY)?;
     let verify = parse_csv(&verify_csv, files::VERIFY, joints, Positions::Required)?;
-    let verification_errors = evaluate(
-        nominal,
-        &calibrated,
-        &result.tracker_frame(),
-        &verify,
-        Against::Desired,
-    )?;
+    // From another station, the frame is registered again (under the calibrated model).
+    let frame = match config.real_cell {
+        Some(r) if r.verification_station != 0 => crate::registration::refit_frame(
+            &calibrated,
+            &crate::evaluation::observations_of(&verify)?,
+        )?,
+        _ => result.tracker_frame(),
+    };
+    let verification_errors = evaluate(nominal, &calibrated, &frame, &verify, Against::Desired)?;
 
     // 5. The truth in the identified parameters.
     observer.progress(Stage::TruthComparison, 0, 1);

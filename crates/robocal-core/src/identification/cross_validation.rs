@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::identification::pipeline::Calibration;
 use crate::identification::solver::{solve, SolverOptions};
 use crate::identification::system::Problem;
-use crate::observations::{Observations, RowExtras, Weighting};
+use crate::observations::{Observations, Weighting};
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rayon::prelude::*;
@@ -53,16 +53,7 @@ pub fn subset(obs: &Observations, keep: impl Fn(usize) -> bool) -> Result<Observ
     let mut out = Observations::new(obs.dof());
     out.set_mm_per_deg(obs.mm_per_rad().to_radians())?;
     for i in (0..obs.len()).filter(|&i| keep(i)) {
-        out.push_with(
-            obs.q(i),
-            *obs.m(i),
-            RowExtras {
-                target: obs.target(i),
-                rotation: obs.rotation(i).copied(),
-                sigma_mm: obs.sigma_mm(i),
-            },
-            obs.line(i),
-        )?;
+        out.push_with(obs.q(i), *obs.m(i), obs.extras(i), obs.line(i))?;
     }
     Ok(out)
 }

@@ -47,6 +47,8 @@ pub mod system;
 #[cfg(test)]
 mod conditioning_tests;
 #[cfg(test)]
+mod real_cell_tests;
+#[cfg(test)]
 mod selection_tests;
 #[cfg(test)]
 mod targets_tests;

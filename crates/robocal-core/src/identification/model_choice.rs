@@ -21,6 +21,11 @@ pub struct AutoFamilies {
     pub harmonics: bool,
     /// Select joint compliance under gravity (none, or every joint `compliance auto` takes).
     pub compliance: bool,
+    /// Select backlash on every revolute joint (tried only when the calibration data have
+    /// approach directions).
+    pub backlash: bool,
+    /// Select thermal expansion (tried only when the calibration data have temperatures).
+    pub thermal: bool,
 }
 
 impl Default for AutoFamilies {
@@ -28,6 +33,8 @@ impl Default for AutoFamilies {
         AutoFamilies {
             harmonics: true,
             compliance: true,
+            backlash: true,
+            thermal: true,
         }
     }
 }

@@ -337,6 +337,7 @@ impl Calibration {
         });
         result.prediction = self.prediction.as_ref().map(Into::into);
         crate::io::result_payload::record(&mut result, &self.calibrated);
+        crate::io::result_thermal::record(&mut result, &self.calibrated);
         result
     }
 }

@@ -1,6 +1,8 @@
 //! The model the data support (`--model auto`): cross-validation over the calibration data
 //! among the geometric model and the geometric model plus transmission harmonics (1, 2), joint
-//! compliance under gravity, and their combinations.
+//! compliance under gravity, backlash (when the data have approach directions), thermal
+//! expansion (when they have temperatures; referred to their mean temperature), and their
+//! combinations.
 //!
 //! Each candidate is fitted once to all calibration points (the whole calibration, plausibility
 //! gate included), then refitted on each of [`FOLDS`] folds with the fold's poses left out,
@@ -27,7 +29,7 @@ use crate::identification::pipeline::{
     calibrate_model, calibrate_model_for, Calibration, CalibrationData, CalibrationSettings,
     Purpose,
 };
-use crate::model::family::{compliance, transmission};
+use crate::model::family::{backlash, compliance, thermal, transmission};
 use crate::model::Robot;
 use crate::progress::{self, Observer};
 
@@ -78,7 +80,24 @@ pub fn families(robot: &Robot) -> Vec<String> {
     if h > 0 {
         out.push(format!("harmonics {h}"));
     }
+    if !backlash::joints(robot).is_empty() {
+        out.push("backlash".to_string());
+    }
+    if thermal::reference_c(robot).is_some() {
+        out.push("thermal".to_string());
+    }
     out
+}
+
+/// The temperature a thermal candidate refers its lengths to: the mean of the calibration
+/// rows' temperatures, rounded to 0.1 deg C (`None` without temperatures).
+pub fn reference_temperature_c(data: &CalibrationData) -> Option<f64> {
+    let obs = data.calibration;
+    let t: Vec<f64> = (0..obs.len())
+        .map(|i| obs.conditions(i).temperature_c)
+        .filter(|t| t.is_finite())
+        .collect();
+    (!t.is_empty()).then(|| (t.iter().sum::<f64>() / t.len() as f64 * 10.0).round() / 10.0)
 }
 
 /// The candidate robots: `nominal` as given, then with the families `auto` selects.
@@ -97,17 +116,37 @@ pub fn candidates(nominal: &Robot, auto: AutoFamilies) -> Result<Vec<Robot>> {
         vec![None]
     };
     let all: Vec<usize> = (0..nominal.dof()).collect();
+    let with_backlash: &[bool] = if auto.backlash {
+        &[false, true]
+    } else {
+        &[false]
+    };
+    let with_thermal: &[bool] = if auto.thermal {
+        &[false, true]
+    } else {
+        &[false]
+    };
     let mut out = Vec::new();
     for &c in with_compliance {
         for h in &harmonics {
-            let mut r = nominal.clone();
-            if c {
-                compliance::enable(&mut r, &compliant, None)?;
+            for &b in with_backlash {
+                for &t in with_thermal {
+                    let mut r = nominal.clone();
+                    if c {
+                        compliance::enable(&mut r, &compliant, None)?;
+                    }
+                    if let Some(h) = *h {
+                        transmission::enable(&mut r, &all, h)?;
+                    }
+                    if b {
+                        backlash::enable(&mut r, &all)?;
+                    }
+                    if t {
+                        thermal::enable(&mut r, thermal::DEFAULT_REFERENCE_C)?;
+                    }
+                    out.push(r);
+                }
             }
-            if let Some(h) = *h {
-                transmission::enable(&mut r, &all, h)?;
-            }
-            out.push(r);
         }
     }
     // Simplest first: fewer parameters, then the order above.
@@ -123,12 +162,24 @@ pub fn select(
     settings: &CalibrationSettings,
     auto: AutoFamilies,
 ) -> Result<ModelSelection> {
+    // Backlash needs approach directions, thermal expansion temperatures.
+    let reference_c = reference_temperature_c(&data);
+    let auto = AutoFamilies {
+        backlash: auto.backlash && data.calibration.has_directions(),
+        thermal: auto.thermal && reference_c.is_some(),
+        ..auto
+    };
     let mut robots = candidates(nominal, auto)?;
+    if let Some(t) = reference_c {
+        for r in &mut robots {
+            thermal::set_reference_c(r, t)?;
+        }
+    }
     let selectable = robots.len();
     // Families the user fixed are in every candidate: the geometric model beside them tells
     // whether they lower the error at all.
     if !families(nominal).is_empty() {
-        robots.push(geometric(nominal)?);
+        robots.push(geometric(nominal));
     }
     let mut fit_settings = settings.clone();
     fit_settings.model = ModelChoice::Given;
@@ -203,12 +254,10 @@ pub fn select(
     })
 }
 
-/// `robot` without its non-geometric families (compliance, transmission harmonics).
-pub fn geometric(robot: &Robot) -> Result<Robot> {
-    let mut r = robot.clone();
-    compliance::enable(&mut r, &[], None)?;
-    transmission::enable(&mut r, &[], 0)?;
-    Ok(r)
+/// `robot` without its non-geometric families (compliance, transmission harmonics, backlash,
+/// thermal expansion): [`Robot::geometric`].
+pub fn geometric(robot: &Robot) -> Robot {
+    robot.geometric()
 }
 
 /// The remark on families given explicitly (`chosen`, which carries them) that do not lower the

@@ -392,21 +392,38 @@ impl<'a> Problem<'a> {
         let q = self.obs.q(i);
         let (point, flange) = if robot.target_count() == 1 {
             // One target: nothing to share (and the pass is not worth copying).
-            robot.target_screws(q, t, None, Some(&mut *jp), jw.as_deref_mut())
+            robot.target_screws_in(
+                q,
+                t,
+                &self.obs.conditions(i),
+                None,
+                Some(&mut *jp),
+                jw.as_deref_mut(),
+            )
         } else {
             match frames {
-                Some((j, pose)) if self.obs.q(*j) == q => {
+                Some((j, pose))
+                    if self.obs.q(*j) == q
+                        && self.obs.conditions(*j).same(&self.obs.conditions(i)) =>
+                {
                     robot.retarget(pose, t);
                     *j = i;
                 }
                 Some((j, pose)) => {
-                    **pose = robot.pose_frames_target(q, t);
+                    **pose = robot.pose_frames_in(q, t, &self.obs.conditions(i));
                     *j = i;
                 }
-                None => *frames = Some((i, Box::new(robot.pose_frames_target(q, t)))),
+                None => {
+                    *frames = Some((
+                        i,
+                        Box::new(robot.pose_frames_in(q, t, &self.obs.conditions(i))),
+                    ))
+                }
             }
             let pose = &frames.as_ref().expect("set above").1;
-            robot.screws_at(pose, None, Some(&mut *jp), jw.as_deref_mut())
+            let out = robot.screws_at(pose, None, Some(&mut *jp), jw.as_deref_mut());
+            robot.scale_grown_columns(&self.obs.conditions(i), jp);
+            out
         };
         let tool = self.tool_state(robot, t, point, &flange);
         let target = self.target(i);
@@ -429,8 +446,14 @@ impl<'a> Problem<'a> {
     ) {
         let rows = self.kind.rows();
         let t = self.obs.target(i);
-        let (point, flange) =
-            robot.target_screws(self.obs.q(i), t, None, Some(&mut *jp), Some(&mut *jw));
+        let (point, flange) = robot.target_screws_in(
+            self.obs.q(i),
+            t,
+            &self.obs.conditions(i),
+            None,
+            Some(&mut *jp),
+            Some(&mut *jw),
+        );
         let rotation =
             Some(flange.rotation.matrix() * robot.target_tool_frame(t).rotation.matrix());
         let tool = ToolState { point, rotation };
@@ -529,13 +552,19 @@ impl<'a> Problem<'a> {
     ) {
         let t = self.obs.target(i);
         let q = self.obs.q(i);
+        let c = self.obs.conditions(i);
         let f = match flange {
-            Some((j, f)) if self.obs.q(*j) == q => {
+            Some((j, f)) if self.obs.q(*j) == q && self.obs.conditions(*j).same(&c) => {
                 *j = i;
                 *f
             }
             _ => {
-                let f = robot.flange_pose(q);
+                // The row's temperature and approach directions, for models that read them.
+                let f = if c.is_unknown() {
+                    robot.flange_pose(q)
+                } else {
+                    robot.pose_frames_in(q, t, &c).flange
+                };
                 *flange = Some((i, f));
                 f
             }

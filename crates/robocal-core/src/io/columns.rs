@@ -55,13 +55,51 @@ pub(crate) struct ColumnLayout {
 /// `a`...) in any case become lower case; any other name is kept as written.
 fn known_name(h: &str) -> String {
     let lower = h.to_ascii_lowercase();
-    let known = joint_column_index(&lower).is_some()
-        || ["x", "y", "z", "a", "b", "c", "set", "id"].contains(&lower.as_str());
-    if known {
+    if is_known(&lower) {
         lower
     } else {
         h.to_owned()
     }
+}
+
+/// Whether a lower-case name is one of robocal's columns.
+fn is_known(lower: &str) -> bool {
+    joint_column_index(lower).is_some()
+        || ["x", "y", "z", "a", "b", "c", "set", "id"].contains(&lower)
+}
+
+/// The robocal column a header name nearly is, for a robot with `dof` joints: the same but for
+/// separators (`q_1`, `Q 1`, `axis-1`), a unit (`x_mm`, `x [mm]`, `q1(deg)`) or the word
+/// `joint` (`joint1`); `None` for a robocal name or one that is not near any.
+fn near_miss(h: &str, dof: usize) -> Option<String> {
+    let lower = h.to_ascii_lowercase();
+    if is_known(&lower) {
+        return None;
+    }
+    let mut core = lower.clone();
+    for unit in [
+        "(mm)", "[mm]", "(deg)", "[deg]", "(rad)", "[rad]", "_mm", "_deg", "_rad",
+    ] {
+        if let Some(c) = core.strip_suffix(unit) {
+            core = c.to_owned();
+        }
+    }
+    let mut core: String = core
+        .chars()
+        .filter(|c| !matches!(c, '_' | '-' | ' ' | '.'))
+        .collect();
+    for (from, to) in [("joint", "q"), ("j", "q")] {
+        if let Some(rest) = core.strip_prefix(from) {
+            if !rest.is_empty() && rest.bytes().all(|b| b.is_ascii_digit()) {
+                core = format!("{to}{rest}");
+            }
+        }
+    }
+    let wanted = match joint_column_index(&core) {
+        Some((_, j)) => (1..=dof).contains(&j),
+        None => ["x", "y", "z"].contains(&core.as_str()),
+    };
+    (wanted && core != lower).then_some(core)
 }
 
 /// A CSV reader with robocal's settings: a header row, fields trimmed, equal row lengths, the
@@ -175,12 +213,22 @@ impl ColumnLayout {
     /// The header as read, for messages: "header is `a,b`, read as 2 columns separated by
     /// commas".
     pub fn header_seen(&self) -> String {
+        let near: Vec<String> = self
+            .headers
+            .iter()
+            .filter_map(|h| near_miss(h, self.q.len()).map(|w| format!("`{h}` is not `{w}`")))
+            .collect();
         format!(
-            "header is `{}`, read as {} column{} separated by {}",
+            "header is `{}`, read as {} column{} separated by {}{}",
             self.headers.join(","),
             self.headers.len(),
             if self.headers.len() == 1 { "" } else { "s" },
-            crate::io::csv_lines::delimiter_name(self.delimiter)
+            crate::io::csv_lines::delimiter_name(self.delimiter),
+            if near.is_empty() {
+                String::new()
+            } else {
+                format!("; {}", near.join(", "))
+            }
         )
     }
 
@@ -198,9 +246,16 @@ impl ColumnLayout {
         if s.is_empty() {
             return Err(perr("empty cell".into()));
         }
-        let v: f64 = s
-            .parse()
-            .map_err(|_| perr(format!("`{s}` is not a number")))?;
+        // A decimal comma, where commas do not separate the columns (`;` or tab): `12,5`.
+        let v: f64 = match s.parse() {
+            Ok(v) => v,
+            Err(_) if self.delimiter != b',' && s.matches(',').count() == 1 && !s.contains('.') => {
+                s.replace(',', ".")
+                    .parse()
+                    .map_err(|_| perr(format!("`{s}` is not a number")))?
+            }
+            Err(_) => return Err(perr(format!("`{s}` is not a number"))),
+        };
         if !v.is_finite() {
             return Err(perr(format!("`{s}` is not a finite number")));
         }

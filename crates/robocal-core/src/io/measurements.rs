@@ -387,6 +387,37 @@ mod tests {
         assert!(e.contains("read as 1 column separated by commas"), "{e}");
         let e = err("q_1,q_2,x,y,z\n1,2,3,4,5\n", Positions::Required);
         assert!(e.contains("read as 5 columns separated by commas"), "{e}");
+        // Names that are robocal's but for separators, units or `joint` are named.
+        assert!(e.contains("`q_1` is not `q1`, `q_2` is not `q2`"), "{e}");
+        let e = err(
+            "Joint1;Joint2;X [mm];y_mm;z\n1;2;3;4;5\n",
+            Positions::Required,
+        );
+        assert!(e.contains("separated by semicolons"), "{e}");
+        assert!(
+            e.contains("`Joint1` is not `q1`, `Joint2` is not `q2`"),
+            "{e}"
+        );
+        assert!(e.contains("`X [mm]` is not `x`, `y_mm` is not `y`"), "{e}");
+        // A joint the robot lacks is no near miss.
+        let e = err("q1;q2;j3;x;y;zz\n1;2;3;4;5;6\n", Positions::Required);
+        assert!(!e.contains("`j3` is not"), "{e}");
+    }
+
+    /// A decimal comma is read where commas do not separate the columns (`;` or tab), and
+    /// only there.
+    #[test]
+    fn decimal_commas_with_semicolons_or_tabs() {
+        for sep in [";", "\t"] {
+            let text = "q1;q2;x;y;z\n1,5;2;7,25;8;9\n".replace(';', sep);
+            let s = parse(&text, Positions::Required).unwrap();
+            assert_eq!(s.rows[0].q[0], 1.5f64.to_radians());
+            assert_eq!(s.rows[0].p.unwrap().x, 7.25);
+            let bad = "q1;q2;x;y;z\n1,5,1;2;7;8;9\n".replace(';', sep);
+            assert!(err(&bad, Positions::Required).contains("`1,5,1` is not a number"));
+        }
+        // With commas as separators `1,5` is two cells: the row is too long.
+        assert!(parse("q1,q2,x,y,z\n1,5,2,7,8,9\n", Positions::Required).is_err());
     }
 
     #[test]

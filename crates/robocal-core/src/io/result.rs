@@ -435,6 +435,7 @@ impl CalibrationResult {
             r.set_display(p, e.calibrated);
         }
         crate::io::result_payload::apply(self, &mut r, path)?;
+        crate::io::result_thermal::apply(self, &mut r, path)?;
         for name in self.parameters.keys() {
             if r.param_by_name(name).is_err() {
                 return Err(bad(

@@ -22,6 +22,7 @@ pub struct ExtrasLayout {
     target: Option<usize>,
     abc: Option<[usize; 3]>,
     sigma: Option<usize>,
+    conditions: super::row_conditions::ConditionsLayout,
 }
 
 impl ExtrasLayout {
@@ -47,6 +48,7 @@ impl ExtrasLayout {
             target: find(TARGET_COLUMN),
             abc,
             sigma: find(SIGMA_COLUMN),
+            conditions: super::row_conditions::ConditionsLayout::of(set)?,
         })
     }
 
@@ -134,6 +136,7 @@ impl ExtrasLayout {
             }
             out.sigma_mm = Some(s);
         }
+        out.conditions = self.conditions.read(set, row)?;
         Ok(out)
     }
 }

@@ -11,7 +11,10 @@
 //! Joint values are model values in internal units: **radians** for a revolute joint, mm for a
 //! prismatic one (its value adds to the row's d, its phi is a constant); lengths in mm.
 
+pub mod conditions;
 pub mod poe;
+
+pub use conditions::Conditions;
 
 use crate::frame::Frame;
 use crate::model::family::{self, PoseFrames, RigidPose};

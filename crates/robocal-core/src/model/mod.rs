@@ -528,12 +528,14 @@ impl Robot {
         Ok(())
     }
 
-    /// This robot without the families that deflect the joints (its geometric model): what a
-    /// simulated cell's nominal robot and a truth file's parameters describe.
+    /// This robot without the families that deflect the joints or grow with the temperature (its
+    /// geometric model): what a simulated cell's nominal robot and a truth file's parameters
+    /// describe.
     pub fn geometric(&self) -> Robot {
         let mut r = self.clone();
         for fam in family::all() {
-            if fam.deflects_joints(&r) {
+            // Thermal expansion is not geometry either: the lengths at one temperature are.
+            if fam.deflects_joints(&r) || fam.key() == family::thermal::KEY {
                 r.family_store.remove(fam.key());
             }
         }

@@ -12,6 +12,7 @@ pub use weighting::{
 };
 
 use crate::error::{Error, Result};
+use crate::kinematics::Conditions;
 use crate::model::Robot;
 use nalgebra::{Matrix3, Vector3};
 use std::path::{Path, PathBuf};
@@ -41,6 +42,9 @@ pub struct Observations {
     mm_per_rad: f64,
     /// The sum of `sigma` (kept with it).
     sigma_sum: f64,
+    /// Each observation's conditions (temperature, approach directions), when some row has
+    /// them.
+    conditions: Option<Vec<Conditions>>,
 }
 
 impl Default for Observations {
@@ -58,6 +62,8 @@ pub struct RowExtras {
     pub rotation: Option<Matrix3<f64>>,
     /// The point's 1-sigma uncertainty per axis (mm).
     pub sigma_mm: Option<f64>,
+    /// The arm's temperature and the joints' approach directions at the row, when known.
+    pub conditions: Option<Conditions>,
 }
 
 /// Most targets one set of observations may use.
@@ -77,6 +83,7 @@ impl Observations {
             sigma: None,
             mm_per_rad: DEFAULT_MM_PER_DEG.to_degrees(),
             sigma_sum: 0.0,
+            conditions: None,
         }
     }
 
@@ -142,6 +149,9 @@ impl Observations {
         }
         if let Some(s) = &mut self.sigma {
             s.push(f64::NAN);
+        }
+        if let Some(c) = &mut self.conditions {
+            c.push(Conditions::UNKNOWN);
         }
         Ok(())
     }
@@ -216,7 +226,69 @@ impl Observations {
             }
             self.sigma_sum += s;
         }
+        if let Some(c) = extras.conditions {
+            self.conditions
+                .get_or_insert_with(|| vec![Conditions::UNKNOWN; i + 1])[i] = c;
+        }
         Ok(())
+    }
+
+    /// Observation `i`'s conditions (temperature, approach directions; unknown when the rows
+    /// carry none).
+    #[inline]
+    pub fn conditions(&self, i: usize) -> Conditions {
+        self.conditions
+            .as_ref()
+            .map_or(Conditions::UNKNOWN, |c| c[i])
+    }
+
+    /// Whether some observation has a known temperature.
+    pub fn has_temperature(&self) -> bool {
+        self.conditions
+            .as_ref()
+            .is_some_and(|c| c.iter().any(|c| c.temperature_c.is_finite()))
+    }
+
+    /// Whether some observation has a known approach direction.
+    pub fn has_directions(&self) -> bool {
+        self.conditions
+            .as_ref()
+            .is_some_and(|c| c.iter().any(|c| c.dir.iter().any(|d| *d != 0)))
+    }
+
+    /// Sets every observation's approach directions from the order of the observations: the
+    /// sign of each joint's motion from the previous observation (a joint that did not move
+    /// keeps its direction; the first observation's are unknown). Temperatures are kept.
+    pub fn derive_directions(&mut self) {
+        let n = self.len();
+        let mut out = Vec::with_capacity(n);
+        let mut dir = [0_i8; crate::model::MAX_JOINTS];
+        for i in 0..n {
+            if i > 0 {
+                for (j, (a, b)) in self.q(i).iter().zip(self.q(i - 1)).enumerate() {
+                    if a > b {
+                        dir[j] = 1;
+                    } else if a < b {
+                        dir[j] = -1;
+                    }
+                }
+            }
+            out.push(Conditions {
+                dir,
+                ..self.conditions(i)
+            });
+        }
+        self.conditions = Some(out);
+    }
+
+    /// Everything observation `i` carries beside its joints and point.
+    pub fn extras(&self, i: usize) -> RowExtras {
+        RowExtras {
+            target: self.target(i),
+            rotation: self.rotation(i).copied(),
+            sigma_mm: self.sigma_mm(i),
+            conditions: self.conditions.as_ref().map(|c| c[i]),
+        }
     }
 
     /// The 0-based target (reflector) observation `i` measures.
@@ -362,7 +434,7 @@ impl Observations {
     /// The nominal (model) tool positions of every point for `robot` (eq. 1).
     pub fn model_positions(&self, robot: &Robot) -> Vec<Vector3<f64>> {
         (0..self.len())
-            .map(|i| robot.target_position(self.q(i), self.target(i)))
+            .map(|i| robot.target_position_in(self.q(i), self.target(i), &self.conditions(i)))
             .collect()
     }
 
@@ -397,6 +469,10 @@ impl Observations {
                 .iter()
                 .map(|v| v.to_bits())
                 .chain(std::iter::once(self.target(i) as u64))
+                // The same joints at another temperature or from other directions are another
+                // measurement (a bidirectional test), not a repeat.
+                .chain(std::iter::once(self.conditions(i).temperature_c.to_bits()))
+                .chain(self.conditions(i).dir.map(|d| d as u64))
         };
         idx.sort_unstable_by(|&a, &b| bits(a).cmp(bits(b)).then(a.cmp(&b)));
         for w in idx.windows(2) {

@@ -19,6 +19,8 @@
 //! candidates of `sigma sqrt(tr(J_i M^-1 J_i^T))`.
 
 pub mod design;
+pub mod pooled;
+pub mod select;
 #[cfg(test)]
 mod tests;
 
@@ -27,23 +29,17 @@ use crate::frame::TrackerFrame;
 use crate::identification::prediction::point_jacobian;
 use crate::identification::{analyze, IdentifiabilityOptions, Observations};
 use crate::model::{Param, Robot};
+use crate::progress::{Observer, Stage};
 use crate::simulation::{random_poses_within, PoseSampler, TrackerRange};
 pub use design::Criterion;
-use design::{log_det, Blocks, Selector, ROWS};
+use design::{log_det, Blocks, ROWS};
 use nalgebra::{DMatrix, Vector3};
 use rand::SeedableRng;
 use rayon::prelude::*;
+pub use select::{Greedy, MAX_EXCHANGE_PASSES};
 
 /// Default number of candidates.
 pub const DEFAULT_CANDIDATES: usize = 10_000;
-
-/// Largest number of exchange passes.
-pub const MAX_EXCHANGE_PASSES: usize = 4;
-
-/// Candidates the exchange passes consider: the chosen poses and the best-scoring others after
-/// the greedy selection (scores change little once a design is good; the passes over all
-/// candidates would cost ten times as much for the same result).
-const EXCHANGE_SHORTLIST: usize = 1500;
 
 /// Candidates the identifiability analysis looks at (the identifiable set does not change with
 /// more random poses).
@@ -231,6 +227,27 @@ fn quality(m: &DMatrix<f64>, n: usize, scale: &[f64], blocks: &Blocks, noise: f6
 
 /// Plans `settings.poses` poses for `robot` (see the module docs).
 pub fn plan(robot: &Robot, settings: &PlanSettings) -> Result<Plan> {
+    plan_observed(robot, settings, &())
+}
+
+/// [`plan`], reporting its progress to `observer` ([`Stage::Candidates`], then
+/// [`Stage::PoseSelection`] and [`Stage::Exchange`]). A plan whose estimated time
+/// ([`select::estimated_seconds`]) exceeds [`select::MAX_SECONDS`] is refused with the estimate.
+pub fn plan_observed(
+    robot: &Robot,
+    settings: &PlanSettings,
+    observer: &dyn Observer,
+) -> Result<Plan> {
+    plan_with(robot, settings, Greedy::Pooled, observer)
+}
+
+/// [`plan_observed`] with the greedy start made as `greedy` says.
+pub fn plan_with(
+    robot: &Robot,
+    settings: &PlanSettings,
+    greedy: Greedy,
+    observer: &dyn Observer,
+) -> Result<Plan> {
     let s = settings;
     if s.poses == 0 {
         return Err(Error::invalid("poses", "must be at least 1"));
@@ -274,9 +291,15 @@ pub fn plan(robot: &Robot, settings: &PlanSettings) -> Result<Plan> {
             ));
         }
     }
+    observer.progress(Stage::Candidates, 0, 1);
     // Candidates already among the included poses (same seed, same rules) are not offered.
     let mut candidates = draw(robot, s, s.candidates, 1)?;
-    candidates.retain(|q| !s.include.contains(q));
+    let taken: std::collections::HashSet<Vec<u64>> = s
+        .include
+        .iter()
+        .map(|q| q.iter().map(|v| v.to_bits()).collect())
+        .collect();
+    candidates.retain(|q| !taken.contains(&q.iter().map(|v| v.to_bits()).collect::<Vec<_>>()));
     let random = draw(robot, s, s.poses, 2)?;
 
     // The identifiable parameters: analysis of the candidates at their nominal tool points.
@@ -303,6 +326,21 @@ pub fn plan(robot: &Robot, settings: &PlanSettings) -> Result<Plan> {
                 } else {
                     format!(" ({} included)", s.include.len())
                 }
+            ),
+        ));
+    }
+    let secs = select::estimated_seconds(s.poses, candidates.len(), k);
+    if secs > select::MAX_SECONDS {
+        return Err(Error::invalid(
+            "poses",
+            format!(
+                "{} poses of {} candidates for {k} parameters would take about {} minutes \
+                 (estimated; a plan is limited to {} minutes): choose fewer poses or \
+                 candidates, or plan in parts, each part's poses included in the next",
+                s.poses,
+                candidates.len(),
+                (secs / 60.0).ceil(),
+                select::MAX_SECONDS / 60.0
             ),
         ));
     }
@@ -338,33 +376,18 @@ pub fn plan(robot: &Robot, settings: &PlanSettings) -> Result<Plan> {
         included.information(&all_included)
     };
     let ridge = DMatrix::identity(k, k) * 1e-6;
+    observer.progress(Stage::Candidates, 1, 1);
 
-    let mut sel = Selector::new(&blocks, &fixed + &ridge, s.criterion, Some(w.clone()));
-    sel.greedy(s.poses);
-    let greedy_value = sel.value();
-    // The exchange passes on a shortlist: the chosen poses first, then the best others.
-    let greedy: Vec<usize> = sel.selected().to_vec();
-    let scores = sel.scores();
-    let mut others: Vec<usize> = (0..blocks.len()).filter(|i| !greedy.contains(i)).collect();
-    others.sort_by(|a, b| scores[*b].total_cmp(&scores[*a]).then(a.cmp(b)));
-    others.truncate(EXCHANGE_SHORTLIST.saturating_sub(greedy.len()));
-    let short: Vec<usize> = greedy.iter().chain(&others).copied().collect();
-    drop(sel);
-    let sub = blocks.subset(&short);
-    let mut ex = Selector::new(&sub, &fixed + &ridge, s.criterion, Some(w));
-    ex.preselect(&(0..greedy.len()).collect::<Vec<_>>());
-    let (mut passes, mut exchanges) = (0, 0);
-    while passes < MAX_EXCHANGE_PASSES {
-        let (swaps, gain) = ex.exchange_pass();
-        passes += 1;
-        exchanges += swaps;
-        // A pass that improves the criterion by less than 0.1% (ln det by 0.001) ends them.
-        if swaps == 0 || gain < 1e-3 {
-            break;
-        }
-    }
-    let chosen: Vec<usize> = ex.selected().iter().map(|&i| short[i]).collect();
-    let final_value = ex.value();
+    let c = select::choose(
+        &blocks,
+        &(&fixed + &ridge),
+        s.criterion,
+        &w,
+        s.poses,
+        greedy,
+        observer,
+    );
+    let chosen = c.chosen;
     let n_all = s.poses + s.include.len();
     let planned = quality(
         &(&fixed + blocks.information(&chosen)),
@@ -390,9 +413,9 @@ pub fn plan(robot: &Robot, settings: &PlanSettings) -> Result<Plan> {
         identified,
         planned,
         random: random_q,
-        greedy_value,
-        final_value,
-        exchange_passes: passes,
-        exchanges,
+        greedy_value: c.greedy_value,
+        final_value: c.final_value,
+        exchange_passes: c.passes,
+        exchanges: c.exchanges,
     })
 }

@@ -119,3 +119,75 @@ fn tracker_noise_weighting_and_the_d_optimal_criterion() {
     assert!(d.planned.log_det >= p.planned.log_det - 1e-9);
     assert!(p.planned.workspace_rms_mm <= d.planned.workspace_rms_mm * (1.0 + 1e-9));
 }
+
+/// The pooled greedy start (the default) ends, after the exchange passes, at a criterion as good
+/// as the eager greedy's over all candidates (the former algorithm); the exchange passes end in
+/// a local optimum either way: for I-optimality as good on average over 12 cases (seeds; with
+/// and without the tracker's noise model and included poses) and never more than 1% worse, for
+/// D-optimality `det M` never more than 1% smaller in 4 cases.
+#[test]
+fn pooled_greedy_is_as_good_as_the_eager_one() {
+    let robot = preset("kuka-kr480-r3330").unwrap();
+    let frame = TrackerFrame::from_vector_deg(&crate::simulation::DEFAULT_TRACKER_FRAME);
+    let include = plan(&robot, &settings(30, 500)).unwrap().poses;
+    let mut ratios = Vec::new();
+    for seed in 0..16u64 {
+        let criterion = if seed < 12 {
+            Criterion::IOptimal
+        } else {
+            Criterion::DOptimal
+        };
+        let mut s = settings(60, 3000);
+        s.seed = 100 + seed;
+        s.criterion = criterion;
+        s.tracker_origin = (seed % 2 == 1).then(|| frame.origin());
+        if seed % 3 == 2 {
+            s.include = include.clone();
+        }
+        let pooled = plan_with(&robot, &s, Greedy::Pooled, &()).unwrap();
+        let eager = plan_with(&robot, &s, Greedy::Eager, &()).unwrap();
+        eprintln!(
+            "{criterion:?} seed {}: greedy {:.6} (pooled) vs {:.6} (eager), final {:.6} vs {:.6}",
+            s.seed, pooled.greedy_value, eager.greedy_value, pooled.final_value, eager.final_value
+        );
+        match criterion {
+            Criterion::IOptimal => ratios.push(pooled.final_value / eager.final_value),
+            // ln det M: det M within 1%.
+            Criterion::DOptimal => assert!(pooled.final_value >= eager.final_value - 0.01),
+        }
+    }
+    let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+    let worst = ratios.iter().cloned().fold(0.0, f64::max);
+    eprintln!("I-optimal, pooled / eager final criterion: mean {mean:.5}, worst {worst:.5}");
+    assert!(mean <= 1.0, "{ratios:?}");
+    assert!(worst < 1.01, "{ratios:?}");
+}
+
+/// A plan reports its stages in order, each count within its total, the selection up to all
+/// its poses; a plan estimated to take too long is refused with the estimate.
+#[test]
+fn plan_reports_progress_and_refuses_what_would_take_too_long() {
+    use std::sync::Mutex;
+    let robot = preset("kuka-kr480-r3330").unwrap();
+    let heard = Mutex::new(Vec::new());
+    let record = |st: Stage, d: usize, t: usize| heard.lock().unwrap().push((st, d, t));
+    plan_observed(&robot, &settings(40, 1000), &record).unwrap();
+    let heard = heard.into_inner().unwrap();
+    assert!(heard.iter().all(|&(_, d, t)| d <= t), "{heard:?}");
+    let first = |st: Stage| heard.iter().position(|e| e.0 == st).unwrap();
+    assert!(first(Stage::Candidates) < first(Stage::PoseSelection));
+    assert!(first(Stage::PoseSelection) < first(Stage::Exchange));
+    assert!(heard.contains(&(Stage::PoseSelection, 40, 40)));
+    assert!(heard.contains(&(Stage::Candidates, 1, 1)));
+    // 150,000 of 200,000: the exchange passes alone would take hours.
+    let secs = select::estimated_seconds(150_000, 200_000, 26);
+    assert!(secs > select::MAX_SECONDS, "{secs}");
+    assert!(select::estimated_seconds(20_000, 20_000, 20) > select::MAX_SECONDS);
+    let e = plan(&robot, &settings(20_000, 20_000))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("would take about") && e.contains("minutes"),
+        "{e}"
+    );
+}

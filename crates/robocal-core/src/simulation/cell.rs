@@ -1,11 +1,13 @@
 //! [`VirtualCell`]: a true robot, a tracker, optional non-geometric errors and seeded random
 //! streams, measured as a real cell would be.
 
+use super::backlash::{approach_directions, home, BacklashModel};
 use super::config::SimulationConfig;
 use super::gravity::GravityModel;
 use super::outliers::{Outlier, OutlierModel};
 use super::plane::{plane_poses, quantize_joints};
 use super::poses::{random_poses, PoseSampler};
+use super::thermal::ThermalModel;
 use super::tracker::Tracker;
 use super::truth::{check_truth_matches, TruthSpec};
 use crate::error::{Error, Result};
@@ -52,6 +54,11 @@ pub struct Readings {
     pub outliers: Vec<Outlier>,
     /// How far gravity moved each tool point (mm); zeros without a gravity model.
     pub deflection_mm: Vec<f64>,
+    /// Each reading's approach direction per joint (+1 or -1), when the cell has backlash.
+    pub directions: Option<Vec<Vec<i8>>>,
+    /// Each reading's time since the session started (s) and the arm's temperature (deg C),
+    /// when the cell has thermal growth.
+    pub thermal: Option<Vec<(f64, f64)>>,
 }
 
 /// A simulated robot cell: the robot the controller believes in (nominal), the robot that really
@@ -67,6 +74,8 @@ pub struct VirtualCell {
     plane_z_mm: Option<f64>,
     gravity: Option<GravityModel>,
     outliers: Option<OutlierModel>,
+    backlash: Option<BacklashModel>,
+    thermal: Option<ThermalModel>,
     seed: u64,
     plane_rng: ChaCha8Rng,
     cal_rng: ChaCha8Rng,
@@ -89,6 +98,8 @@ impl VirtualCell {
             plane_z_mm: None,
             gravity: None,
             outliers: None,
+            backlash: None,
+            thermal: None,
             seed,
             plane_rng: stream_rng(seed, Stream::Plane),
             cal_rng: stream_rng(seed, Stream::Calibration),
@@ -113,7 +124,7 @@ impl VirtualCell {
             }
         };
         let tracker = Tracker::new(
-            config.tracker_frame.to_tracker_frame(),
+            config.station_tracker_frame().to_tracker_frame(),
             config.noise_mm,
             config.noise_per_m,
         )?;
@@ -126,6 +137,8 @@ impl VirtualCell {
         if let Some(o) = config.outliers {
             cell = cell.with_outliers(o)?;
         }
+        cell.backlash.clone_from(&config.backlash);
+        cell.thermal.clone_from(&config.thermal);
         Ok(cell)
     }
 
@@ -209,11 +222,19 @@ impl VirtualCell {
 
     /// Where the true tool point is (mm, base frame) when the controller is commanded to `q`
     /// (rad): the truth robot's forward kinematics at `q + dq` (gravity deflection, if any).
+    /// Backlash and thermal growth depend on the session (see [`VirtualCell::measure`]).
     pub fn true_position(&self, q: &[f64]) -> Vector3<f64> {
-        match &self.gravity {
-            Some(g) => self.truth.tool_position(&g.deflected(&self.truth, q)),
-            None => self.truth.tool_position(q),
-        }
+        position_of(&self.truth, self.gravity.as_ref(), q)
+    }
+
+    /// The backlash model, if any.
+    pub fn backlash(&self) -> Option<&BacklashModel> {
+        self.backlash.as_ref()
+    }
+
+    /// The thermal growth model, if any.
+    pub fn thermal(&self) -> Option<&ThermalModel> {
+        self.thermal.as_ref()
     }
 
     /// Where target `t`'s frame really is (base frame) when the controller is commanded to `q`
@@ -283,8 +304,29 @@ impl VirtualCell {
     /// Measures the tool at every joint vector (rad), returning the readings with the exact
     /// values, the outliers and the gravity effect. Joint vectors must have the robot's joint
     /// count and finite values; values outside the limits are measured anyway (the caller may
-    /// warn: see [`Robot::joints_outside_limits`]).
+    /// warn: see [`Robot::joints_outside_limits`]). The joint vectors are one session visited in
+    /// order: with backlash, each joint stops short on the side it came from (from the robot's
+    /// home); with thermal growth, row r is measured `r` poses into the warm-up.
     pub fn measure(&mut self, qs: &[Vec<f64>]) -> Result<Readings> {
+        self.measure_approached(qs, None)
+    }
+
+    /// [`VirtualCell::measure`] with each pose's approach directions given (+1 or -1 per joint,
+    /// one list per pose): the program approaches every pose from those sides (an approach
+    /// move before it), instead of from wherever the previous pose left the joints.
+    pub fn measure_approached(
+        &mut self,
+        qs: &[Vec<f64>],
+        given: Option<&[Vec<i8>]>,
+    ) -> Result<Readings> {
+        if let Some(g) = given {
+            if g.len() != qs.len() {
+                return Err(Error::invalid(
+                    "directions",
+                    format!("{} direction lists for {} poses", g.len(), qs.len()),
+                ));
+            }
+        }
         for (i, q) in qs.iter().enumerate() {
             self.truth
                 .check_joints(q, &format!("joint vector {}", i + 1))?;
@@ -292,10 +334,29 @@ impl VirtualCell {
         let mut points = Vec::with_capacity(qs.len());
         let mut exact = Vec::with_capacity(qs.len());
         let mut deflection_mm = Vec::with_capacity(qs.len());
-        for q in qs {
-            let p = self.true_position(q);
+        let directions = self.backlash.as_ref().map(|_| match given {
+            Some(g) => g.to_vec(),
+            None => approach_directions(&home(&self.truth), qs),
+        });
+        let thermal = self.thermal.as_ref().map(|t| {
+            (0..qs.len())
+                .map(|r| (t.time_s(r), t.temperature_c(t.time_s(r))))
+                .collect::<Vec<_>>()
+        });
+        for (r, q) in qs.iter().enumerate() {
+            let grown = match (&self.thermal, &thermal) {
+                (Some(t), Some(v)) => Some(t.grown(&self.truth, v[r].1)),
+                _ => None,
+            };
+            let robot = grown.as_ref().unwrap_or(&self.truth);
+            let reached = match (&self.backlash, &directions) {
+                (Some(b), Some(d)) => Some(b.reached(robot, q, &d[r])),
+                _ => None,
+            };
+            let q = reached.as_deref().unwrap_or(q);
+            let p = position_of(robot, self.gravity.as_ref(), q);
             deflection_mm.push(match &self.gravity {
-                Some(_) => (p - self.truth.tool_position(q)).norm(),
+                Some(_) => (p - robot.tool_position(q)).norm(),
                 None => 0.0,
             });
             exact.push(self.tracker.exact(&p));
@@ -327,7 +388,17 @@ impl VirtualCell {
             exact,
             outliers,
             deflection_mm,
+            directions,
+            thermal,
         })
+    }
+}
+
+/// The tool point of `robot` commanded to `q`, deflected by `gravity` if given.
+fn position_of(robot: &Robot, gravity: Option<&GravityModel>, q: &[f64]) -> Vector3<f64> {
+    match gravity {
+        Some(g) => robot.tool_position(&g.deflected(robot, q)),
+        None => robot.tool_position(q),
     }
 }
 

@@ -1,8 +1,11 @@
 //! The settings of a simulated measurement session, validated before any work is done.
 
+use super::backlash::BacklashModel;
 use super::gravity::GravityModel;
 use super::outliers::OutlierModel;
 use super::poses::PoseSampler;
+use super::repeatability::RepeatabilityModel;
+use super::thermal::ThermalModel;
 use crate::error::{Error, Result};
 use crate::io::result::FrameVec;
 use crate::model::Robot;
@@ -60,6 +63,25 @@ pub struct SimulationConfig {
     pub gravity: Option<GravityModel>,
     /// Gross outliers (off when `None`).
     pub outliers: Option<OutlierModel>,
+    /// The robot's repeatability: a random error per joint and per move (off when `None`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub repeatability: Option<RepeatabilityModel>,
+    /// Gear play: joints stop short on the side they came from, the poses visited in row
+    /// order (off when `None`; see [`BacklashModel`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub backlash: Option<BacklashModel>,
+    /// Thermal growth of the arm warming up over the session (off when `None`; see
+    /// [`ThermalModel`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thermal: Option<ThermalModel>,
+    /// The tracker set-up: 0 measures from `tracker_frame`, k >= 1 from a fresh station
+    /// elsewhere (see [`super::station_frame`]).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub station: u32,
+}
+
+fn is_zero(v: &u32) -> bool {
+    *v == 0
 }
 
 impl Default for SimulationConfig {
@@ -87,6 +109,10 @@ impl Default for SimulationConfig {
             noise_per_m: DEFAULT_NOISE_PER_M,
             gravity: None,
             outliers: None,
+            repeatability: None,
+            backlash: None,
+            thermal: None,
+            station: 0,
         }
     }
 }
@@ -126,6 +152,10 @@ impl SimulationConfig {
         if let Some(o) = &self.outliers {
             o.validate()?;
         }
+        if let Some(r) = &self.repeatability {
+            r.validate(nominal.dof())?;
+        }
+        self.validate_real_cell(nominal.dof())?;
         Ok(())
     }
 

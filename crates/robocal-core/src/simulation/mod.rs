@@ -35,7 +35,9 @@
 //! # Ok::<(), robocal_core::Error>(())
 //! ```
 
+mod backlash;
 mod cell;
+mod conditions;
 mod config;
 mod gravity;
 mod gravity_equivalent;
@@ -43,13 +45,18 @@ mod monte_carlo;
 mod outliers;
 mod plane;
 mod poses;
+mod repeatability;
 mod session;
+mod station;
 mod targets;
+mod thermal;
 mod tracker;
 mod truth;
 mod truth_file;
 
+pub use backlash::{approach_directions, home, BacklashModel, MAX_HALF_PLAY};
 pub use cell::{stream_rng, Readings, Stream, VirtualCell};
+pub use conditions::{direction_column, TEMPERATURE_COLUMN, TIME_COLUMN};
 pub use config::{
     SimulationConfig, DEFAULT_NOISE_MM, DEFAULT_NOISE_PER_M, DEFAULT_TRACKER_FRAME,
     FOOTPRINT_FRACTION,
@@ -59,13 +66,18 @@ pub use monte_carlo::{run_trials, simulate_trials, trial_seed};
 pub use outliers::{Outlier, OutlierModel};
 pub use plane::{plane_poses, quantize_joints, reach_position};
 pub use poses::{random_poses, random_poses_within, PoseSampler, TrackerRange};
+pub use repeatability::{RepeatabilityModel, DEFAULT_TOOL_MM};
 pub use session::{
     simulate, simulate_joints, Simulation, SET_CALIBRATION, SET_PLANE, SET_VALIDATION,
 };
+pub use station::{station_frame, MAX_STATION};
 pub use targets::TargetMeasurement;
+pub use thermal::{ThermalModel, TEMPERATURE_STEP_C};
 pub use tracker::Tracker;
 pub use truth::{check_truth_matches, parameter_differences, GeometricErrors, TruthSpec};
 pub use truth_file::{OutlierRecord, SetInfo, TruthFile};
 
+#[cfg(test)]
+mod real_cell_tests;
 #[cfg(test)]
 mod tests;

@@ -3,6 +3,7 @@
 //! measured (the verification phase), with the truth file that goes beside the data.
 
 use super::cell::{Readings, VirtualCell};
+use super::conditions::write_conditions;
 use super::config::SimulationConfig;
 use super::truth::{GeometricErrors, TruthSpec};
 use super::truth_file::{OutlierRecord, SetInfo, TruthFile};
@@ -127,20 +128,21 @@ pub fn simulate(
     all.extend(plane.iter().cloned());
     all.extend(cal.iter().cloned());
     all.extend(val.iter().cloned());
-    let readings = measure(&mut cell, &all, &mut done, total, observer)?;
+    let readings = measure(&mut cell, &all, None, config, &mut done, total, observer)?;
     let pts = &readings.points;
     let (a, b) = (plane.len(), plane.len() + cal.len());
     let mut rows = Vec::with_capacity(all.len());
     rows.extend(rows_of(plane, &pts[..a], "P", SET_PLANE, 2));
     rows.extend(rows_of(cal, &pts[a..b], "C", SET_CALIBRATION, 2 + a));
     rows.extend(rows_of(val, &pts[b..], "V", SET_VALIDATION, 2 + b));
-    let measurements = MeasurementSet {
+    let mut measurements = MeasurementSet {
         path: PathBuf::from("<simulated>"),
         joints: nominal.joint_space().clone(),
         extra_columns: vec!["id".into(), "set".into()],
         rows,
         warnings: Vec::new(),
     };
+    write_conditions(&mut measurements, &readings);
     Ok(finish(
         cell,
         measurements,
@@ -157,7 +159,8 @@ pub fn simulate(
 /// and `config` (the poses settings of `config` are not used): how the verification phase
 /// measures commanded joints. The rows keep the file's order and extra columns; any `x,y,z` in
 /// the file are replaced by the new readings. Joint values outside the limits are measured and
-/// reported in [`Simulation::warnings`].
+/// reported in [`Simulation::warnings`]. With backlash, a file with `dir1..dirN` (every cell
+/// given) is approached from those sides; otherwise the directions follow the row order.
 pub fn simulate_joints(
     nominal: &Robot,
     truth: &TruthSpec,
@@ -192,9 +195,18 @@ pub fn simulate_joints(
         }
     }
     let qs: Vec<Vec<f64>> = joints.rows.iter().map(|r| r.q.clone()).collect();
-    let mut done = qs.len();
     let total = 2 * qs.len();
-    let readings = measure(&mut cell, &qs, &mut done, total, observer)?;
+    let given = super::conditions::given_directions(joints)?;
+    let mut done = qs.len();
+    let readings = measure(
+        &mut cell,
+        &qs,
+        given.as_deref(),
+        config,
+        &mut done,
+        total,
+        observer,
+    )?;
     let rows = joints
         .rows
         .iter()
@@ -207,13 +219,14 @@ pub fn simulate_joints(
             extra: r.extra.clone(),
         })
         .collect();
-    let measurements = MeasurementSet {
+    let mut measurements = MeasurementSet {
         path: PathBuf::from("<simulated>"),
         joints: nominal.joint_space().clone(),
         extra_columns: joints.extra_columns.clone(),
         rows,
         warnings: Vec::new(),
     };
+    write_conditions(&mut measurements, &readings);
     Ok(finish(
         cell,
         measurements,
@@ -226,15 +239,36 @@ pub fn simulate_joints(
     ))
 }
 
-/// Measures all poses in one batch (outliers are drawn per batch) and reports progress.
+/// Measures all poses in one batch (outliers are drawn per batch) and reports progress. With a
+/// repeatability model the robot stops at the commanded joints plus its random error per move
+/// (the rows keep the commanded joints).
+/// Measures the commanded joints `qs` (approached from the sides `given`, else from where the
+/// previous pose left the joints): the robot attains them within its repeatability, if the
+/// settings give one.
 fn measure(
     cell: &mut VirtualCell,
     qs: &[Vec<f64>],
+    given: Option<&[Vec<i8>]>,
+    config: &SimulationConfig,
     done: &mut usize,
     total: usize,
     observer: &dyn Observer,
 ) -> Result<Readings> {
-    let r = cell.measure(qs)?;
+    let attained = config
+        .repeatability
+        .as_ref()
+        .map(|m| m.attained(cell.truth(), qs, config.seed));
+    // The approach directions are the commanded path's: a joint the program does not move
+    // stays on its side of the gear play, whatever scatter the repeatability adds.
+    let commanded = match (given, &attained, &config.backlash) {
+        (None, Some(_), Some(_)) => Some(super::backlash::approach_directions(
+            &super::backlash::home(cell.truth()),
+            qs,
+        )),
+        _ => None,
+    };
+    let given = given.or(commanded.as_deref());
+    let r = cell.measure_approached(attained.as_deref().unwrap_or(qs), given)?;
     *done += qs.len();
     observer.progress(Stage::Measurement, *done, total);
     Ok(r)
@@ -349,7 +383,7 @@ impl Simulation {
             nominal: nominal.name().to_owned(),
             truth: self.truth_label.clone(),
             parameters: TruthFile::parameter_entries(nominal, truth),
-            tracker_frame: self.config.tracker_frame,
+            tracker_frame: self.config.station_tracker_frame(),
             settings: self.config.clone(),
             geometric_errors: self.geometric_errors,
             joints_file: self.joints_file.clone(),

@@ -31,7 +31,8 @@ impl Simulation {
     /// Measures the session's poses again as `how` says (every target, orientations), replacing
     /// the rows (renumbered in file order: each pose's targets in turn), the exact readings and
     /// the gravity deflections. Nothing changes when `how` asks for nothing more than points.
-    /// Fails for sessions with outliers (they are drawn for single points) and, with
+    /// Fails for sessions with outliers, backlash or thermal growth (simulated for single
+    /// points) and, with
     /// `all_targets`, for a robot with a single target.
     pub fn measure_targets(&mut self, how: &TargetMeasurement) -> Result<()> {
         if !how.is_active() {
@@ -42,6 +43,13 @@ impl Simulation {
                 "outliers",
                 "outliers are drawn for single points: not with several targets or 6-DoF \
                  measurements",
+            ));
+        }
+        if self.cell.backlash().is_some() || self.cell.thermal().is_some() {
+            return Err(Error::invalid(
+                "targets",
+                "backlash and thermal growth are simulated for single points: not with several \
+                 targets or 6-DoF measurements",
             ));
         }
         let count = self.cell.truth().target_count();

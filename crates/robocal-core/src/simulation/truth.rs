@@ -75,7 +75,7 @@ impl GeometricErrors {
                 Unit::Mm => self.length_sigma_mm,
                 Unit::Deg => self.angle_sigma_deg.to_radians(),
                 // Non-geometric coefficients are not geometric errors.
-                Unit::MicroradPerNm | Unit::MicroradPerM => 0.0,
+                Unit::MicroradPerNm | Unit::MicroradPerM | Unit::PpmPerK => 0.0,
             };
             let z: f64 = StandardNormal.sample(rng);
             r.set(p, r.get(p) + sigma * z);

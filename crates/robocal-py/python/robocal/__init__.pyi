@@ -356,3 +356,27 @@ def plan(
     noise_per_m: float = 0.005,
 ) -> Plan:
     """The CLI's ``robocal plan``: the poses worth measuring, and their predicted quality."""
+
+
+class Imported(NamedTuple):
+    csv: str
+    report: Sequence[str]
+
+def import_measurements(
+    points: Union[str, PathLike],
+    joints: Union[str, PathLike],
+    match_by: str,
+    out: Optional[Union[str, PathLike]] = None,
+    *,
+    points_format: str = "auto",
+    joints_format: str = "auto",
+    time_offset: Optional[float] = None,
+    length_unit: Optional[str] = None,
+    angle_unit: Optional[str] = None,
+    joint_columns: Optional[Sequence[str]] = None,
+    name_column: Optional[str] = None,
+    robot: Optional[Robot] = None,
+    still_deg: Optional[float] = None,
+    dwell_min_s: Optional[float] = None,
+    time_tolerance: float = 0.2,
+) -> Imported: ...

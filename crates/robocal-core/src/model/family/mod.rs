@@ -19,15 +19,19 @@
 //!
 //! The geometric families of the paper's 36-parameter model (section II.B):
 //! [`link`] (alpha, d, a, phi), [`beta`] (Hayati tilts), [`base`] (frame B) and [`tool`] (T);
-//! beyond geometry, acting through the joints: [`compliance`] (joint compliance under gravity)
-//! and [`transmission`] (harmonics of the joints' transmission errors).
+//! beyond geometry, acting through the joints: [`compliance`] (joint compliance under gravity),
+//! [`transmission`] (harmonics of the joints' transmission errors) and [`backlash`] (gear play
+//! against the approach direction); and [`thermal`] (lengths growing with the temperature). The
+//! last two read the row's conditions ([`RigidPose::conditions`]).
 
+pub mod backlash;
 pub mod base;
 pub mod beta;
 pub mod compliance;
 pub mod link;
 pub mod plausible;
 pub mod reflector;
+pub mod thermal;
 pub mod tool;
 pub mod transmission;
 
@@ -164,7 +168,7 @@ pub fn by_key(key: &str) -> Option<(FamilyId, &'static dyn ParameterFamily)> {
 
 // The registry: a family's `ID` constant is its position here.
 #[cfg(not(test))]
-static REGISTRY: [&dyn ParameterFamily; 7] = [
+static REGISTRY: [&dyn ParameterFamily; 9] = [
     &link::Link,
     &beta::Beta,
     &base::Base,
@@ -172,11 +176,13 @@ static REGISTRY: [&dyn ParameterFamily; 7] = [
     &reflector::Reflector,
     &compliance::Compliance,
     &transmission::Transmission,
+    &backlash::Backlash,
+    &thermal::Thermal,
 ];
 
 // Tests add a family written only against the trait, which proves the seam (`seam_tests`).
 #[cfg(test)]
-static REGISTRY: [&dyn ParameterFamily; 8] = [
+static REGISTRY: [&dyn ParameterFamily; 10] = [
     &link::Link,
     &beta::Beta,
     &base::Base,
@@ -184,6 +190,8 @@ static REGISTRY: [&dyn ParameterFamily; 8] = [
     &reflector::Reflector,
     &compliance::Compliance,
     &transmission::Transmission,
+    &backlash::Backlash,
+    &thermal::Thermal,
     &seam_tests::JointOffsets,
 ];
 
@@ -262,6 +270,8 @@ pub struct RigidPose {
     pub axes: [(Vector3<f64>, Vector3<f64>); MAX_JOINTS],
     /// The tool point (mm, ACS).
     pub point: Vector3<f64>,
+    /// The measurement row's conditions (temperature, approach directions), when known.
+    pub conditions: crate::kinematics::Conditions,
 }
 
 impl Default for RigidPose {
@@ -270,6 +280,7 @@ impl Default for RigidPose {
             commanded: [0.0; MAX_JOINTS],
             axes: [(Vector3::zeros(), Vector3::zeros()); MAX_JOINTS],
             point: Vector3::zeros(),
+            conditions: crate::kinematics::Conditions::UNKNOWN,
         }
     }
 }

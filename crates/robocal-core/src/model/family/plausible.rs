@@ -91,6 +91,10 @@ impl Plausible {
                     "1 degree of joint deflection at the robot's reach",
                 )
             },
+            Unit::PpmPerK => Plausible::moving(
+                super::thermal::MAX_PPM_PER_K,
+                "250 ppm/K, ten times aluminium's expansion",
+            ),
         }
     }
 

@@ -15,7 +15,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
 const KEY: &str = "qoffset";
-const ID: FamilyId = FamilyId::new(7);
+const ID: FamilyId = FamilyId::new(9);
 
 /// Constant offsets added to the joint values (a test family).
 pub struct JointOffsets;
@@ -103,6 +103,8 @@ fn the_registry_positions_are_the_families_ids() {
             .unwrap();
         super::compliance::enable(&mut r, &[1, 2], Some(10.0)).unwrap();
         super::transmission::enable(&mut r, &[0, 1, 2, 3, 4, 5], 2).unwrap();
+        super::backlash::enable(&mut r, &[0, 1, 2]).unwrap();
+        super::thermal::enable(&mut r, 20.0).unwrap();
         fam.params(&r, &mut ps);
         assert!(!ps.is_empty(), "{}", fam.key());
         for p in ps {

@@ -1,0 +1,334 @@
+//! Tracker exports with a header row (Leica and generic CSV): the header is classified into the
+//! columns robocal uses by the format's own names ([`super::leica`], [`super::csv_points`]),
+//! the rest are listed as ignored, and each row becomes a [`PointRow`].
+
+use super::lines::{comma_ambiguity, is_comma_number, number, Delimiter, Dialect, LineReader};
+use super::points::{quaternion_abc, resolve_length_unit, PointRow, PointTable, U95_PER_SIGMA};
+use super::timestamp;
+use super::units::LengthUnit;
+use super::{ImportConfig, PointsFormat};
+use crate::error::{Error, Result};
+use std::io::BufRead;
+
+/// A column robocal reads from a tracker export.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Col {
+    /// x, y or z (0, 1, 2).
+    Pos(usize),
+    /// A 6-DoF orientation angle A, B or C in degrees (0, 1, 2).
+    Abc(usize),
+    /// Quaternion component 0..3 (scalar first).
+    Quat(usize),
+    /// Expanded uncertainty U(95).
+    U95,
+    /// 1-sigma uncertainty (mm).
+    Sigma,
+    /// Temperature.
+    Temperature,
+    /// Time stamp.
+    Time,
+    /// The point's name.
+    Name,
+}
+
+/// How a format names its columns: `classify(name)` for a header cell's lower-case name
+/// (unit removed).
+pub struct Naming {
+    /// The format.
+    pub format: PointsFormat,
+    /// The column a header name stands for.
+    pub classify: fn(&str) -> Option<Col>,
+    /// The unit a file of this format has when its header names none.
+    pub default_unit: Option<(LengthUnit, &'static str)>,
+}
+
+/// Default names of a point-name column.
+pub const NAME_COLUMNS: [&str; 5] = ["name", "id", "point", "point id", "point name"];
+
+struct Layout {
+    cols: Vec<(usize, Col, String)>,
+    n_header: usize,
+}
+
+/// Reads a headed export.
+pub fn read<R: BufRead>(
+    lines: &mut LineReader<R>,
+    naming: &Naming,
+    config: &ImportConfig,
+) -> Result<PointTable> {
+    let path = lines.path().to_owned();
+    let (header_line, header) = loop {
+        match lines.next_line()? {
+            None => return Err(Error::parse(&path, None, None, "empty file: no header row")),
+            Some((_, l)) if l.trim().is_empty() => continue,
+            Some((n, l)) => break (n, l.to_owned()),
+        }
+    };
+    let delimiter = Delimiter::of_header(&header);
+    let mut cells = Vec::new();
+    delimiter.split(&header, &mut cells);
+    let mut layout = Layout {
+        cols: Vec::new(),
+        n_header: cells.len(),
+    };
+    let mut ignored = Vec::new();
+    let mut file_unit: Option<(LengthUnit, String)> = None;
+    let mut u95_unit = None;
+    let mut fahrenheit = false;
+    let wanted_name = config.name_column.as_deref().map(str::to_lowercase);
+    for (i, cell) in cells.iter().enumerate() {
+        let (name, unit) = super::units::split_header(cell);
+        let col = match &wanted_name {
+            Some(w) if *w == name => Some(Col::Name),
+            Some(_) if NAME_COLUMNS.contains(&name.as_str()) => None,
+            _ => (naming.classify)(&name),
+        };
+        let Some(col) = col else {
+            if !cell.is_empty() {
+                ignored.push(cell.to_string());
+            }
+            continue;
+        };
+        if layout.cols.iter().any(|(_, c, _)| *c == col) {
+            return Err(Error::parse(
+                &path,
+                Some(header_line),
+                Some(cell),
+                "a second column for the same quantity",
+            ));
+        }
+        let unit_err = |u: &str| {
+            Error::parse(
+                &path,
+                Some(header_line),
+                Some(cell),
+                format!("unknown unit `{u}` (mm, m or in); give the `length_unit` setting instead"),
+            )
+        };
+        match (col, &unit) {
+            (Col::Pos(_), Some(u)) => {
+                let lu = LengthUnit::from_word(u).ok_or_else(|| unit_err(u))?;
+                match &file_unit {
+                    Some((other, w)) if *other != lu => {
+                        return Err(Error::parse(
+                            &path,
+                            Some(header_line),
+                            Some(cell),
+                            format!("in {lu}, but {w} is in {other}"),
+                        ))
+                    }
+                    Some(_) => {}
+                    None => file_unit = Some((lu, format!("header `{}`", cell.trim()))),
+                }
+            }
+            (Col::U95, Some(u)) => {
+                u95_unit = Some(LengthUnit::from_word(u).ok_or_else(|| unit_err(u))?);
+            }
+            (Col::Temperature, Some(u)) => {
+                let u = u.trim_start_matches(['°', 'º']).to_ascii_lowercase();
+                match u.as_str() {
+                    "c" => {}
+                    "f" => fahrenheit = true,
+                    _ => {
+                        return Err(Error::parse(
+                            &path,
+                            Some(header_line),
+                            Some(cell),
+                            format!("unknown temperature unit `{u}` (C or F)"),
+                        ))
+                    }
+                }
+            }
+            _ => {}
+        }
+        layout.cols.push((i, col, cell.to_string()));
+    }
+    for (k, axis) in ["x", "y", "z"].iter().enumerate() {
+        if !layout.cols.iter().any(|(_, c, _)| *c == Col::Pos(k)) {
+            return Err(Error::parse(
+                &path,
+                Some(header_line),
+                Some(axis),
+                format!(
+                    "missing column (the header, read as {} columns separated by {}, has: {})",
+                    cells.len(),
+                    delimiter,
+                    cells.join(" | ")
+                ),
+            ));
+        }
+    }
+    let quats = layout
+        .cols
+        .iter()
+        .filter(|(_, c, _)| matches!(c, Col::Quat(_)))
+        .count();
+    if quats != 0 && quats != 4 {
+        return Err(Error::parse(
+            &path,
+            Some(header_line),
+            Some("Q0..Q3"),
+            "a quaternion needs all four columns Q0, Q1, Q2, Q3",
+        ));
+    }
+    let abcs = layout
+        .cols
+        .iter()
+        .filter(|(_, c, _)| matches!(c, Col::Abc(_)))
+        .count();
+    if abcs != 0 && abcs != 3 {
+        return Err(Error::parse(
+            &path,
+            Some(header_line),
+            Some("a,b,c"),
+            "an orientation needs all three columns a, b, c",
+        ));
+    }
+    let (unit, unit_source) =
+        resolve_length_unit(&path, file_unit, config.length_unit, naming.default_unit)?;
+    let u95_k = u95_unit.unwrap_or(unit).to_mm() / unit.to_mm();
+    let mut decimal = None;
+    let mut rows = Vec::new();
+    while let Some((line, text)) = lines.next_line()? {
+        let mut fields = Vec::with_capacity(layout.n_header);
+        if text.trim().is_empty() {
+            continue;
+        }
+        delimiter.split(text, &mut fields);
+        if fields.len() != layout.n_header {
+            if delimiter == Delimiter::Comma && fields.len() > layout.n_header {
+                return Err(comma_ambiguity(&path, line, layout.n_header, fields.len()));
+            }
+            return Err(Error::parse(
+                &path,
+                Some(line),
+                None,
+                format!(
+                    "{} fields where the header (line {header_line}) has {} (a truncated \
+                     export?)",
+                    fields.len(),
+                    layout.n_header
+                ),
+            ));
+        }
+        let dec = *decimal.get_or_insert_with(|| {
+            let x = layout
+                .cols
+                .iter()
+                .find(|(_, c, _)| *c == Col::Pos(0))
+                .unwrap()
+                .0;
+            if delimiter != Delimiter::Comma && is_comma_number(fields[x]) {
+                ','
+            } else {
+                '.'
+            }
+        });
+        rows.push(row(
+            &path,
+            line,
+            &fields,
+            &layout,
+            dec,
+            [u95_k, 1.0 / unit.to_mm()],
+            fahrenheit,
+        )?);
+    }
+    super::points::finish(PointTable {
+        path,
+        format: naming.format,
+        dialect: Dialect {
+            delimiter,
+            decimal: decimal.unwrap_or('.'),
+            header_line: Some(header_line),
+        },
+        length_unit: unit,
+        unit_source,
+        ignored_columns: ignored,
+        rows,
+    })
+}
+
+fn row(
+    path: &std::path::Path,
+    line: usize,
+    fields: &[&str],
+    layout: &Layout,
+    dec: char,
+    // U(95) and sigma_mm values into the file's length unit (`finish` converts to mm).
+    k: [f64; 2],
+    fahrenheit: bool,
+) -> Result<PointRow> {
+    let mut r = PointRow {
+        line,
+        name: None,
+        p: [0.0; 3],
+        abc_deg: None,
+        sigma_mm: None,
+        temperature_c: None,
+        time_s: None,
+    };
+    let mut quat = [None; 4];
+    let mut abc = [0.0; 3];
+    let num = |i: usize, h: &str| number(path, line, h, fields[i], dec);
+    for (i, col, h) in &layout.cols {
+        let v = fields[*i];
+        let optional = !matches!(col, Col::Pos(_));
+        if v.is_empty() && optional {
+            continue;
+        }
+        match *col {
+            Col::Pos(k) => r.p[k] = num(*i, h)?,
+            Col::Abc(k) => {
+                abc[k] = num(*i, h)?;
+                r.abc_deg = Some(abc);
+            }
+            Col::Quat(k) => quat[k] = Some(num(*i, h)?),
+            Col::U95 => r.sigma_mm = Some(num(*i, h)? * k[0] / U95_PER_SIGMA),
+            Col::Sigma => r.sigma_mm = Some(num(*i, h)? * k[1]),
+            Col::Temperature => {
+                let t = num(*i, h)?;
+                r.temperature_c = Some(if fahrenheit {
+                    (t - 32.0) * 5.0 / 9.0
+                } else {
+                    t
+                });
+            }
+            Col::Time => {
+                r.time_s = Some(
+                    timestamp::seconds(v)
+                        .map_err(|m| Error::parse(path, Some(line), Some(h), m))?,
+                )
+            }
+            Col::Name => r.name = Some(v.to_owned()),
+        }
+    }
+    match quat {
+        [Some(a), Some(b), Some(c), Some(d)] => {
+            r.abc_deg = Some(quaternion_abc(path, line, [a, b, c, d])?)
+        }
+        [None, None, None, None] => {}
+        _ => {
+            return Err(Error::parse(
+                path,
+                Some(line),
+                Some("Q0..Q3"),
+                "some quaternion components are empty",
+            ))
+        }
+    }
+    if r.abc_deg.is_some()
+        && layout
+            .cols
+            .iter()
+            .any(|(i, c, _)| matches!(c, Col::Abc(_)) && fields[*i].is_empty())
+    {
+        return Err(Error::parse(
+            path,
+            Some(line),
+            Some("a,b,c"),
+            "some of a, b, c are empty",
+        ));
+    }
+    Ok(r)
+}

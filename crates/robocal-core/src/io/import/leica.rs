@@ -1,0 +1,50 @@
+//! Leica tracker software CSV (e.g. with a T-Mac probe): `X  [mm],Y  [mm],Z  [mm],U(95)  [mm],
+//! U(95) X/Y/Z [mm],Tilt [deg],Q0,Q1,Q2,Q3,Image RMS [µm],Target,Temperature [C],Pressure [mBar],
+//! Humidity [%],Time Stamp,OTG Applied,Delete`. Read: X, Y, Z (unit from the header), U(95)
+//! as `sigma_mm` (divided by [`super::points::U95_PER_SIGMA`]), Q0..Q3 (scalar first) as a,b,c,
+//! Temperature (C or F), Time Stamp (day first, leading apostrophe), and a point-name column
+//! when there is one. Other columns are listed as ignored.
+
+use super::headed::{Col, Naming, NAME_COLUMNS};
+use super::lines::LineReader;
+use super::points::PointTable;
+use super::{ImportConfig, PointsFormat};
+use crate::error::Result;
+use std::io::BufRead;
+
+/// The column a Leica header name stands for.
+pub fn classify(name: &str) -> Option<Col> {
+    Some(match name {
+        "x" => Col::Pos(0),
+        "y" => Col::Pos(1),
+        "z" => Col::Pos(2),
+        "u(95)" => Col::U95,
+        "q0" => Col::Quat(0),
+        "q1" => Col::Quat(1),
+        "q2" => Col::Quat(2),
+        "q3" => Col::Quat(3),
+        "temperature" => Col::Temperature,
+        "time stamp" | "timestamp" => Col::Time,
+        n if NAME_COLUMNS.contains(&n) => Col::Name,
+        _ => return None,
+    })
+}
+
+/// Whether a header line looks like a Leica export (`U(95)` or `Time Stamp` beside X, Y, Z).
+pub fn looks_like(header: &str) -> bool {
+    let h = header.to_ascii_lowercase();
+    (h.contains("u(95)") || h.contains("time stamp")) && h.contains("x ")
+}
+
+/// Reads a Leica export.
+pub fn read<R: BufRead>(lines: &mut LineReader<R>, config: &ImportConfig) -> Result<PointTable> {
+    super::headed::read(
+        lines,
+        &Naming {
+            format: PointsFormat::Leica,
+            classify,
+            default_unit: None,
+        },
+        config,
+    )
+}

@@ -1,0 +1,144 @@
+//! Forward kinematics under a measurement row's conditions (DESIGN.md, "Measurement CSV
+//! additions (real cells)"): the arm's temperature and each joint's approach direction. The
+//! families that read them ([`crate::model::family::backlash`], [`crate::model::family::thermal`])
+//! see them through [`RigidPose::conditions`]; without those families, or with unknown
+//! conditions, the passes here equal the plain ones.
+
+use crate::frame::Frame;
+use crate::model::family::{backlash, link, thermal, PoseFrames, RigidPose};
+use crate::model::{Robot, MAX_JOINTS};
+use nalgebra::Vector3;
+use std::borrow::Cow;
+
+/// What a measurement row says about the robot beside its joint values.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Conditions {
+    /// The arm's temperature (deg C); NaN when unknown.
+    pub temperature_c: f64,
+    /// Each joint's approach direction: +1 or -1, 0 when unknown.
+    pub dir: [i8; MAX_JOINTS],
+}
+
+impl Conditions {
+    /// Nothing known: no temperature, no directions.
+    pub const UNKNOWN: Conditions = Conditions {
+        temperature_c: f64::NAN,
+        dir: [0; MAX_JOINTS],
+    };
+
+    /// Whether `other` holds the same conditions (unknown temperatures count as equal).
+    pub fn same(&self, other: &Conditions) -> bool {
+        self.temperature_c.to_bits() == other.temperature_c.to_bits() && self.dir == other.dir
+    }
+
+    /// Whether anything is known.
+    pub fn is_unknown(&self) -> bool {
+        self.temperature_c.is_nan() && self.dir.iter().all(|d| *d == 0)
+    }
+}
+
+impl Default for Conditions {
+    fn default() -> Self {
+        Conditions::UNKNOWN
+    }
+}
+
+impl Robot {
+    /// The model as it stands at `c`'s temperature: itself, or with its lengths grown by the
+    /// thermal family.
+    fn at_temperature(&self, c: &Conditions) -> Cow<'_, Robot> {
+        match thermal::scale(self, c.temperature_c) {
+            Some(s) => Cow::Owned(thermal::scaled_lengths(self, s)),
+            None => Cow::Borrowed(self),
+        }
+    }
+
+    /// [`Robot::pose_frames_target`] under conditions `c`: the lengths grown to its temperature
+    /// (family `thermal`), the joints deflected knowing its approach directions (family
+    /// `backlash`). `rigid.conditions` holds `c`.
+    pub fn pose_frames_in(&self, q: &[f64], t: usize, c: &Conditions) -> PoseFrames {
+        if c.is_unknown() {
+            return self.pose_frames_target(q, t);
+        }
+        let r = self.at_temperature(c);
+        let r = r.as_ref();
+        let mut rigid = r.rigid_pose(q);
+        rigid.conditions = *c;
+        let mut ch = if r.deflects_joints() {
+            let mut buf = [0.0; MAX_JOINTS];
+            r.rigid_pose_frames(r.deflect_with(&rigid, q, &mut buf), t)
+        } else {
+            r.rigid_pose_frames(q, t)
+        };
+        ch.rigid = rigid;
+        ch
+    }
+
+    /// Target `t`'s point (mm, ACS) under conditions `c` (see [`Robot::pose_frames_in`]).
+    pub fn target_position_in(&self, q: &[f64], t: usize, c: &Conditions) -> Vector3<f64> {
+        if c.is_unknown() {
+            return self.target_position(q, t);
+        }
+        self.pose_frames_in(q, t, c).point
+    }
+
+    /// The model with conditions `c` folded in, for tools that take one fixed state of the cell
+    /// (compensation at the cell's temperature, every joint approached from one side): the
+    /// lengths grown to `c`'s temperature and the thermal family removed; each modelled
+    /// backlash turned into the joint offset `phi_j - backlash_j * dir_j` of `c`'s direction and
+    /// the backlash family removed. Unknown parts of `c` leave the model at its reference
+    /// temperature, or at the middle of the play.
+    pub fn at_conditions(&self, c: &Conditions) -> crate::error::Result<Robot> {
+        let mut r = self.at_temperature(c).into_owned();
+        r.set_family_values(thermal::KEY, None)?;
+        for j in backlash::joints(self) {
+            let b = self.get(crate::model::Param::new(backlash::ID, 0, j as u16));
+            let phi = crate::model::Param::phi(j);
+            r.set(phi, r.get(phi) - b * f64::from(c.dir[j]));
+        }
+        r.set_family_values(backlash::KEY, None)?;
+        Ok(r)
+    }
+
+    /// [`Robot::target_screws`] under conditions `c`.
+    pub fn target_screws_in(
+        &self,
+        q: &[f64],
+        t: usize,
+        c: &Conditions,
+        jq: Option<&mut [Vector3<f64>]>,
+        jp: Option<&mut [Vector3<f64>]>,
+        jw: Option<&mut [Vector3<f64>]>,
+    ) -> (Vector3<f64>, Frame) {
+        let pose = self.pose_frames_in(q, t, c);
+        let mut jp = jp;
+        let out = self.screws_at(&pose, jq, jp.as_deref_mut(), jw);
+        if let Some(jp) = jp {
+            self.scale_grown_columns(c, jp);
+        }
+        out
+    }
+
+    /// Scales the columns of the lengths thermal growth scales (each link's `d` and `a`) by the
+    /// growth factor at `c`'s temperature: the columns of the families are
+    /// taken at the grown lengths, while the parameters are the lengths at the reference.
+    pub(crate) fn scale_grown_columns(&self, c: &Conditions, jp: &mut [Vector3<f64>]) {
+        let Some(s) = thermal::scale(self, c.temperature_c) else {
+            return;
+        };
+        let n = self.dof();
+        for (id, span) in self.family_spans() {
+            if *id == link::ID {
+                for v in &mut jp[span.start + n..span.start + 3 * n] {
+                    *v *= s;
+                }
+            }
+        }
+    }
+}
+
+/// Sets `rigid`'s conditions (for families that build passes themselves).
+pub fn with_conditions(mut rigid: RigidPose, c: &Conditions) -> RigidPose {
+    rigid.conditions = *c;
+    rigid
+}

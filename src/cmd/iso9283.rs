@@ -1,0 +1,430 @@
+//! `robocal iso9283`: the ISO 9283 pose accuracy and repeatability test: `plan` writes the test
+//! (the cube, P1..P5, the cycles, the joints to command), `evaluate` computes AP, RP, AD, RD and
+//! drift from the measured test.
+
+use super::common;
+use super::io_plan::IoPlan;
+use crate::exit;
+use clap::{Args, Subcommand};
+use robocal_core::frame::TrackerFrame;
+use robocal_core::io::write_atomic;
+use robocal_core::iso9283::{
+    evaluate, make_plan, plan_csv, read_plan, read_test_data, Evaluation, PlanSettings, Spec,
+    TrackerMpe, CYCLE_ORDER, DEFAULT_CYCLES,
+};
+use std::path::PathBuf;
+
+#[derive(Subcommand, Debug)]
+pub enum Iso9283Cmd {
+    /// The test plan: the largest cube (edges parallel to the base axes) the robot reaches at
+    /// every test pose with the tool orientation, P1..P5 on its diagonal plane, the cycles P1,
+    /// P5, P4, P3, P2; with --params, the compensated joints on the calibrated model.
+    Plan(PlanArgs),
+    /// AP, RP (position and orientation), AD, RD and drift per pose from the measured test, the
+    /// tracker's uncertainty beside RP, pass/fail against --spec.
+    Evaluate(EvaluateArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct PlanArgs {
+    /// The nominal robot: a preset, a TOML robot file or a URDF [default: the robot embedded in
+    /// --params].
+    #[arg(long, required_unless_present = "params")]
+    robot: Option<String>,
+    /// A calibration result: the plan's joints are then the compensated ones on its calibrated
+    /// model (the same commanded poses), for the test after calibration.
+    #[arg(long)]
+    params: Option<PathBuf>,
+    /// Number of cycles (ISO 9283: 30).
+    #[arg(long, default_value_t = DEFAULT_CYCLES)]
+    cycles: usize,
+    /// The cube's edge (mm) [default: the largest that fits].
+    #[arg(long, value_name = "L")]
+    cube_mm: Option<f64>,
+    /// The cube's centre X,Y,Z (mm, base frame) [default: searched].
+    #[arg(long, value_name = "X,Y,Z", allow_hyphen_values = true)]
+    center: Option<String>,
+    /// The tool orientation A,B,C (deg, base frame) at every pose [default: the tool's
+    /// orientation at the middle of the joint ranges, or the first default seed configuration
+    /// away from singularities].
+    #[arg(long, value_name = "A,B,C", allow_hyphen_values = true)]
+    orientation: Option<String>,
+    /// The plan CSV to write (cycle,pose,q1..qn,x_c,y_c,z_c,a_c,b_c,c_c).
+    #[arg(long)]
+    out: PathBuf,
+}
+
+#[derive(Args, Debug)]
+pub struct EvaluateArgs {
+    /// The plan CSV (`robocal iso9283 plan --out`).
+    #[arg(long)]
+    plan: PathBuf,
+    /// The measured test: the plan's rows with the attained x,y,z (and a,b,c for 6-DoF data,
+    /// time_s for drift), in the tracker frame of --params or in the base frame with --frame base.
+    #[arg(long)]
+    data: PathBuf,
+    /// The calibration result: its tracker frame maps the data to the base frame; its robot
+    /// (and calibrated model, for a compensated plan) checks the plan.
+    #[arg(long, required_unless_present = "frame", conflicts_with = "frame")]
+    params: Option<PathBuf>,
+    /// `base`: the data are in the robot's base frame (no tracker frame to apply).
+    #[arg(long, value_parser = ["base"])]
+    frame: Option<String>,
+    /// The nominal robot [default: the robot embedded in --params; required with --frame base].
+    #[arg(long)]
+    robot: Option<String>,
+    /// Acceptance limits, e.g. ap=0.5,rp=0.1 (mm): pass/fail per pose and overall.
+    #[arg(long, value_name = "ap=MM,rp=MM")]
+    spec: Option<String>,
+    /// The tracker's maximum permissible error, MM or MM,MM_PER_M (e.g. 0.015,0.006)
+    /// [default: 0.015 mm + 0.006 mm/m].
+    #[arg(long, value_name = "MM[,MM_PER_M]")]
+    tracker_mpe: Option<String>,
+    /// Print the evaluation as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+pub fn run(c: Iso9283Cmd) -> anyhow::Result<()> {
+    match c {
+        Iso9283Cmd::Plan(a) => plan(a),
+        Iso9283Cmd::Evaluate(a) => evaluate_cmd(a),
+    }
+}
+
+fn triple(flag: &str, s: &str) -> anyhow::Result<[f64; 3]> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| exit::usage(format!("{flag}: `{s}` is not a list of numbers")))?;
+    match v[..] {
+        [a, b, c] if v.iter().all(|x| x.is_finite()) => Ok([a, b, c]),
+        _ => Err(exit::usage(format!(
+            "{flag}: expected 3 finite values, got `{s}`"
+        ))),
+    }
+}
+
+fn plan(a: PlanArgs) -> anyhow::Result<()> {
+    let mut io = IoPlan::new();
+    io.robot_opt("--robot", a.robot.as_deref())
+        .input_opt("--params", a.params.as_deref())
+        .output("--out", &a.out, "the plan is a file");
+    io.check()?;
+    let settings = PlanSettings {
+        cycles: a.cycles,
+        edge_mm: a.cube_mm,
+        centre_mm: a
+            .center
+            .as_deref()
+            .map(|s| triple("--center", s))
+            .transpose()?,
+        orientation_deg: a
+            .orientation
+            .as_deref()
+            .map(|s| triple("--orientation", s))
+            .transpose()?,
+        ..PlanSettings::default()
+    };
+    settings.validate()?;
+    let model = common::model(a.robot.as_deref(), a.params.as_deref())?;
+    if let (Some((_, res)), Some(p)) = (&model.calibrated, &a.params) {
+        common::warn_not_calibrated(res, p)?;
+    }
+    let calibrated = model.calibrated.as_ref().map(|c| &c.0);
+    let plan = make_plan(&model.nominal, calibrated, &settings)?;
+    write_atomic(&a.out, &plan_csv(&plan, &model.nominal))?;
+
+    let c = plan.cube.centre;
+    outln!(
+        "cube: edge {:.1} mm, centre ({:.1}, {:.1}, {:.1}) mm (base frame){}",
+        plan.cube.edge_mm,
+        c.x,
+        c.y,
+        c.z,
+        if a.cube_mm.is_none() {
+            ", the largest that fits"
+        } else {
+            ""
+        }
+    )?;
+    let o = plan.pose_vector_deg(1);
+    outln!(
+        "tool orientation A={:.3} B={:.3} C={:.3} deg; measuring plane through the cube's \
+         corners (-,-,-), (+,-,-), (+,+,+), (-,+,+)",
+        o[3],
+        o[4],
+        o[5]
+    )?;
+    let robot = &model.nominal;
+    let names: Vec<String> = (1..=robot.dof()).map(|i| format!("q{i}")).collect();
+    outln!(
+        "{:<5}{:>11}{:>11}{:>11}  joints{} (deg)",
+        "pose",
+        "x (mm)",
+        "y (mm)",
+        "z (mm)",
+        if plan.compensated { " compensated" } else { "" }
+    )?;
+    for k in 1..=5 {
+        let v = plan.pose_vector_deg(k);
+        let q: Vec<String> = robot
+            .joints_to_display(&plan.joints[k - 1])
+            .iter()
+            .zip(&names)
+            .map(|(v, n)| format!("{n}={v:.4}"))
+            .collect();
+        outln!(
+            "P{k:<4}{:>11.3}{:>11.3}{:>11.3}  {}",
+            v[0],
+            v[1],
+            v[2],
+            q.join(" ")
+        )?;
+    }
+    let order: Vec<String> = CYCLE_ORDER.iter().map(|p| format!("P{p}")).collect();
+    outln!(
+        "wrote {} ({} rows: {} cycles of {})",
+        a.out.display(),
+        5 * plan.cycles,
+        plan.cycles,
+        order.join(", ")
+    )?;
+    Ok(())
+}
+
+fn evaluate_cmd(a: EvaluateArgs) -> anyhow::Result<()> {
+    let mut io = IoPlan::new();
+    io.robot_opt("--robot", a.robot.as_deref())
+        .input_opt("--params", a.params.as_deref())
+        .input("--plan", &a.plan)
+        .input("--data", &a.data);
+    io.check()?;
+    let spec = a.spec.as_deref().map(Spec::parse).transpose()?;
+    let tracker = match a.tracker_mpe.as_deref() {
+        Some(s) => TrackerMpe::parse(s)?,
+        None => TrackerMpe::default(),
+    };
+    if a.params.is_none() && a.robot.is_none() {
+        return Err(exit::usage("--frame base needs --robot NAME|FILE"));
+    }
+    let model = common::model(a.robot.as_deref(), a.params.as_deref())?;
+    let frame = match &model.calibrated {
+        Some((_, res)) => res.tracker_frame.to_tracker_frame(),
+        None => TrackerFrame::identity(),
+    };
+    let calibrated = model.calibrated.as_ref().map(|c| &c.0);
+    let plan = read_plan(&a.plan, &model.nominal, calibrated)?;
+    let poses = read_test_data(&a.data, &plan, &model.nominal, &frame)?;
+    let ev = evaluate(&poses, &tracker, &frame.origin(), spec.as_ref())?;
+    if a.json {
+        outln!("{}", serde_json::to_string_pretty(&ev)?)?;
+    } else {
+        print_table(&ev, a.params.is_some())?;
+    }
+    Ok(())
+}
+
+/// Prints the evaluation as tables.
+fn print_table(ev: &Evaluation, tracker_frame: bool) -> anyhow::Result<()> {
+    let orient = ev.poses.iter().any(|p| p.orientation.is_some());
+    let drift = ev.poses.iter().any(|p| p.drift.is_some());
+    out!(
+        "{:<5}{:>4}{:>10}{:>10}{:>10}{:>10}{:>10}{:>11}",
+        "pose",
+        "n",
+        "AP (mm)",
+        "AP_x",
+        "AP_y",
+        "AP_z",
+        "RP (mm)",
+        "MPE (mm)"
+    )?;
+    if orient {
+        out!("{:>10}{:>10}", "AP_ang(°)", "RP_max(°)")?;
+    }
+    if drift {
+        out!("{:>10}{:>10}", "dAP (mm)", "dRP (mm)")?;
+    }
+    outln!("{}", if ev.spec.is_some() { "  result" } else { "" })?;
+    for p in &ev.poses {
+        out!(
+            "P{:<4}{:>4}{:>10.4}{:>10.4}{:>10.4}{:>10.4}{:>10.4}{:>11.4}",
+            p.pose,
+            p.n,
+            p.ap_mm,
+            p.ap_x_mm,
+            p.ap_y_mm,
+            p.ap_z_mm,
+            p.rp_mm,
+            p.tracker_mpe_mm
+        )?;
+        if orient {
+            match &p.orientation {
+                Some(o) => out!(
+                    "{:>10.5}{:>10.5}",
+                    o.ap_angle_deg,
+                    o.rp_a_deg.max(o.rp_b_deg).max(o.rp_c_deg)
+                )?,
+                None => out!("{:>20}", "")?,
+            }
+        }
+        if drift {
+            match &p.drift {
+                Some(d) => out!("{:>10.4}{:>10.4}", d.dap_mm, d.drp_mm)?,
+                None => out!("{:>20}", "")?,
+            }
+        }
+        let mark = if p.rp_below_tracker { " *" } else { "" };
+        match p.pass {
+            Some(true) => outln!("  pass{mark}")?,
+            Some(false) => outln!("  FAIL{mark}")?,
+            None => outln!("{mark}")?,
+        }
+    }
+    let d = &ev.distance;
+    outln!(
+        "distance P{}-P{}: commanded {:.3} mm, AD {:.4} mm, RD {:.4} mm",
+        d.from,
+        d.to,
+        d.commanded_mm,
+        d.ad_mm,
+        d.rd_mm
+    )?;
+    let t = &ev.tracker;
+    outln!(
+        "tracker MPE {} mm + {} mm/m at the {}; RP below it is marked * (not resolved by the \
+         instrument)",
+        t.mpe_mm,
+        t.per_m_mm,
+        if tracker_frame {
+            "tracker's distance from each pose"
+        } else {
+            "distance from the base origin (--frame base)"
+        }
+    )?;
+    if ev.poses.iter().any(|p| p.rp_below_tracker) {
+        outln!("* RP below the tracker's MPE: an upper bound set by the instrument")?;
+    }
+    if let (Some(s), Some(pass)) = (&ev.spec, ev.pass) {
+        let lim = |v: Option<f64>| v.map_or("-".to_owned(), |v| format!("{v} mm"));
+        outln!(
+            "spec AP <= {}, RP <= {}: {}",
+            lim(s.ap_mm),
+            lim(s.rp_mm),
+            if pass { "PASS" } else { "FAIL" }
+        )?;
+    }
+    Ok(())
+}
+
+/// The ISO 9283 tests of `report --iso9283 PLAN.csv,DATA.csv` (repeatable): each evaluated with
+/// the result's tracker frame, its plan checked against the result's robot (a compensated plan
+/// against the calibrated model).
+pub(super) fn report_tests(
+    args: &[String],
+    nominal: &robocal_core::Robot,
+    calibrated: &robocal_core::Robot,
+    result: &robocal_core::io::CalibrationResult,
+) -> anyhow::Result<Vec<robocal_report::IsoTest>> {
+    let frame = result.tracker_frame.to_tracker_frame();
+    let mut out = Vec::new();
+    for arg in args {
+        let Some((plan, data)) = arg.split_once(',') else {
+            return Err(exit::usage(format!(
+                "--iso9283 {arg}: expected PLAN.csv,DATA.csv"
+            )));
+        };
+        let (plan, data) = (PathBuf::from(plan), PathBuf::from(data));
+        let mut io = IoPlan::new();
+        io.input("--iso9283", &plan).input("--iso9283", &data);
+        io.check()?;
+        let p = read_plan(&plan, nominal, Some(calibrated))?;
+        let compensated = p.rows.first().is_some_and(|r| {
+            let c = p.poses[r.pose - 1].translation.vector;
+            (nominal.tool_position(&r.q) - c).norm() > robocal_core::iso9283::PLAN_TOLERANCE_MM
+        });
+        let poses = read_test_data(&data, &p, nominal, &frame)?;
+        let ev = evaluate(&poses, &TrackerMpe::default(), &frame.origin(), None)?;
+        let label = format!(
+            "{} ({} joints, plan {})",
+            robocal_report::file_name(&data),
+            if compensated {
+                "compensated"
+            } else {
+                "nominal"
+            },
+            robocal_report::file_name(&plan)
+        );
+        out.push(robocal_report::IsoTest::from_evaluation(label, &ev));
+    }
+    Ok(out)
+}
+
+/// The demo's last table: the ISO 9283 test (30 cycles, the largest cube) of the experiment's
+/// robot before calibration (nominal joints) and after (compensated joints), run in the
+/// experiment's cell with the class-default repeatability and evaluated in the calibration's
+/// tracker frame.
+pub(super) fn demo_table(exp: &robocal_core::experiment::Experiment) -> anyhow::Result<()> {
+    use robocal_core::iso9283::simulate_test;
+    use robocal_core::simulation::{RepeatabilityModel, TruthSpec};
+    let nominal = exp.session.cell.nominal();
+    let truth = TruthSpec::Robot(exp.session.cell.truth().clone());
+    let mut cfg = exp.config.verification_session();
+    // Measured from the calibration's tracker set-up: its fitted frame maps the points to the
+    // base frame (a verification from another station would need registering again).
+    cfg.station = 0;
+    let repeat = RepeatabilityModel::default_for(nominal);
+    cfg.repeatability = Some(repeat.clone());
+    let frame = exp.result.tracker_frame.to_tracker_frame();
+    let settings = PlanSettings::default();
+    let mut figures = Vec::new();
+    for (label, calibrated) in [
+        ("before calibration (nominal joints)", None),
+        (
+            "after calibration (compensated joints)",
+            Some(&exp.calibrated),
+        ),
+    ] {
+        let plan = make_plan(nominal, calibrated, &settings)?;
+        let ev = simulate_test(
+            nominal,
+            &truth,
+            &cfg,
+            &plan,
+            &frame,
+            &TrackerMpe::default(),
+            &(),
+        )?;
+        if figures.is_empty() {
+            let c = plan.cube.centre;
+            outln!(
+                "ISO 9283 pose accuracy and repeatability ({} cycles, cube of {:.0} mm centred \
+                 at {:.0}, {:.0}, {:.0} mm; repeatability {:.5} deg per joint and move):",
+                plan.cycles,
+                plan.cube.edge_mm,
+                c.x,
+                c.y,
+                c.z,
+                repeat.std_deg[0]
+            )?;
+        }
+        outln!("{label}:")?;
+        print_table(&ev, true)?;
+        let worst = |f: fn(&robocal_core::iso9283::PoseResult) -> f64| {
+            ev.poses.iter().map(f).fold(0.0, f64::max)
+        };
+        figures.push((worst(|p| p.ap_mm), worst(|p| p.rp_mm)));
+    }
+    outln!(
+        "AP (worst pose) {:.3} mm before, {:.3} mm after calibration; RP {:.3} mm before, {:.3} \
+         mm after",
+        figures[0].0,
+        figures[1].0,
+        figures[0].1,
+        figures[1].1
+    )?;
+    outln!()?;
+    Ok(())
+}
