@@ -29,6 +29,9 @@ pub enum Col {
     Time,
     /// The point's name.
     Name,
+    /// A mark that the point was deleted in the tracker software (Leica's `Delete`): such rows
+    /// are left out and listed.
+    Deleted,
 }
 
 /// How a format names its columns: `classify(name)` for a header cell's lower-case name
@@ -189,6 +192,7 @@ pub fn read<R: BufRead>(
     let u95_k = u95_unit.unwrap_or(unit).to_mm() / unit.to_mm();
     let mut decimal = None;
     let mut rows = Vec::new();
+    let mut deleted_lines = Vec::new();
     while let Some((line, text)) = lines.next_line()? {
         let mut fields = Vec::with_capacity(layout.n_header);
         if text.trim().is_empty() {
@@ -224,6 +228,10 @@ pub fn read<R: BufRead>(
                 '.'
             }
         });
+        if is_deleted(&path, line, &fields, &layout)? {
+            deleted_lines.push(line);
+            continue;
+        }
         rows.push(row(
             &path,
             line,
@@ -246,7 +254,32 @@ pub fn read<R: BufRead>(
         unit_source,
         ignored_columns: ignored,
         rows,
+        deleted_lines,
     })
+}
+
+/// Whether the row's deletion mark (if the export has the column) says the point was deleted:
+/// `1`, `true`, `yes`, `x` (any case) yes; empty, `0`, `false`, `no` no; anything else is an
+/// error naming the line.
+fn is_deleted(
+    path: &std::path::Path,
+    line: usize,
+    fields: &[&str],
+    layout: &Layout,
+) -> Result<bool> {
+    let Some((i, _, h)) = layout.cols.iter().find(|(_, c, _)| *c == Col::Deleted) else {
+        return Ok(false);
+    };
+    match fields[*i].trim().to_ascii_lowercase().as_str() {
+        "1" | "true" | "yes" | "x" => Ok(true),
+        "" | "0" | "false" | "no" => Ok(false),
+        v => Err(Error::parse(
+            path,
+            Some(line),
+            Some(h),
+            format!("`{v}` is not a deletion mark (1/0, true/false, yes/no)"),
+        )),
+    }
 }
 
 fn row(
@@ -301,6 +334,7 @@ fn row(
                 )
             }
             Col::Name => r.name = Some(v.to_owned()),
+            Col::Deleted => {}
         }
     }
     match quat {

@@ -58,6 +58,8 @@ pub struct PointTable {
     pub ignored_columns: Vec<String>,
     /// The points, in file order.
     pub rows: Vec<PointRow>,
+    /// Lines of rows the export marks deleted (left out).
+    pub deleted_lines: Vec<usize>,
 }
 
 /// The length unit of a file: what the file says, else what the option says, else a format's

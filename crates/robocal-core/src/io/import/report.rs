@@ -25,6 +25,8 @@ pub struct ImportReport {
     pub length_unit_source: String,
     /// Columns of the export not used.
     pub ignored_columns: Vec<String>,
+    /// Lines of rows the export marks deleted (left out).
+    pub deleted_lines: Vec<usize>,
     /// Points in the export.
     pub points: usize,
     /// The joint log.
@@ -123,6 +125,7 @@ pub(super) fn build(p: Parts<'_>) -> ImportReport {
         length_unit: t.length_unit,
         length_unit_source: t.unit_source.clone(),
         ignored_columns: t.ignored_columns.clone(),
+        deleted_lines: t.deleted_lines.clone(),
         points: t.rows.len(),
         joints_path: p.joints_path.to_owned(),
         joints_format: l.format,
@@ -184,6 +187,22 @@ impl ImportReport {
             v.push(format!(
                 "points columns not used: {}",
                 self.ignored_columns.join(", ")
+            ));
+        }
+        if !self.deleted_lines.is_empty() {
+            v.push(format!(
+                "points marked deleted in the export, left out: {} (line{} {})",
+                self.deleted_lines.len(),
+                if self.deleted_lines.len() == 1 {
+                    ""
+                } else {
+                    "s"
+                },
+                self.deleted_lines
+                    .iter()
+                    .map(|l| l.to_string())
+                    .collect::<Vec<_>>()
+                    .join(", ")
             ));
         }
         if let Some(n) = self.dwells {

@@ -74,6 +74,7 @@ pub fn read<R: BufRead>(lines: &mut LineReader<R>, config: &ImportConfig) -> Res
         length_unit: unit,
         unit_source,
         ignored_columns: Vec::new(),
+        deleted_lines: Vec::new(),
         rows,
     })
 }
