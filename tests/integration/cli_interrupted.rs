@@ -26,8 +26,28 @@ fn long_compensation(d: &Path, out: &Path) -> Vec<String> {
     .collect()
 }
 
-/// Starts `args`, waits until its temporary file for `out` exists, sends `signal`; gives the
-/// exit status and stderr.
+/// Whether process `pid` has a complete record of a temporary (`$TMPDIR/robocal-UID/
+/// temporaries/PID-*`: device and inode, then the temporary's path).
+fn record_written(pid: u32) -> bool {
+    // SAFETY: getuid has no preconditions and cannot fail.
+    let uid = unsafe { libc::getuid() };
+    let dir = std::env::temp_dir()
+        .join(format!("robocal-{uid}"))
+        .join("temporaries");
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return false;
+    };
+    entries.flatten().any(|e| {
+        e.file_name()
+            .to_string_lossy()
+            .starts_with(&format!("{pid}-"))
+            && std::fs::read_to_string(e.path())
+                .is_ok_and(|t| t.split_once('\n').is_some_and(|(_, p)| p.ends_with(".tmp")))
+    })
+}
+
+/// Starts `args`, waits until its temporary file for `out` and its record exist, sends
+/// `signal`; gives the exit status and stderr.
 fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i32>, String) {
     use std::os::unix::process::ExitStatusExt;
     let child = command()
@@ -44,6 +64,16 @@ fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i
             start.elapsed() < std::time::Duration::from_secs(60),
             "no temporary file {prefix}*.tmp in {}",
             dir.display()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    // The record that proves the temporary robocal's is written just after it: a signal in
+    // between leaves a temporary nothing proves (kept, as a user's file would be).
+    while !record_written(child.id()) {
+        assert!(
+            start.elapsed() < std::time::Duration::from_secs(60),
+            "no complete record of the temporary of process {}",
+            child.id()
         );
         std::thread::sleep(std::time::Duration::from_millis(2));
     }
