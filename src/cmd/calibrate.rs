@@ -281,36 +281,51 @@ fn apply_beta(robot: &mut Robot, arg: &str) -> anyhow::Result<Vec<usize>> {
     }
 }
 
+/// A joint-family flag's joints (0-based, sorted, once each): `none` (or absent) none, `auto`
+/// those `auto` gives, else a comma list of joint numbers 1..dof.
+pub(super) fn joint_list(
+    flag: &str,
+    arg: Option<&str>,
+    robot: &Robot,
+    auto: impl FnOnce(&Robot) -> Vec<usize>,
+) -> anyhow::Result<Vec<usize>> {
+    let list = match arg.unwrap_or("none").trim() {
+        "none" | "" => return Ok(Vec::new()),
+        "auto" => return Ok(auto(robot)),
+        list => list,
+    };
+    let mut out = Vec::new();
+    for part in list.split(',') {
+        let j: usize = part.trim().parse().map_err(|_| {
+            exit::usage(format!(
+                "{flag}: `{part}` is not `auto`, `none` or a joint number"
+            ))
+        })?;
+        if j == 0 || j > robot.dof() {
+            return Err(exit::usage(format!(
+                "{flag}: joint {j} does not exist (robot `{}` has joints 1..{})",
+                robot.name(),
+                robot.dof()
+            )));
+        }
+        if !out.contains(&(j - 1)) {
+            out.push(j - 1);
+        }
+    }
+    out.sort_unstable();
+    Ok(out)
+}
+
 /// Applies `--compliance`, `--payload-kg` and `--harmonics`; returns the compliant joints
 /// (0-based).
 fn apply_joint_families(robot: &mut Robot, a: &CalibrateArgs) -> anyhow::Result<Vec<usize>> {
     use robocal_core::model::family::{compliance, transmission};
-    let joints = match a.compliance.as_deref().unwrap_or("none").trim() {
-        "none" | "" => Vec::new(),
-        "auto" => compliance::auto_joints(robot),
-        list => {
-            let mut out = Vec::new();
-            for part in list.split(',') {
-                let j: usize = part.trim().parse().map_err(|_| {
-                    exit::usage(format!(
-                        "--compliance: `{part}` is not `auto`, `none` or a joint number"
-                    ))
-                })?;
-                if j == 0 || j > robot.dof() {
-                    return Err(exit::usage(format!(
-                        "--compliance: joint {j} does not exist (robot `{}` has joints 1..{})",
-                        robot.name(),
-                        robot.dof()
-                    )));
-                }
-                if !out.contains(&(j - 1)) {
-                    out.push(j - 1);
-                }
-            }
-            out.sort_unstable();
-            out
-        }
-    };
+    let joints = joint_list(
+        "--compliance",
+        a.compliance.as_deref(),
+        robot,
+        compliance::auto_joints,
+    )?;
     if a.payload_kg.is_some() && joints.is_empty() {
         return Err(exit::usage(
             "--payload-kg: the payload makes the joint compliances physical; give --compliance              auto or a list of joints too",

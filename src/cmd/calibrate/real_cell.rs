@@ -14,32 +14,9 @@ pub(super) fn apply(
     backlash_arg: Option<&str>,
     thermal_arg: Option<&str>,
 ) -> anyhow::Result<()> {
-    let joints: Vec<usize> = match backlash_arg.unwrap_or("none").trim() {
-        "none" | "" => Vec::new(),
-        "auto" => (0..robot.dof()).collect(),
-        list => {
-            let mut out = Vec::new();
-            for part in list.split(',') {
-                let j: usize = part.trim().parse().map_err(|_| {
-                    exit::usage(format!(
-                        "--backlash: `{part}` is not `auto`, `none` or a joint number"
-                    ))
-                })?;
-                if j == 0 || j > robot.dof() {
-                    return Err(exit::usage(format!(
-                        "--backlash: joint {j} does not exist (robot `{}` has joints 1..{})",
-                        robot.name(),
-                        robot.dof()
-                    )));
-                }
-                if !out.contains(&(j - 1)) {
-                    out.push(j - 1);
-                }
-            }
-            out.sort_unstable();
-            out
-        }
-    };
+    let joints = super::joint_list("--backlash", backlash_arg, robot, |r| {
+        (0..r.dof()).collect()
+    })?;
     backlash::enable(robot, &joints).map_err(|e| exit::usage(e.to_string()))?;
     if thermal_arg == Some("auto") {
         thermal::enable(robot, thermal::DEFAULT_REFERENCE_C)

@@ -179,7 +179,7 @@ pub fn select(
     // Families the user fixed are in every candidate: the geometric model beside them tells
     // whether they lower the error at all.
     if !families(nominal).is_empty() {
-        robots.push(geometric(nominal));
+        robots.push(nominal.geometric());
     }
     let mut fit_settings = settings.clone();
     fit_settings.model = ModelChoice::Given;
@@ -252,12 +252,6 @@ pub fn select(
         candidates,
         robot: robots[chosen].clone(),
     })
-}
-
-/// `robot` without its non-geometric families (compliance, transmission harmonics, backlash,
-/// thermal expansion): [`Robot::geometric`].
-pub fn geometric(robot: &Robot) -> Robot {
-    robot.geometric()
 }
 
 /// The remark on families given explicitly (`chosen`, which carries them) that do not lower the

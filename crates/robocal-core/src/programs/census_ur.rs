@@ -6,14 +6,15 @@
 //! the robot description's until `set_tcp(p[...])` (a literal pose, or a variable assigned one);
 //! any other `set_tcp` makes it unknown. Poses are in the robot's base frame.
 //!
-//! A target combined with a literal pose counts as that target with an offset ([`Offset`]):
+//! A target combined with a literal pose counts as that target with an offset ([`super::frames::Offset`]):
 //! `pose_trans(T, p[...])` (after T), `pose_trans(p[...], T)` with T a variable (T in the
 //! literal's frame), `pose_add(T, p[...])`; T is a literal pose or a variable. Any other
 //! combination (a variable offset, a nested call) is computed at run time.
 
 use super::census::{split_args, target_ref, Motion, TargetRef};
-use super::frames::{FrameSpec, Frames, Offset};
+use super::frames::{FrameSpec, Frames};
 use super::lex::{line_end, past_string};
+use super::urscript::{call_end, first_argument, literal_pose, offset_call};
 use std::collections::HashMap;
 
 const MOTIONS: [&str; 8] = [
@@ -22,93 +23,6 @@ const MOTIONS: [&str; 8] = [
 
 fn is_ident(c: u8) -> bool {
     c.is_ascii_alphanumeric() || c == b'_'
-}
-
-/// A literal pose `p[x, y, z, rx, ry, rz]` as a frame (mm).
-fn literal_pose(s: &str) -> Option<crate::frame::Frame> {
-    let inner = s.trim().strip_prefix("p[")?.strip_suffix(']')?;
-    let v: Vec<f64> = inner
-        .split(',')
-        .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
-        .collect::<Option<_>>()?;
-    (v.len() == 6).then(|| super::urscript::pose_of(&v))
-}
-
-/// The first argument of the call whose arguments (and closing parenthesis) are `rest`.
-fn first_argument(rest: &str) -> &str {
-    let b = rest.as_bytes();
-    let first = split_args(b, 0, b.len())
-        .first()
-        .map_or(rest, |r| &rest[r.clone()]);
-    // The call's own `)` when it has one argument.
-    if first.matches(')').count() > first.matches('(').count() {
-        first.strip_suffix(')').unwrap_or(first).trim_end()
-    } else {
-        first
-    }
-}
-
-/// For a `pose_trans(..)` or `pose_add(..)` argument `a`: its target and offset when its
-/// operands are a target and a literal pose (see the module docs), `Some(None)` when they are
-/// not; `None` when `a` is not such a call.
-pub(crate) fn offset_call(a: &str) -> Option<Option<(&str, Offset)>> {
-    let (name, rest) = a.trim().split_once('(')?;
-    let add = match name.trim_end() {
-        "pose_trans" => false,
-        "pose_add" => true,
-        _ => return None,
-    };
-    let inner = rest.trim_end().strip_suffix(')')?;
-    let b = inner.as_bytes();
-    let ops: Vec<&str> = split_args(b, 0, b.len())
-        .into_iter()
-        .map(|r| &inner[r])
-        .collect();
-    let ident =
-        |s: &str| !s.is_empty() && s.bytes().all(is_ident) && !s.as_bytes()[0].is_ascii_digit();
-    let target = |s: &str| ident(s) || s.starts_with("p[");
-    Some(match ops[..] {
-        [t, o] if target(t) && literal_pose(o).is_some() => {
-            let o = literal_pose(o).expect("checked");
-            Some((
-                t,
-                if add {
-                    Offset::Add(o)
-                } else {
-                    Offset::After(o)
-                },
-            ))
-        }
-        [o, t] if !add && ident(t) && literal_pose(o).is_some() => {
-            Some((t, Offset::Before(literal_pose(o).expect("checked"))))
-        }
-        _ => None,
-    })
-}
-
-/// The end of the call whose `(` is at `open` (the index of its `)`, or of the line's end).
-pub(crate) fn call_end(b: &[u8], open: usize) -> usize {
-    let mut depth = 0usize;
-    let mut i = open;
-    while i < b.len() {
-        match b[i] {
-            b'(' | b'[' => depth += 1,
-            b')' | b']' => {
-                depth = depth.saturating_sub(1);
-                if depth == 0 {
-                    return i;
-                }
-            }
-            b'\n' | b'#' => return i,
-            b'"' | b'\'' => {
-                i = past_string(b, i);
-                continue;
-            }
-            _ => {}
-        }
-        i += 1;
-    }
-    b.len()
 }
 
 /// The motions of a URScript text, with the TCP in force.
@@ -232,7 +146,10 @@ mod tests {
         assert!(matches!(m[2].frames.tool, FrameSpec::Known(_)));
         // A target with a literal offset is that target; a variable offset is computed.
         assert_eq!(m[3].refs, [TargetRef::Named("pick".into())]);
-        assert!(matches!(m[3].frames.offset, Some(Offset::After(_))));
+        assert!(matches!(
+            m[3].frames.offset,
+            Some(super::super::frames::Offset::After(_))
+        ));
         assert!(m[4].no_target.is_some());
         assert_eq!(m[5].refs, [TargetRef::Inline, TargetRef::Inline]);
         assert!(m[5].frames.tool.unknown().is_some());

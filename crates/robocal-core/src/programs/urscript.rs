@@ -15,7 +15,8 @@
 //! line) and strings are skipped. A hand-written reader: there is no maintained Rust parser of
 //! URScript.
 
-use super::census_ur::{call_end, offset_call};
+use super::census::split_args;
+use super::frames::Offset;
 use super::lex::{line_end, past_string};
 use super::{Field, ProgramTarget, TargetKind};
 use crate::error::{Error, Result};
@@ -69,6 +70,93 @@ fn list(b: &[u8], open: usize) -> Option<(Vec<Range<usize>>, usize)> {
 
 fn is_ident(c: u8) -> bool {
     c.is_ascii_alphanumeric() || c == b'_'
+}
+
+/// A literal pose `p[x, y, z, rx, ry, rz]` as a frame (mm).
+pub(crate) fn literal_pose(s: &str) -> Option<crate::frame::Frame> {
+    let inner = s.trim().strip_prefix("p[")?.strip_suffix(']')?;
+    let v: Vec<f64> = inner
+        .split(',')
+        .map(|x| x.trim().parse::<f64>().ok().filter(|v| v.is_finite()))
+        .collect::<Option<_>>()?;
+    (v.len() == 6).then(|| pose_of(&v))
+}
+
+/// The first argument of the call whose arguments (and closing parenthesis) are `rest`.
+pub(crate) fn first_argument(rest: &str) -> &str {
+    let b = rest.as_bytes();
+    let first = split_args(b, 0, b.len())
+        .first()
+        .map_or(rest, |r| &rest[r.clone()]);
+    // The call's own `)` when it has one argument.
+    if first.matches(')').count() > first.matches('(').count() {
+        first.strip_suffix(')').unwrap_or(first).trim_end()
+    } else {
+        first
+    }
+}
+
+/// For a `pose_trans(..)` or `pose_add(..)` argument `a`: its target and offset when its
+/// operands are a target and a literal pose (see the module docs), `Some(None)` when they are
+/// not; `None` when `a` is not such a call.
+pub(crate) fn offset_call(a: &str) -> Option<Option<(&str, Offset)>> {
+    let (name, rest) = a.trim().split_once('(')?;
+    let add = match name.trim_end() {
+        "pose_trans" => false,
+        "pose_add" => true,
+        _ => return None,
+    };
+    let inner = rest.trim_end().strip_suffix(')')?;
+    let b = inner.as_bytes();
+    let ops: Vec<&str> = split_args(b, 0, b.len())
+        .into_iter()
+        .map(|r| &inner[r])
+        .collect();
+    let ident =
+        |s: &str| !s.is_empty() && s.bytes().all(is_ident) && !s.as_bytes()[0].is_ascii_digit();
+    let target = |s: &str| ident(s) || s.starts_with("p[");
+    Some(match ops[..] {
+        [t, o] if target(t) && literal_pose(o).is_some() => {
+            let o = literal_pose(o).expect("checked");
+            Some((
+                t,
+                if add {
+                    Offset::Add(o)
+                } else {
+                    Offset::After(o)
+                },
+            ))
+        }
+        [o, t] if !add && ident(t) && literal_pose(o).is_some() => {
+            Some((t, Offset::Before(literal_pose(o).expect("checked"))))
+        }
+        _ => None,
+    })
+}
+
+/// The end of the call whose `(` is at `open` (the index of its `)`, or of the line's end).
+pub(crate) fn call_end(b: &[u8], open: usize) -> usize {
+    let mut depth = 0usize;
+    let mut i = open;
+    while i < b.len() {
+        match b[i] {
+            b'(' | b'[' => depth += 1,
+            b')' | b']' => {
+                depth = depth.saturating_sub(1);
+                if depth == 0 {
+                    return i;
+                }
+            }
+            b'\n' | b'#' => return i,
+            b'"' | b'\'' => {
+                i = past_string(b, i);
+                continue;
+            }
+            _ => {}
+        }
+        i += 1;
+    }
+    b.len()
 }
 
 /// Finds the targets of a URScript program's text, in file order.

@@ -6,7 +6,7 @@
 //! ```
 //!
 //! `dir_j` is the row's approach direction (`dir1..dirN`, or derived from the row order; see
-//! [`crate::kinematics::Conditions`]); a row whose direction is unknown (0) is taken at the
+//! [`crate::model::Conditions`]); a row whose direction is unknown (0) is taken at the
 //! middle of the play. With every row approached from the same side the column equals the
 //! joint's offset `phi` and the identifiability analysis fixes the parameter.
 

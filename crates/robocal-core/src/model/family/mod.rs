@@ -140,6 +140,13 @@ pub trait ParameterFamily: Sync {
         false
     }
 
+    /// Whether this family is beyond this robot's geometry: it moves the joints
+    /// ([`ParameterFamily::deflects_joints`]) or depends on the conditions of a measurement (a
+    /// temperature). [`Robot::geometric`] drops such families.
+    fn beyond_geometry(&self, robot: &Robot) -> bool {
+        self.deflects_joints(robot)
+    }
+
     /// Adds the family's joint deflection `dq(q, theta)` at the commanded joint values to `dq`
     /// (internal units). `rigid` holds the forward pass at the commanded joints without any
     /// deflection (`rigid.commanded` are the joint values). Forward kinematics evaluates the
@@ -271,7 +278,7 @@ pub struct RigidPose {
     /// The tool point (mm, ACS).
     pub point: Vector3<f64>,
     /// The measurement row's conditions (temperature, approach directions), when known.
-    pub conditions: crate::kinematics::Conditions,
+    pub conditions: crate::model::Conditions,
 }
 
 impl Default for RigidPose {
@@ -280,7 +287,7 @@ impl Default for RigidPose {
             commanded: [0.0; MAX_JOINTS],
             axes: [(Vector3::zeros(), Vector3::zeros()); MAX_JOINTS],
             point: Vector3::zeros(),
-            conditions: crate::kinematics::Conditions::UNKNOWN,
+            conditions: crate::model::Conditions::UNKNOWN,
         }
     }
 }

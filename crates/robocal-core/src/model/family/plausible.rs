@@ -34,6 +34,9 @@ pub const JOINT_DEFLECTION_DEG: f64 = 1.0;
 /// torque turns by 0.057 degrees; real joints have 0.01 to 10 µrad/(N·m).
 pub const COMPLIANCE_MAX_URAD_PER_NM: f64 = 1000.0;
 
+/// The largest plausible thermal expansion coefficient (ppm/K): ten times aluminium's 23 ppm/K.
+pub const THERMAL_MAX_PPM_PER_K: f64 = 250.0;
+
 /// A parameter's plausible range (display units, see the module docs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plausible {
@@ -91,10 +94,14 @@ impl Plausible {
                     "1 degree of joint deflection at the robot's reach",
                 )
             },
-            Unit::PpmPerK => Plausible::moving(
-                super::thermal::MAX_PPM_PER_K,
-                "250 ppm/K, ten times aluminium's expansion",
-            ),
+            Unit::PpmPerK => Plausible {
+                min: -THERMAL_MAX_PPM_PER_K,
+                max: THERMAL_MAX_PPM_PER_K,
+                ..Plausible::moving(
+                    THERMAL_MAX_PPM_PER_K,
+                    "250 ppm/K, ten times aluminium's expansion",
+                )
+            },
         }
     }
 

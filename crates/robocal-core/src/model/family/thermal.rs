@@ -25,8 +25,8 @@ pub const KEY: &str = "thermal";
 /// This family's registry position.
 pub const ID: FamilyId = FamilyId::new(8);
 
-/// The largest plausible coefficient (ppm/K): ten times aluminium's 23 ppm/K.
-pub const MAX_PPM_PER_K: f64 = 250.0;
+/// The largest plausible coefficient (ppm/K): [`super::plausible::THERMAL_MAX_PPM_PER_K`].
+pub const MAX_PPM_PER_K: f64 = super::plausible::THERMAL_MAX_PPM_PER_K;
 
 // Store layout: [k (1/K), reference temperature (deg C)].
 const K: usize = 0;
@@ -40,6 +40,11 @@ fn param() -> Param {
 }
 
 impl ParameterFamily for Thermal {
+    fn beyond_geometry(&self, robot: &Robot) -> bool {
+        // The lengths at one temperature are geometry; their growth with it is not.
+        robot.family_values(KEY).is_some()
+    }
+
     fn key(&self) -> &'static str {
         KEY
     }
@@ -75,15 +80,8 @@ impl ParameterFamily for Thermal {
     /// Within `-`[`MAX_PPM_PER_K`]`..`[`MAX_PPM_PER_K`]: structures of steel, cast iron,
     /// aluminium and carbon fibre lie within -1..25 ppm/K; the lumped coefficient also absorbs
     /// how unevenly the arm warms, hence the margin.
-    fn plausible(&self, _robot: &Robot, _p: Param) -> super::plausible::Plausible {
-        super::plausible::Plausible {
-            min: -MAX_PPM_PER_K,
-            max: MAX_PPM_PER_K,
-            ..super::plausible::Plausible::moving(
-                MAX_PPM_PER_K,
-                "250 ppm/K, ten times aluminium's expansion",
-            )
-        }
+    fn plausible(&self, robot: &Robot, _p: Param) -> super::plausible::Plausible {
+        super::plausible::Plausible::of_unit(robot, crate::model::Unit::PpmPerK)
     }
 
     fn enable(&self, robot: &mut Robot, _p: Param) -> Result<()> {

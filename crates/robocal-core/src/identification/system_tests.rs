@@ -1,0 +1,171 @@
+//! Tests of the parent module (`identification::system`).
+
+use super::*;
+use crate::model::presets::preset;
+use crate::simulation::{random_poses, PoseSampler};
+use rand::SeedableRng;
+
+/// The normal-equation right-hand side is minus the objective's gradient: check it against
+/// central finite differences of the objective, for every loss.
+#[test]
+fn gradient_matches_finite_differences() {
+    let truth = preset("kuka-kr480-r3330-table3").unwrap();
+    let nominal = preset("kuka-kr480-r3330").unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+    let qs = random_poses(&truth, 30, &PoseSampler::default(), &mut rng).unwrap();
+    let mut obs = Observations::new(6);
+    for q in &qs {
+        obs.push(q, truth.tool_position(q), 0).unwrap();
+    }
+    let params: Vec<Param> = nominal.params();
+    let p = Problem::new(&nominal, &params, &obs, &TrackerFrame::identity());
+    for loss in [
+        Loss::SumOfNorms { delta: 1e-6 },
+        Loss::Squared,
+        Loss::Huber { k: 0.8 },
+        Loss::Cauchy { c: 0.5 },
+    ] {
+        let acc = p.accumulate(&nominal, &loss, Level::Full);
+        let x0 = p.values(&nominal);
+        for (j, param) in params.iter().enumerate() {
+            let h = if param.unit() == crate::model::Unit::Deg {
+                1e-7
+            } else {
+                1e-5
+            };
+            let mut r = nominal.clone();
+            let mut x = x0.clone();
+            x[j] += h;
+            p.apply(&mut r, &x);
+            let fp = p.objective(&r, &loss);
+            x[j] -= 2.0 * h;
+            p.apply(&mut r, &x);
+            let fm = p.objective(&r, &loss);
+            let fd = (fp - fm) / (2.0 * h);
+            let an = -acc.b[j];
+            let scale = acc.a[(j, j)].sqrt() * acc.weighted_sq.sqrt() + 1e-12;
+            assert!(
+                (fd - an).abs() <= 1e-6 * scale + 1e-9,
+                "{loss:?} {param}: fd {fd} vs analytic {an}"
+            );
+        }
+        // The Hessian is symmetric positive semi-definite and never above A radially.
+        let h = acc.h.unwrap();
+        assert!((&h - h.transpose()).amax() <= 1e-9 * h.amax());
+    }
+}
+
+fn kr480_problem_data(n: usize, noise_mm: f64) -> (Robot, Observations) {
+    use rand_distr::{Distribution, Normal};
+    let truth = preset("kuka-kr480-r3330-table3").unwrap();
+    let nominal = preset("kuka-kr480-r3330").unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let qs = random_poses(&truth, n, &PoseSampler::default(), &mut rng).unwrap();
+    let noise = Normal::new(0.0, noise_mm).unwrap();
+    let mut obs = Observations::new(6);
+    for q in &qs {
+        let p = truth.tool_position(q);
+        let m = p + Vector3::from_fn(|_, _| noise.sample(&mut rng));
+        obs.push(q, m, 0).unwrap();
+    }
+    (nominal, obs)
+}
+
+/// `S` (the full pass's unweighted Gram matrix, accumulated as `A` plus the down-weighted
+/// points' share) equals `sum J^T J` formed directly, with a loss that leaves some points at
+/// full weight and down-weights the others.
+#[test]
+fn full_pass_gram_matrix_is_the_unweighted_sum() {
+    let (nominal, obs) = kr480_problem_data(200, 0.0);
+    let params = nominal.params();
+    let p = Problem::new(&nominal, &params, &obs, &TrackerFrame::identity());
+    let norms = p.fit_norms(&nominal);
+    let mut sorted = norms.clone();
+    sorted.sort_by(f64::total_cmp);
+    let loss = Loss::Huber {
+        k: sorted[sorted.len() / 2],
+    };
+    let full_weight = norms.iter().filter(|&&r| loss.weight(r) == 1.0).count();
+    assert!(full_weight > 50 && full_weight < 150, "{full_weight}");
+    let acc = p.accumulate(&nominal, &loss, Level::Full);
+    let k = params.len();
+    let (mut jp, mut jr) = (
+        vec![Vector3::zeros(); nominal.param_count()],
+        vec![0.0; 3 * k],
+    );
+    let mut want = DMatrix::<f64>::zeros(k, k);
+    for i in 0..obs.len() {
+        let mut e = [0.0; 3];
+        p.observation_rows(&nominal, i, &mut jp, None, &mut e, &mut jr);
+        let j = DMatrix::from_row_slice(3, k, &jr);
+        want += j.transpose() * j;
+    }
+    let s = acc.s.unwrap();
+    assert!(
+        (&s - &want).amax() <= 1e-10 * want.amax(),
+        "{}",
+        (&s - &want).amax()
+    );
+}
+
+/// A pass gives the same bits on one thread and on four.
+#[test]
+fn passes_are_deterministic_across_thread_counts() {
+    let (nominal, obs) = kr480_problem_data(3 * CHUNK + 17, 0.05);
+    let params = nominal.params();
+    let p = Problem::new(&nominal, &params, &obs, &TrackerFrame::identity());
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let acc = p.accumulate(&nominal, &Loss::SumOfNorms { delta: 1e-6 }, Level::Full);
+            let f = p.objective(&nominal, &Loss::Squared);
+            (
+                acc.a,
+                acc.b,
+                acc.s.unwrap(),
+                acc.h.unwrap(),
+                acc.objective,
+                f,
+            )
+        })
+    };
+    let one = run(1);
+    for _ in 0..3 {
+        let four = run(4);
+        assert!(one.0 == four.0 && one.1 == four.1 && one.2 == four.2 && one.3 == four.3);
+        assert_eq!(one.4.to_bits(), four.4.to_bits());
+        assert_eq!(one.5.to_bits(), four.5.to_bits());
+    }
+}
+
+/// A pass gives the same bits with AVX as with the baseline instructions (on a processor
+/// without AVX both runs are the baseline). Fewer points than a parallel pass takes, so the
+/// chunks run on this thread, where the baseline is forced.
+#[test]
+fn passes_give_the_same_bits_with_and_without_avx() {
+    let (nominal, obs) = kr480_problem_data(CHUNK + 45, 0.05);
+    let params = nominal.params();
+    let p = Problem::new(&nominal, &params, &obs, &TrackerFrame::identity());
+    for loss in [
+        Loss::SumOfNorms { delta: 1e-6 },
+        Loss::Cauchy { c: 0.05 },
+        Loss::Squared,
+    ] {
+        let run = |baseline: bool| {
+            crate::identification::simd::force_baseline(baseline);
+            let acc = p.accumulate(&nominal, &loss, Level::Full);
+            let f = p.objective(&nominal, &loss);
+            crate::identification::simd::force_baseline(false);
+            (acc, f)
+        };
+        let (wide, fw) = run(false);
+        let (base, fb) = run(true);
+        assert!(wide.a == base.a && wide.b == base.b, "{loss:?}");
+        assert!(wide.s == base.s && wide.h == base.h, "{loss:?}");
+        assert_eq!(wide.objective.to_bits(), base.objective.to_bits());
+        assert_eq!(fw.to_bits(), fb.to_bits());
+    }
+}
