@@ -4,21 +4,29 @@
 //! expansion (when they have temperatures; referred to their mean temperature), and their
 //! combinations.
 //!
+//! The candidates are found by a forward search: from the robot as given, each round fits every
+//! model with one family more than the current one (or the next harmonic order), and moves to
+//! the best of them when it lowers the current model's cross-validated error by more than its
+//! own standard error; the search stops where none does. Combinations are so tried only on top
+//! of families that earned their place, and a geometric robot costs the robot as given and one
+//! round of single families.
+//!
 //! Each candidate is fitted once to all calibration points (the whole calibration, plausibility
-//! gate included), then refitted on each of [`FOLDS`] folds with the fold's poses left out,
-//! warm-started from the full fit with the same identified parameters, frame and final loss
-//! (the folds in parallel). Rows of one pose (several reflectors, 6-DoF rows) stay in one fold.
-//! The candidate's cross-validated error is the mean position error of every calibration point
+//! gate included) and cross-validated over [`FOLDS`] folds by pose (see
+//! [`super::cross_validation`]: one Newton step from the full fit on the other folds' normal
+//! equations). Rows of one pose (several reflectors, 6-DoF rows) stay in one fold. The
+//! candidate's cross-validated error is the mean position error of every calibration point
 //! under the fit that left it out; its standard error that mean's (per-point spread over the
 //! square root of the count).
 //!
-//! The choice (the one-standard-error rule): among the candidates whose full fit converged and
-//! passed the plausibility gate, the one with the fewest identified parameters whose error is
-//! within one standard error of the lowest. The robot as given (the first candidate) is part of
-//! every other: when its fit fails, does not converge or fails the gate, it is the choice, and
-//! its calibration reports why. A family therefore stays only when it lowers the
-//! cross-validated error by more than the best candidate's standard error, and the simpler model
-//! wins a tie.
+//! The choice (the one-standard-error rule): among the candidates fitted whose full fit
+//! converged and passed the plausibility gate, the one with the fewest identified parameters
+//! whose error is within one standard error of the lowest. The robot as given (the first
+//! candidate) is part of every other: when its fit fails, does not converge or fails the gate,
+//! it is the choice, and its calibration reports why. A family therefore stays only when it
+//! lowers the cross-validated error by more than the best candidate's standard error, and the
+//! simpler model wins a tie. The chosen candidate's fit is the result's (completed with the
+//! prediction's workspace map and the validation points), not fitted again.
 
 use crate::error::Result;
 use crate::identification::cross_validation::{cross_validate, CrossValidation};
@@ -26,12 +34,13 @@ pub use crate::identification::model_choice::{
     AutoFamilies, Candidate, ModelChoice, ModelSelection,
 };
 use crate::identification::pipeline::{
-    calibrate_model, calibrate_model_for, Calibration, CalibrationData, CalibrationSettings,
-    Purpose,
+    calibrate_model, calibrate_model_for, complete, Calibration, CalibrationData,
+    CalibrationSettings, Purpose,
 };
 use crate::model::family::{backlash, compliance, thermal, transmission};
 use crate::model::Robot;
 use crate::progress::{self, Observer};
+use rayon::prelude::*;
 
 /// Folds of the cross-validation.
 pub const FOLDS: usize = 5;
@@ -59,12 +68,16 @@ pub fn calibrate(
         return calibrate_model(nominal, data, settings, observer);
     };
     observer.progress(progress::Stage::ModelSelection, 0, 1);
-    let chosen = select(nominal, data, settings, auto)?;
+    let (chosen, fit) = select_fitted(nominal, data, settings, auto)?;
     let given = CalibrationSettings {
         model: ModelChoice::Given,
         ..settings.clone()
     };
-    let mut cal = calibrate_model(&chosen.robot, data, &given, observer)?;
+    // The chosen candidate's fit is the result's: it only lacks what a candidate skips.
+    let mut cal = match fit {
+        Some(fit) => complete(fit, data, &given, observer)?,
+        None => calibrate_model(&chosen.robot, data, &given, observer)?,
+    };
     cal.settings.model = settings.model;
     cal.model_selection = Some(chosen);
     Ok(cal)
@@ -100,58 +113,70 @@ pub fn reference_temperature_c(data: &CalibrationData) -> Option<f64> {
     (!t.is_empty()).then(|| (t.iter().sum::<f64>() / t.len() as f64 * 10.0).round() / 10.0)
 }
 
-/// The candidate robots: `nominal` as given, then with the families `auto` selects.
-pub fn candidates(nominal: &Robot, auto: AutoFamilies) -> Result<Vec<Robot>> {
-    let compliant = compliance::auto_joints(nominal);
-    let with_compliance: &[bool] = if auto.compliance && !compliant.is_empty() {
-        &[false, true]
-    } else {
-        &[false]
-    };
-    let harmonics: Vec<Option<usize>> = if auto.harmonics {
-        std::iter::once(None)
-            .chain(HARMONICS.iter().map(|&h| Some(h)))
-            .collect()
-    } else {
-        vec![None]
-    };
-    let all: Vec<usize> = (0..nominal.dof()).collect();
-    let with_backlash: &[bool] = if auto.backlash {
-        &[false, true]
-    } else {
-        &[false]
-    };
-    let with_thermal: &[bool] = if auto.thermal {
-        &[false, true]
-    } else {
-        &[false]
-    };
-    let mut out = Vec::new();
-    for &c in with_compliance {
-        for h in &harmonics {
-            for &b in with_backlash {
-                for &t in with_thermal {
-                    let mut r = nominal.clone();
-                    if c {
-                        compliance::enable(&mut r, &compliant, None)?;
-                    }
-                    if let Some(h) = *h {
-                        transmission::enable(&mut r, &all, h)?;
-                    }
-                    if b {
-                        backlash::enable(&mut r, &all)?;
-                    }
-                    if t {
-                        thermal::enable(&mut r, thermal::DEFAULT_REFERENCE_C)?;
-                    }
-                    out.push(r);
-                }
-            }
+/// A candidate's non-geometric families, as the search builds them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct Families {
+    compliance: bool,
+    /// Order of the transmission harmonics (0: none).
+    harmonics: usize,
+    backlash: bool,
+    thermal: bool,
+}
+
+impl Families {
+    /// The sets with one family more (the next harmonic order for the harmonics), among those
+    /// `auto` selects; `compliant`: whether the robot has joints compliance can take.
+    fn larger(self, auto: AutoFamilies, compliant: bool) -> Vec<Families> {
+        let mut out = Vec::new();
+        if auto.compliance && compliant && !self.compliance {
+            out.push(Families {
+                compliance: true,
+                ..self
+            });
         }
+        if auto.harmonics && HARMONICS.contains(&(self.harmonics + 1)) {
+            out.push(Families {
+                harmonics: self.harmonics + 1,
+                ..self
+            });
+        }
+        if auto.backlash && !self.backlash {
+            out.push(Families {
+                backlash: true,
+                ..self
+            });
+        }
+        if auto.thermal && !self.thermal {
+            out.push(Families {
+                thermal: true,
+                ..self
+            });
+        }
+        out
     }
-    // Simplest first: fewer parameters, then the order above.
-    out.sort_by_key(|r| r.param_count());
-    Ok(out)
+
+    /// `nominal` with these families (their parameters at zero); thermal expansion referred to
+    /// `reference_c`.
+    fn robot(self, nominal: &Robot, reference_c: Option<f64>) -> Result<Robot> {
+        let mut r = nominal.clone();
+        if self.compliance {
+            compliance::enable(&mut r, &compliance::auto_joints(nominal), None)?;
+        }
+        if self.harmonics > 0 {
+            let all: Vec<usize> = (0..nominal.dof()).collect();
+            transmission::enable(&mut r, &all, self.harmonics)?;
+        }
+        if self.backlash {
+            backlash::enable(&mut r, &(0..nominal.dof()).collect::<Vec<_>>())?;
+        }
+        if self.thermal {
+            thermal::enable(&mut r, thermal::DEFAULT_REFERENCE_C)?;
+        }
+        if let Some(t) = reference_c {
+            thermal::set_reference_c(&mut r, t)?;
+        }
+        Ok(r)
+    }
 }
 
 /// Chooses the model the calibration data support among the [`candidates`] of `nominal` (see
@@ -162,6 +187,17 @@ pub fn select(
     settings: &CalibrationSettings,
     auto: AutoFamilies,
 ) -> Result<ModelSelection> {
+    Ok(select_fitted(nominal, data, settings, auto)?.0)
+}
+
+/// [`select`], with the chosen candidate's fit when it converged within the candidates'
+/// iteration limit (a fit that did not is redone with the settings' limit).
+fn select_fitted(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    auto: AutoFamilies,
+) -> Result<(ModelSelection, Option<Calibration>)> {
     // Backlash needs approach directions, thermal expansion temperatures.
     let reference_c = reference_temperature_c(&data);
     let auto = AutoFamilies {
@@ -169,18 +205,6 @@ pub fn select(
         thermal: auto.thermal && reference_c.is_some(),
         ..auto
     };
-    let mut robots = candidates(nominal, auto)?;
-    if let Some(t) = reference_c {
-        for r in &mut robots {
-            thermal::set_reference_c(r, t)?;
-        }
-    }
-    let selectable = robots.len();
-    // Families the user fixed are in every candidate: the geometric model beside them tells
-    // whether they lower the error at all.
-    if !families(nominal).is_empty() {
-        robots.push(nominal.geometric());
-    }
     let mut fit_settings = settings.clone();
     fit_settings.model = ModelChoice::Given;
     fit_settings.solver.max_iterations =
@@ -189,69 +213,141 @@ pub fn select(
         validation: None,
         ..data
     };
-    let mut candidates = Vec::with_capacity(robots.len());
-    for (i, robot) in robots.iter().enumerate() {
-        let mut cand = Candidate {
+    let fit = |robot: &Robot, reference: bool| -> (Candidate, Option<Calibration>) {
+        match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &()) {
+            Err(e) => {
+                let mut cand = Candidate::new(robot, reference);
+                cand.rejected = Some(format!("the fit failed: {e}"));
+                (cand, None)
+            }
+            Ok(cal) => assess(robot, reference, cal, data),
+        }
+    };
+    let compliant = !compliance::auto_joints(nominal).is_empty();
+    let given = Families::default().robot(nominal, reference_c)?;
+    // The robot as given is part of every candidate: its fit failing is the calibration's.
+    let (c0, f0) = assess(
+        &given,
+        false,
+        calibrate_model_for(&given, data, &fit_settings, Purpose::Candidate, &())?,
+        data,
+    );
+    let mut sets = vec![Families::default()];
+    let mut robots = vec![given];
+    let mut candidates = vec![c0];
+    let mut fits = vec![f0];
+    // Forward search: from the robot as given, each round fits every set with one family more
+    // than the current one, and moves to the best if it lowers the error by more than its
+    // standard error; the search stops where none does.
+    let mut current = 0;
+    while candidates[current].rejected.is_none() {
+        let next: Vec<Families> = sets[current]
+            .larger(auto, compliant)
+            .into_iter()
+            .filter(|f| !sets.contains(f))
+            .collect();
+        let built: Vec<Robot> = next
+            .iter()
+            .map(|f| f.robot(nominal, reference_c))
+            .collect::<Result<_>>()?;
+        let outcomes: Vec<(Candidate, Option<Calibration>)> =
+            built.par_iter().map(|r| fit(r, false)).collect();
+        let first = candidates.len();
+        for ((f, r), o) in next.into_iter().zip(built).zip(outcomes) {
+            let (c, fitted) = o;
+            sets.push(f);
+            robots.push(r);
+            candidates.push(c);
+            fits.push(fitted);
+        }
+        let best = (first..candidates.len())
+            .filter(|&i| candidates[i].rejected.is_none())
+            .min_by(|&a, &b| cv(&candidates[a]).total_cmp(&cv(&candidates[b])));
+        match best {
+            Some(b) if lowers(&candidates[b], &candidates[current]) => current = b,
+            _ => break,
+        }
+    }
+    // Families the user fixed are in every candidate: the geometric model beside them tells
+    // whether they lower the error at all.
+    if !families(nominal).is_empty() {
+        let geometric = nominal.geometric();
+        let (c, _) = fit(&geometric, true);
+        robots.push(geometric);
+        candidates.push(c);
+        fits.push(None);
+    }
+    let chosen = choose(&candidates);
+    candidates[chosen].chosen = true;
+    let selection = ModelSelection {
+        folds: FOLDS,
+        remark: overfitting(&candidates[chosen], candidates.iter().find(|c| c.reference)),
+        candidates,
+        robot: robots.swap_remove(chosen),
+    };
+    Ok((selection, fits.swap_remove(chosen)))
+}
+
+/// A candidate's fit judged: rejected when it did not converge or fails the plausibility gate,
+/// else cross-validated. The fit is returned when it stands.
+fn assess(
+    robot: &Robot,
+    reference: bool,
+    cal: Calibration,
+    data: CalibrationData,
+) -> (Candidate, Option<Calibration>) {
+    let mut cand = Candidate::new(robot, reference);
+    cand.identified = cal.identifiability.identified.len();
+    let whole = cal.whole_solve();
+    if !whole.termination.converged() {
+        cand.rejected = Some(format!(
+            "the solver {} after {} iterations",
+            whole.termination.describe(),
+            whole.iterations
+        ));
+        return (cand, None);
+    }
+    if cal.plausibility.implausible() {
+        cand.rejected = Some(format!(
+            "failed the plausibility gate: {}",
+            cal.plausibility
+                .failures()
+                .map(|f| f.detail.clone())
+                .collect::<Vec<_>>()
+                .join("; ")
+        ));
+        return (cand, None);
+    }
+    match cross_validate(&cal, data.calibration, FOLDS) {
+        Ok(CrossValidation {
+            mean_mm,
+            std_error_mm,
+            ..
+        }) => {
+            cand.cv_mean_mm = Some(mean_mm);
+            cand.cv_std_error_mm = Some(std_error_mm);
+            (cand, Some(cal))
+        }
+        Err(e) => {
+            cand.rejected = Some(format!("the cross-validation failed: {e}"));
+            (cand, None)
+        }
+    }
+}
+
+impl Candidate {
+    /// A candidate for `robot` not yet fitted.
+    fn new(robot: &Robot, reference: bool) -> Candidate {
+        Candidate {
             families: families(robot),
             identified: 0,
             cv_mean_mm: None,
             cv_std_error_mm: None,
             rejected: None,
             chosen: false,
-            reference: i >= selectable,
-        };
-        match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &()) {
-            // The robot as given is part of every candidate: its error is the calibration's.
-            Err(e) if i == 0 => return Err(e),
-            Err(e) => cand.rejected = Some(format!("the fit failed: {e}")),
-            Ok(cal) => {
-                cand.identified = cal.identifiability.identified.len();
-                let whole = cal.whole_solve();
-                if !whole.termination.converged() {
-                    cand.rejected = Some(format!(
-                        "the solver {} after {} iterations",
-                        whole.termination.describe(),
-                        whole.iterations
-                    ));
-                } else if cal.plausibility.implausible() {
-                    cand.rejected = Some(format!(
-                        "failed the plausibility gate: {}",
-                        cal.plausibility
-                            .failures()
-                            .map(|f| f.detail.clone())
-                            .collect::<Vec<_>>()
-                            .join("; ")
-                    ));
-                }
-                if cand.rejected.is_some() {
-                    candidates.push(cand);
-                    continue;
-                }
-                match cross_validate(&cal, data.calibration, FOLDS) {
-                    Ok(CrossValidation {
-                        mean_mm,
-                        std_error_mm,
-                        ..
-                    }) => {
-                        cand.cv_mean_mm = Some(mean_mm);
-                        cand.cv_std_error_mm = Some(std_error_mm);
-                    }
-                    Err(e) => {
-                        cand.rejected = Some(format!("the cross-validation failed: {e}"));
-                    }
-                }
-            }
+            reference,
         }
-        candidates.push(cand);
     }
-    let chosen = choose(&candidates);
-    candidates[chosen].chosen = true;
-    Ok(ModelSelection {
-        folds: FOLDS,
-        remark: overfitting(&candidates[chosen], candidates.iter().find(|c| c.reference)),
-        candidates,
-        robot: robots[chosen].clone(),
-    })
 }
 
 /// The remark on families given explicitly (`chosen`, which carries them) that do not lower the
@@ -278,6 +374,17 @@ fn overfitting(chosen: &Candidate, reference: Option<&Candidate>) -> Option<Stri
             r.identified
         )
     })
+}
+
+/// A candidate's cross-validated error (infinite when it has none).
+fn cv(c: &Candidate) -> f64 {
+    c.cv_mean_mm.unwrap_or(f64::INFINITY)
+}
+
+/// Whether `larger` lowers `smaller`'s cross-validated error by more than its own standard
+/// error.
+fn lowers(larger: &Candidate, smaller: &Candidate) -> bool {
+    cv(larger) + larger.cv_std_error_mm.unwrap_or(f64::INFINITY) < cv(smaller)
 }
 
 /// The one-standard-error rule over the selectable candidates (simplest first in `c`): the

@@ -91,7 +91,7 @@ pub(super) fn identifiable(
 }
 
 /// Why the identified parameters are too nearly dependent for double precision, if they are.
-fn ill_conditioned(ident: &Identifiability) -> Option<String> {
+pub(super) fn ill_conditioned(ident: &Identifiability) -> Option<String> {
     ident.ill_conditioned().then(|| {
         let (p, ind) = ident
             .least_independent()

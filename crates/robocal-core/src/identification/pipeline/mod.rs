@@ -267,6 +267,57 @@ fn calibrate_once(
     outcome::assemble(&job, start, identified, solved)
 }
 
+/// Completes a calibration `cal` fitted for [`Purpose::Candidate`] without validation points
+/// (a model selection's candidate) into the result [`calibrate_model`] would give for `data`
+/// and `settings`: the same fit, with the prediction's workspace map, the validation points'
+/// errors and the gate on them. The fit's steps are not repeated: the registration, tool fit,
+/// identifiability and solve are the candidate's.
+pub(crate) fn complete(
+    cal: Calibration,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    observer: &dyn Observer,
+) -> Result<Calibration> {
+    inputs::check(&cal.nominal, &data, settings)?;
+    let nominal = cal.nominal.clone();
+    let robot = if cal.tool_fit.applied {
+        cal.tool_fit.apply(&nominal)
+    } else {
+        nominal.clone()
+    };
+    let observations = Weighting {
+        tracker: cal.weighting.tracker,
+        ..settings.weighting
+    }
+    .apply(data.calibration)?;
+    let start = start::StartModel {
+        registration: cal.registration,
+        tool_fit: cal.tool_fit,
+        weighting: cal.weighting,
+        observations,
+        robot,
+        frame: cal.frame,
+    };
+    let identified = identify::Identified {
+        ill_conditioned: identify::ill_conditioned(&cal.identifiability),
+        identifiability: cal.identifiability,
+    };
+    let solved = stages::Solved {
+        robot: cal.calibrated,
+        loss: cal.stages.last().expect("at least one stage").loss,
+        stages: cal.stages,
+        robust_scale: cal.robust_scale_mm,
+    };
+    let job = Job {
+        nominal: &nominal,
+        data,
+        settings,
+        purpose: Purpose::Result,
+        observer,
+    };
+    outcome::assemble(&job, start, identified, solved)
+}
+
 /// The stages of a solve as one report: the last stage's termination (a stage that does not
 /// converge ends the solve), the iterations and evaluations of all stages, the first stage's
 /// initial objective and the last one's final values.
