@@ -323,9 +323,9 @@ impl<'a> Predictor<'a> {
 
     /// The prediction from the model-error covariances `J C J^T` of the poses averaged over (the
     /// calibration poses), and the workspace map.
+    /// `models` are those of [`averaged_poses`].
     fn predict_from(&self, models: &[Matrix3<f64>], floor_z_mm: f64, map: bool) -> Prediction {
-        let stride = models.len().div_ceil(MAX_POSES).max(1);
-        let picked: Vec<&Matrix3<f64>> = models.iter().step_by(stride).collect();
+        let picked: Vec<&Matrix3<f64>> = models.iter().collect();
         let means = map_poses(picked.len(), || (), |_, i| self.mean_norm(picked[i]));
         let (mut sum, mut sum_sq, mut model_sq) = (0.0, 0.0, 0.0);
         for (model, mean) in picked.iter().zip(&means) {
@@ -353,10 +353,11 @@ impl<'a> Predictor<'a> {
 
     /// The prediction over poses `qs` (the calibration poses) and the workspace map.
     pub fn predict(&self, qs: &[&[f64]], floor_z_mm: f64) -> Prediction {
+        let picked = averaged_poses(qs.len());
         let models = map_poses(
-            qs.len(),
+            picked.len(),
             || self.scratch(),
-            |s, i| self.model_at(s, qs[i], 0).1,
+            |s, i| self.model_at(s, qs[picked[i]], 0).1,
         );
         self.predict_from(&models, floor_z_mm, true)
     }
@@ -439,22 +440,28 @@ pub fn noise_sigma(
     (sum / kept.len() as f64).sqrt()
 }
 
-/// The leverages `h_i = tr(J_i S^-1 J_i^T)` of points `kept` (Jacobian blocks of `rows x k`,
-/// row-major, point i's at `jac[i * rows * k..]`), `S = sum J^T J` over them; `None` when `S` is
-/// singular. With `S = L L^T`, `h_i` is the squared norm of `L^-1 J_i^T`, by forward
-/// substitution row by row.
-fn leverages(jac: &[f64], k: usize, rows: usize, kept: &[usize]) -> Option<Vec<f64>> {
-    let block = rows * k;
+/// The leverages `h_i = tr(J_i S^-1 J_i^T)` of points `kept` (each point's Jacobian block of
+/// `rows x k`, row-major, written by `jacobian(scratch, i, out)`), `S = sum J^T J` over them;
+/// `None` when `S` is singular. With `S = L L^T`, `h_i` is the squared norm of `L^-1 J_i^T`, by
+/// forward substitution row by row. The blocks are computed twice (for `S`, then for `h`)
+/// rather than stored: the memory stays flat however many points there are.
+fn leverages<S: Send>(
+    k: usize,
+    rows: usize,
+    kept: &[usize],
+    scratch: &(dyn Fn() -> S + Sync),
+    jacobian: &(dyn Fn(&mut S, usize, &mut [f64]) + Sync),
+) -> Option<Vec<f64>> {
     // S in chunks (in parallel for many points, the same bits on any number of threads).
-    let upper = crate::identification::system::chunked(
+    let (_, _, upper) = crate::identification::system::chunked(
         kept.len(),
-        || vec![0.0; k * k],
-        |m, n| {
-            let i = kept[n];
-            add_gram(m, &jac[i * block..(i + 1) * block], rows, k, 1.0);
+        || (scratch(), vec![0.0; rows * k], vec![0.0; k * k]),
+        |(s, j, m), n| {
+            jacobian(s, kept[n], j);
+            add_gram(m, j, rows, k, 1.0);
         },
         |mut a, b| {
-            a.iter_mut().zip(&b).for_each(|(x, y)| *x += y);
+            a.2.iter_mut().zip(&b.2).for_each(|(x, y)| *x += y);
             a
         },
     );
@@ -473,9 +480,9 @@ fn leverages(jac: &[f64], k: usize, rows: usize, kept: &[usize]) -> Option<Vec<f
     let l: Vec<f64> = (0..m * m).map(|i| l[(i / m, i % m)]).collect();
     let h = map_poses(
         kept.len(),
-        || vec![0.0; rows * m],
-        |y, n| {
-            let j = &jac[kept[n] * block..(kept[n] + 1) * block];
+        || (scratch(), vec![0.0; rows * k], vec![0.0; rows * m]),
+        |(s, j, y), n| {
+            jacobian(s, kept[n], j);
             // The rows' forward substitutions side by side (independent sums in flight).
             let mut h = 0.0;
             for a in 0..m {
@@ -530,38 +537,62 @@ pub(crate) fn predict_with(
     let pred = Predictor::new(calibrated, covariance, 0.0)?;
     let k = pred.index.len();
     let n = calibration.len();
-    let per_pose = map_poses(
-        n,
-        || pred.scratch(),
-        |s, i| {
-            // With AVX where the processor has it (the same bits, see `simd`).
-            with_avx(
-                #[inline(always)]
-                || {
-                    let q = calibration.q(i);
-                    let (p, model) = pred.model_at(s, q, calibration.target(i));
-                    (s.j.clone(), model, p.z)
-                },
-            )
-        },
-    );
-    let mut jac = Vec::with_capacity(n * 3 * k);
-    let mut models = Vec::with_capacity(n);
-    let mut floor = f64::INFINITY;
-    for (j, m, z) in per_pose {
-        jac.extend_from_slice(&j);
-        models.push(m);
-        floor = floor.min(z);
-    }
+    // Each point's Jacobian, recomputed where needed rather than stored for a million points.
+    // With AVX where the processor has it (the same bits, see `simd`).
+    let jacobian = |s: &mut Scratch, i: usize, out: &mut [f64]| {
+        with_avx(
+            #[inline(always)]
+            || {
+                target_jacobian(
+                    pred.robot,
+                    &pred.index,
+                    calibration.q(i),
+                    calibration.target(i),
+                    &mut s.jp,
+                    out,
+                )
+            },
+        )
+    };
     // (The leverages come from the tool point's rows: exact for point measurements.)
     let sigma = noise_sigma(residual_norms, rows, threshold_mm, &|kept| {
-        leverages(&jac, k, 3, kept)
+        leverages(k, 3, kept, &|| pred.scratch(), &|s, i, out| {
+            jacobian(s, i, out);
+        })
     });
     if !sigma.is_finite() {
         return None;
     }
+    // The lowest tool point (the map's floor), and the model parts at the poses averaged over.
+    let floor = crate::identification::system::chunked(
+        n,
+        || f64::INFINITY,
+        |lowest, i| {
+            let p = calibrated.target_position(calibration.q(i), calibration.target(i));
+            *lowest = lowest.min(p.z);
+        },
+        f64::min,
+    );
+    let picked = averaged_poses(n);
+    let models = map_poses(
+        picked.len(),
+        || pred.scratch(),
+        |s, i| {
+            let i = picked[i];
+            with_avx(
+                #[inline(always)]
+                || pred.model_at(s, calibration.q(i), calibration.target(i)).1,
+            )
+        },
+    );
     let pred = Predictor { sigma, ..pred };
     Some(pred.predict_from(&models, floor, map))
+}
+
+/// The poses of `n` a prediction averages over: every one, or an even spread of at most
+/// [`MAX_POSES`].
+fn averaged_poses(n: usize) -> Vec<usize> {
+    (0..n).step_by(n.div_ceil(MAX_POSES).max(1)).collect()
 }
 
 #[cfg(test)]
