@@ -24,13 +24,36 @@ struct Walk<'a> {
     hit: RefCell<Option<String>>,
 }
 
-/// One value of the document at `path` (`""` for the root).
-struct Node<'w, 'a> {
-    walk: &'w Walk<'a>,
-    path: String,
+/// Where a value sits in the document: a chain of keys and indices up to the root, written out
+/// as a path (`points.calibration[3].line`) only when a walk stops there (building every
+/// value's path would allocate for each of a result's thousands of array elements).
+enum At<'p> {
+    Root,
+    Key(&'p str, &'p At<'p>),
+    Index(usize, &'p At<'p>),
 }
 
-impl<'de> DeserializeSeed<'de> for Node<'_, '_> {
+impl At<'_> {
+    /// The path written out (`""` for the root).
+    fn path(&self) -> String {
+        match self {
+            At::Root => String::new(),
+            At::Key(k, up) => match up.path() {
+                p if p.is_empty() => (*k).to_string(),
+                p => format!("{p}.{k}"),
+            },
+            At::Index(i, up) => format!("{}[{i}]", up.path()),
+        }
+    }
+}
+
+/// One value of the document, at `at`.
+struct Node<'w, 'a, 'p> {
+    walk: &'w Walk<'a>,
+    at: &'p At<'p>,
+}
+
+impl<'de> DeserializeSeed<'de> for Node<'_, '_, '_> {
     type Value = ();
 
     fn deserialize<D: de::Deserializer<'de>>(self, d: D) -> Result<(), D::Error> {
@@ -38,7 +61,7 @@ impl<'de> DeserializeSeed<'de> for Node<'_, '_> {
     }
 }
 
-impl<'de> Visitor<'de> for Node<'_, '_> {
+impl<'de> Visitor<'de> for Node<'_, '_, '_> {
     type Value = ();
 
     fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
@@ -72,9 +95,10 @@ impl<'de> Visitor<'de> for Node<'_, '_> {
     fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<(), A::Error> {
         let mut i = 0;
         loop {
+            let at = At::Index(i, self.at);
             let node = Node {
                 walk: self.walk,
-                path: format!("{}[{i}]", self.path),
+                at: &at,
             };
             if seq.next_element_seed(node)?.is_none() {
                 return Ok(());
@@ -86,24 +110,21 @@ impl<'de> Visitor<'de> for Node<'_, '_> {
     fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<(), A::Error> {
         let mut seen = HashSet::new();
         while let Some(key) = map.next_key::<String>()? {
-            let path = if self.path.is_empty() {
-                key.clone()
-            } else {
-                format!("{}.{key}", self.path)
-            };
+            let at = At::Key(&key, self.at);
             let stop = match self.walk.find {
-                Some(target) => target == path,
-                None => !seen.insert(key),
+                Some(target) => target == at.path(),
+                None => seen.contains(&key),
             };
             if stop {
                 // serde_json adds the line of the key just read to this error.
-                *self.walk.hit.borrow_mut() = Some(path);
+                *self.walk.hit.borrow_mut() = Some(at.path());
                 return Err(de::Error::custom("duplicate key"));
             }
             map.next_value_seed(Node {
                 walk: self.walk,
-                path,
+                at: &at,
             })?;
+            seen.insert(key);
         }
         Ok(())
     }
@@ -153,7 +174,7 @@ fn run(walk: &Walk, text: &str) -> Result<(), serde_json::Error> {
     let mut de = serde_json::Deserializer::from_str(text);
     Node {
         walk,
-        path: String::new(),
+        at: &At::Root,
     }
     .deserialize(&mut de)?;
     de.end()

@@ -142,12 +142,10 @@ pub struct CalibrationResult {
     /// Orientation errors of 6-DoF data (deg).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orientation_errors: Option<super::result_cell::OrientationErrors>,
-    /// Per-point errors.
-    #[serde(
-        default,
-        skip_serializing_if = "Option::is_none",
-        serialize_with = "sorted_opt"
-    )]
+    /// Per-point errors. Written directly, not through `sorted_opt`: its structs declare their
+    /// fields in alphabetical order, and a million points through a `serde_json::Value` took
+    /// 600 MB.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub points: Option<Points>,
     /// The predicted accuracy at new poses.
     #[serde(
@@ -240,12 +238,21 @@ impl CalibrationResult {
     /// the `status` is one robocal writes ([`KNOWN_STATUSES`]) and that every number is within
     /// its plausible range ([`crate::ranges`]): parameters, tracker frame and error statistics.
     pub fn parse(text: &str, path: &Path) -> Result<CalibrationResult> {
+        Ok(Self::parse_with_nominal(text, path)?.0)
+    }
+
+    /// [`CalibrationResult::parse`], with the nominal robot the result describes (when it
+    /// describes one).
+    fn parse_with_nominal(
+        text: &str,
+        path: &Path,
+    ) -> Result<(CalibrationResult, Option<crate::model::Robot>)> {
         let r: CalibrationResult = crate::io::input::parse_json(text, path, "robocal result")?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         check_status(r.status.as_ref(), text, path)?;
         check_parameters(&r.parameters, text, path)?;
         check_frame(&r.tracker_frame, "tracker_frame", text, path)?;
-        r.robot.nominal_robot(path, Some(text))?;
+        let nominal = r.robot.nominal_robot(path, Some(text))?;
         let e = &r.errors;
         let tables = [
             ("calibration", Some(&e.calibration)),
@@ -266,7 +273,7 @@ impl CalibrationResult {
                 }
             }
         }
-        Ok(r)
+        Ok((r, nominal))
     }
 
     /// Writes the result atomically as pretty JSON, after reading the text back as every command
@@ -277,12 +284,11 @@ impl CalibrationResult {
         let mut s = serde_json::to_string_pretty(self)
             .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
         s.push('\n');
-        let readable = Self::parse(&s, path).and_then(|back| {
-            match back.robot.nominal_robot(path, Some(&s))? {
+        let readable =
+            Self::parse_with_nominal(&s, path).and_then(|(back, nominal)| match nominal {
                 Some(nominal) => back.calibrated_robot(&nominal, path).map(|_| ()),
                 None => Ok(()),
-            }
-        });
+            });
         if let Err(e) = readable {
             return Err(Error::Implausible(format!(
                 "the result cannot be right: robocal's own readers (evaluate, compensate, report, \
@@ -551,6 +557,7 @@ fn check_status(status: Option<&StatusValue>, text: &str, path: &Path) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::result_sections::PointEntry;
     use serde_json::{json, Value};
 
     fn good() -> Value {
@@ -583,6 +590,24 @@ mod tests {
     fn line_of(v: &Value, needle: &str) -> usize {
         let text = serde_json::to_string_pretty(v).unwrap();
         1 + text.lines().position(|l| l.contains(needle)).unwrap()
+    }
+
+    /// `points` is written as declared, not through a sorted `Value`: its keys must come out
+    /// in the order every other section's do.
+    #[test]
+    fn points_are_written_with_sorted_keys() {
+        let p = |line, before_mm, after_mm| PointEntry {
+            after_mm,
+            before_mm,
+            line,
+        };
+        let points = Points {
+            calibration: vec![p(2, 1.5, 0.01), p(3, f64::NAN, 0.02)],
+            validation: Some(vec![p(9, 2.5, 0.03)]),
+        };
+        let direct = serde_json::to_string_pretty(&points).unwrap();
+        let via_value = serde_json::to_string_pretty(&serde_json::to_value(&points).unwrap());
+        assert_eq!(direct, via_value.unwrap());
     }
 
     #[test]

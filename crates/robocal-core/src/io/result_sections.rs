@@ -465,20 +465,21 @@ pub struct DownweightedEntry {
     pub weight: f64,
 }
 
-/// One point's errors.
+/// One point's errors. (Fields in alphabetical order: the result writes them as declared.)
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PointEntry {
-    /// Its line.
-    pub line: usize,
-    /// Error of the nominal model (mm).
-    #[serde(deserialize_with = "nullable::f64")]
-    pub before_mm: f64,
     /// Error of the calibrated model (mm).
     #[serde(deserialize_with = "nullable::f64")]
     pub after_mm: f64,
+    /// Error of the nominal model (mm).
+    #[serde(deserialize_with = "nullable::f64")]
+    pub before_mm: f64,
+    /// Its line.
+    pub line: usize,
 }
 
-/// `points`: per-point errors.
+/// `points`: per-point errors. (Fields in alphabetical order: the result writes them as
+/// declared.)
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Points {
     /// The calibration points.
