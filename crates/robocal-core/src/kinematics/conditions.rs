@@ -31,7 +31,7 @@ impl Robot {
         }
         let r = self.at_temperature(c);
         let r = r.as_ref();
-        let mut rigid = r.rigid_pose(q);
+        let mut rigid = r.rigid_for_families(q);
         rigid.conditions = *c;
         let mut ch = if r.deflects_joints() {
             let mut buf = [0.0; MAX_JOINTS];

@@ -88,7 +88,7 @@ impl Robot {
         if !self.deflects_joints() {
             return q;
         }
-        let rigid = self.rigid_pose(q);
+        let rigid = self.rigid_for_families(q);
         self.deflect_with(&rigid, q, buf)
     }
 
@@ -124,7 +124,7 @@ impl Robot {
         if !self.deflects_joints() {
             return self.rigid_pose_frames(q, t);
         }
-        let rigid = self.rigid_pose(q);
+        let rigid = self.rigid_for_families(q);
         let mut buf = [0.0; MAX_JOINTS];
         let mut ch = self.rigid_pose_frames(self.deflect_with(&rigid, q, &mut buf), t);
         ch.rigid = rigid;
@@ -143,6 +143,21 @@ impl Robot {
         ch.point = f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
         ch.target = t;
         ch
+    }
+
+    /// What the families' deflections read at the commanded joints `q`: the rigid forward pass
+    /// ([`Robot::rigid_pose`]) when one of them reads its axes (compliance), else the commanded
+    /// joints alone (transmission errors and backlash need no forward pass).
+    pub(crate) fn rigid_for_families(&self, q: &[f64]) -> RigidPose {
+        let axes = family::all()
+            .iter()
+            .any(|f| f.deflects_joints(self) && f.deflection_reads_axes(self));
+        if axes {
+            return self.rigid_pose(q);
+        }
+        let mut out = RigidPose::default();
+        out.commanded[..q.len()].copy_from_slice(q);
+        out
     }
 
     /// The joint axes and the tool point at exactly the joint values `q`, without deflection: a

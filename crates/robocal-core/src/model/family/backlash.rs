@@ -115,6 +115,10 @@ impl ParameterFamily for Backlash {
         });
     }
 
+    fn deflection_reads_axes(&self, _robot: &Robot) -> bool {
+        false
+    }
+
     fn deflects_joints(&self, robot: &Robot) -> bool {
         robot.family_values(KEY).is_some()
     }

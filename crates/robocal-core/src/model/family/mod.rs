@@ -140,6 +140,13 @@ pub trait ParameterFamily: Sync {
         false
     }
 
+    /// Whether this family's deflection (and its columns) read the rigid pass's joint axes and
+    /// tool point ([`RigidPose::axes`], [`RigidPose::point`]), not only the commanded joints:
+    /// without such a family the forward kinematics skips that pass.
+    fn deflection_reads_axes(&self, _robot: &Robot) -> bool {
+        true
+    }
+
     /// Whether this family is beyond this robot's geometry: it moves the joints
     /// ([`ParameterFamily::deflects_joints`]) or depends on the conditions of a measurement (a
     /// temperature). [`Robot::geometric`] drops such families.

@@ -53,6 +53,21 @@ fn store_len(n: usize) -> usize {
     FLAGS + n + n * MAX_HARMONICS * 2
 }
 
+/// `(sin(h q), cos(h q))` for `h = 1..=count`, from one `sin_cos` by the angle-addition
+/// recurrence (a few ulps from the direct values for the few harmonics there are; the trigonometric
+/// functions were a fifth of a fit's time when each harmonic called its own).
+#[inline]
+fn harmonic_terms(q: f64, count: usize) -> [(f64, f64); MAX_HARMONICS] {
+    let mut out = [(0.0, 0.0); MAX_HARMONICS];
+    let (s1, c1) = q.sin_cos();
+    let (mut s, mut c) = (s1, c1);
+    for t in out.iter_mut().take(count) {
+        *t = (s, c);
+        (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
+    }
+    out
+}
+
 /// The transmission-error family (see the module docs).
 pub struct Transmission;
 
@@ -143,15 +158,25 @@ impl ParameterFamily for Transmission {
         dp: &mut [Vector3<f64>],
         mut dw: Option<&mut [Vector3<f64>]>,
     ) {
+        let count = harmonics(robot);
+        let q = &pose.rigid.commanded;
+        let mut terms = [[(0.0, 0.0); MAX_HARMONICS]; crate::model::MAX_JOINTS];
+        for (t, &qi) in terms.iter_mut().zip(&q[..robot.dof()]) {
+            *t = harmonic_terms(qi, count);
+        }
         let mut k = 0;
         each_param(robot, |_, i, h, sine| {
-            let x = (h + 1) as f64 * pose.rigid.commanded[i];
-            let b = if sine { x.sin() } else { x.cos() };
+            let (s, c) = terms[i][h];
+            let b = if sine { s } else { c };
             let (sv, sw) = pose.joint_screw(robot, i);
             dp[k] = sv * b;
             put(&mut dw, k, sw * b);
             k += 1;
         });
+    }
+
+    fn deflection_reads_axes(&self, _robot: &Robot) -> bool {
+        false
     }
 
     fn deflects_joints(&self, robot: &Robot) -> bool {
@@ -166,8 +191,8 @@ impl ParameterFamily for Transmission {
         let q = &rigid.commanded;
         let count = v[COUNT] as usize;
         for i in (0..n).filter(|&i| v[FLAGS + i] == 1.0) {
-            for h in 0..count {
-                let (s, c) = ((h + 1) as f64 * q[i]).sin_cos();
+            let terms = harmonic_terms(q[i], count);
+            for (h, &(s, c)) in terms.iter().enumerate().take(count) {
                 dq[i] += v[slot(n, i, h, false)] * c + v[slot(n, i, h, true)] * s;
             }
         }
