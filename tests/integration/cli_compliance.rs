@@ -263,3 +263,58 @@ fn real_ur5_and_wam_improve_with_compliance_and_harmonics() {
         assert_eq!(j["status"], "calibrated");
     }
 }
+
+/// The default model (`--model auto`) on the real UR5 and WAM: the families the calibration
+/// data support, chosen by cross-validation, validate at or below 0.091 mm on the UR5 (the
+/// geometric model: 0.101 mm) and 3.0 mm on the WAM; and every family set the UR5's selection
+/// may fit converges within 25 iterations of the default objective.
+#[test]
+fn real_ur5_and_wam_default_model_and_iterations() {
+    let Some(data) = real_data() else { return };
+    let dir = Dir::new();
+    let calibrate = |robot: &str, name: &str, extra: &[&str]| {
+        let out = dir.join(format!("{robot}-{name}.json"));
+        let mut args = vec![
+            "calibrate".to_owned(),
+            "--robot".to_owned(),
+            example(&format!("{robot}.toml")),
+            "--data".to_owned(),
+            p(&data.join(format!("jacobi_{robot}_grid.csv"))).to_owned(),
+            "--validate".to_owned(),
+            p(&data.join(format!("jacobi_{robot}_random.csv"))).to_owned(),
+            "--out".to_owned(),
+            p(&out).to_owned(),
+        ];
+        args.extend(extra.iter().map(|s| s.to_string()));
+        ok(&args);
+        read_json(&out)
+    };
+    for (robot, limit) in [("ur5", 0.091), ("wam", 3.0)] {
+        let j = calibrate(robot, "auto", &[]);
+        let v = mean(&j, "validation");
+        let chosen = j["model_selection"]["candidates"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["chosen"] == true)
+            .map(|c| c["families"].clone());
+        eprintln!("{robot} default: {chosen:?}, validation {v:.4} mm");
+        assert!(v <= limit, "{robot}: {v} mm with {chosen:?}");
+        assert_eq!(j["status"], "calibrated");
+    }
+    for (name, extra) in [
+        ("geometric", vec![]),
+        ("h1", vec!["--harmonics", "1"]),
+        ("h2", vec!["--harmonics", "2"]),
+        ("c", vec!["--compliance", "auto"]),
+        ("c-h1", vec!["--compliance", "auto", "--harmonics", "1"]),
+        ("c-h2", vec!["--compliance", "auto", "--harmonics", "2"]),
+    ] {
+        let mut args = vec!["--model", "geometric"];
+        args.extend(extra);
+        let j = calibrate("ur5", name, &args);
+        let it = j["solver"]["iterations"].as_u64().unwrap();
+        eprintln!("ur5 {name}: {it} iterations");
+        assert!(it <= 25, "ur5 {name}: {it} iterations");
+    }
+}

@@ -17,8 +17,16 @@ pub(crate) fn print_selection(
         sel.chosen().name(),
         sel.folds
     )?;
+    // The name column as wide as the longest name (four families' names exceed 40 characters).
+    let w = sel
+        .candidates
+        .iter()
+        .map(|c| c.name().len())
+        .chain([40])
+        .max()
+        .unwrap_or(40);
     outln!(
-        "  {:<40} {:>10} {:>16} {:>10}",
+        "  {:<w$} {:>10} {:>16} {:>10}",
         "candidate",
         "parameters",
         "CV mean (mm)",
@@ -27,7 +35,7 @@ pub(crate) fn print_selection(
     for c in &sel.candidates {
         let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
         outln!(
-            "{} {:<40} {:>10} {:>16} {:>10}{}",
+            "{} {:<w$} {:>10} {:>16} {:>10}{}",
             if c.chosen { "*" } else { " " },
             c.name(),
             c.identified,
