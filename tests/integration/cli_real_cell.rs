@@ -7,8 +7,8 @@
 use crate::util::*;
 use std::path::Path;
 
-/// The calibrated model's mean error on `data` (`evaluate --json`).
-fn evaluated_mean(res: &Path, data: &Path) -> f64 {
+/// `evaluate --json` of `res` on `data`.
+fn evaluated(res: &Path, data: &Path) -> serde_json::Value {
     let o = ok(&[
         "evaluate",
         "--robot",
@@ -19,8 +19,7 @@ fn evaluated_mean(res: &Path, data: &Path) -> f64 {
         p(data),
         "--json",
     ]);
-    let v: serde_json::Value = serde_json::from_str(&o.stdout()).unwrap();
-    v["calibrated"]["mean_mm"].as_f64().unwrap()
+    serde_json::from_str(&o.stdout()).unwrap()
 }
 
 #[test]
@@ -69,9 +68,18 @@ fn evaluate_reads_the_conditions_and_compensate_folds_them_and_writes_the_approa
 
     // evaluate under each row's temperature and approach: the families follow the cell, the
     // geometric model cannot.
-    let (f, g) = (evaluated_mean(&fam, &val), evaluated_mean(&geo, &val));
+    let (vf, vg) = (evaluated(&fam, &val), evaluated(&geo, &val));
+    let mean = |v: &serde_json::Value| v["calibrated"]["mean_mm"].as_f64().unwrap();
+    let (f, g) = (mean(&vf), mean(&vg));
     eprintln!("validation by evaluate: families {f:.4} mm, geometric {g:.4} mm");
     assert!(f < 0.6 * g && f < 0.08, "families {f} vs geometric {g}");
+    // What each family explains: the calibrated model without it is worse on these data; the
+    // geometric result has nothing to take away.
+    let without = |k: &str| vf["calibrated_without"][k]["mean_mm"].as_f64().unwrap();
+    let (t, b) = (without("thermal"), without("backlash"));
+    eprintln!("families without the temperature {t:.4} mm, without the directions {b:.4} mm");
+    assert!(t > f && b > f, "{t} {b} vs {f}");
+    assert!(vg.get("calibrated_without").is_none());
 
     // The desired poses: the validation joints alone.
     let (h, rows) = read_csv(&val);
