@@ -126,6 +126,8 @@ struct Settings {
     changes: Option<PathBuf>,
     keep_going: bool,
     config: Option<PathBuf>,
+    /// The calibration models backlash: every pose approached from below (written as dir1..dirN).
+    from_below: bool,
 }
 
 impl TryFrom<&CompensateArgs> for Settings {
@@ -206,6 +208,7 @@ impl TryFrom<&CompensateArgs> for Settings {
         let outputs = plan.check()?;
         let (nominal, mut calibrated, res) = calibrated_model(a.robot.as_deref(), &a.params)?;
         super::common::apply_payload(&mut calibrated, a.payload_kg)?;
+        let from_below = conditions::approached_from_below(&calibrated);
         let calibrated = conditions::fold(&calibrated, a.temperature_c)?;
         if let Some(why) = res.partial_reason() {
             return Err(exit::input(format!(
@@ -247,6 +250,7 @@ impl TryFrom<&CompensateArgs> for Settings {
             changes: a.changes.clone(),
             keep_going: a.keep_going,
             config: a.config.clone(),
+            from_below,
         })
     }
 }
@@ -268,6 +272,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         changes,
         keep_going,
         config,
+        from_below,
     } = Settings::try_from(&a)?;
     let dof = nominal.dof();
     let joints = nominal.joint_space();
@@ -305,13 +310,10 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 path.display()
             )?;
         }
-        let mut w = CommandedWriter::to_output(
-            outputs.open(&out)?,
-            joints,
-            true,
-            full_pose,
-            reader.extra_columns(),
-        )?;
+        let (columns, added) =
+            conditions::direction_columns(reader.extra_columns(), dof, from_below);
+        let mut w =
+            CommandedWriter::to_output(outputs.open(&out)?, joints, true, full_pose, &columns)?;
         let mut outside = Listing::default();
         while let Some(r) = reader.next_row().with_context(context)? {
             nominal.check_joints(&r.q, &format!("{}:{}", path.display(), r.line))?;
@@ -338,7 +340,11 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 }
             };
             tally.add(&nominal, r.line, &c, Some(&r.q));
-            w.write(&c, Some(&r.q), &r.extra)?;
+            w.write(
+                &c,
+                Some(&r.q),
+                &conditions::with_directions(&r.extra, added),
+            )?;
             tally.tick(&pb);
         }
         for warning in reader.finish().with_context(context)? {
@@ -374,13 +380,9 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 path.display()
             )?;
         }
-        let mut w = CommandedWriter::to_output(
-            outputs.open(&out)?,
-            joints,
-            false,
-            full_pose,
-            &set.extra_columns,
-        )?;
+        let (columns, added) = conditions::direction_columns(&set.extra_columns, dof, from_below);
+        let mut w =
+            CommandedWriter::to_output(outputs.open(&out)?, joints, false, full_pose, &columns)?;
         for t in &set.rows {
             if let Some(s) = &t.seed {
                 cal.check_joints(s, &format!("{}:{}", path.display(), t.line))?;
@@ -400,7 +402,7 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
                 },
             };
             tally.add(&nominal, t.line, &c, None);
-            w.write(&c, None, &t.extra)?;
+            w.write(&c, None, &conditions::with_directions(&t.extra, added))?;
             tally.tick(&pb);
         }
         (path, w)

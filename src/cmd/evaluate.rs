@@ -2,6 +2,8 @@
 //! calibrated model (validation, paper section IV), or of measured commanded poses against their
 //! desired positions (verification, section V.B, Table V).
 
+mod conditions;
+
 use super::common;
 use super::io_plan::{self, IoPlan};
 use anyhow::Context;
@@ -170,6 +172,13 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     let ev =
         Evaluator::new(&nominal, &cal, &frame, &header, against)?.with_nominal_frame(nominal_frame);
     let names = ev.series();
+    // The calibrated model without each condition family the data's columns feed.
+    let without = conditions::models_without(&cal, &header)?;
+    let ev_without = without
+        .iter()
+        .map(|w| Evaluator::new(&nominal, &w.model, &frame, &header, against))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut sums_without = vec![0.0; without.len()];
     let mut per_point = match &per_point_path {
         Some(p) => Some(PerPointWriter::to_output(
             outputs.open(p)?,
@@ -186,6 +195,9 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         let e = ev.errors(&r)?;
         norms[0].push(e[0].norm());
         norms[1].push(e[1].norm());
+        for (sum, ev) in sums_without.iter_mut().zip(&ev_without) {
+            *sum += ev.errors(&r)?[1].norm();
+        }
         if let Some(w) = &mut per_point {
             w.write(&r, &e)?;
         }
@@ -222,6 +234,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         })
         .collect();
     let reference = ev.reference();
+    let means_without: Vec<f64> = sums_without.iter().map(|s| s / n.max(1) as f64).collect();
     if json {
         let mut o = serde_json::Map::new();
         o.insert("data".into(), data.display().to_string().into());
@@ -264,6 +277,17 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
                 }),
             );
         }
+        if !without.is_empty() {
+            o.insert(
+                "calibrated_without".into(),
+                without
+                    .iter()
+                    .zip(&means_without)
+                    .map(|(w, m)| (w.key.to_owned(), serde_json::json!({ "mean_mm": m })))
+                    .collect::<serde_json::Map<_, _>>()
+                    .into(),
+            );
+        }
         if let Some(p) = &per_point_path {
             o.insert("per_point".into(), p.display().to_string().into());
         }
@@ -277,6 +301,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             &res,
             refit_frame.then_some(&frame),
         )?;
+        conditions::print(&without, &means_without, series[1].stats.mean_mm)?;
     }
     Ok(())
 }

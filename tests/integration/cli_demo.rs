@@ -152,11 +152,12 @@ fn demo_prints_the_papers_tables_and_its_commands_reproduce_the_files() {
         ver[2]
     );
     assert_eq!(row(&out, "Table V.", "points"), [75.0, 75.0, 75.0, 75.0]);
-    // Beside the paper: geometric, elasto-geometric, and with backlash and thermal expansion;
-    // the last closes the gap between verification and prediction.
+    // Beside the paper: geometric, elasto-geometric, and with backlash and thermal expansion,
+    // each against the calibration's prediction at new poses; the last verifies within 15% of
+    // its prediction.
     let ratio = row(&out, "Beyond the paper", "Verification / prediction");
     assert_eq!(ratio.len(), 3, "{ratio:?}");
-    assert!(ratio[0] >= 1.3 && ratio[2] < ratio[0], "{ratio:?}");
+    assert!(ratio[2] <= 1.15 && ratio[2] < ratio[0], "{ratio:?}");
     let v = row(&out, "Beyond the paper", "Verification mean (mm)");
     assert!(v[2] < 0.25 * v[0], "{v:?}");
     assert!(

@@ -7,10 +7,11 @@ use crate::options::{self, Options};
 use crate::robot::PyRobot;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use robocal_core::identification::{calibrate, split_measurements, CalibrationData};
+use robocal_core::identification::{calibrate, selection, split_measurements, CalibrationData};
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::result_sections::RowsOutside;
 use robocal_core::io::{read_measurements, Positions};
+use robocal_core::model::family::{backlash, thermal};
 use robocal_core::{Observations, Robot};
 use std::path::{Path, PathBuf};
 
@@ -242,6 +243,42 @@ pub fn calibrate_files(
     run(py, &nominal, data, &opts, outside, warnings)
 }
 
+/// The model fitted to `data`, as the CLI's: with thermal expansion its lengths referred to the
+/// calibration rows' mean temperature (an `InputError` without temperatures); with backlash and
+/// no approach directions, the directions derived from the row order (a warning).
+fn fit_to_data(robot: &Robot, data: &mut Data, warnings: &mut Vec<String>) -> PyResult<Robot> {
+    let mut r = robot.clone();
+    let what = data
+        .data_file
+        .as_deref()
+        .unwrap_or("the calibration points");
+    if thermal::reference_c(&r).is_some() {
+        let cd = CalibrationData {
+            calibration: &data.calibration,
+            plane: None,
+            validation: None,
+        };
+        let Some(t) = selection::reference_temperature_c(&cd) else {
+            return Err(input(format!(
+                "thermal=\"auto\": {what} have no temperature_c (the arm's temperature at each \
+                 row, deg C; give the data as a file with that column)"
+            )));
+        };
+        thermal::set_reference_c(&mut r, t).py_err()?;
+        warnings.push(format!(
+            "thermal expansion referred to {t:.1} deg C (the calibration rows' mean)"
+        ));
+    }
+    if !backlash::joints(&r).is_empty() && !data.calibration.has_directions() {
+        data.calibration.derive_directions();
+        warnings.push(format!(
+            "{what} have no dir1..dirN: approach directions derived from the row order (the \
+             motion from the previous calibration row; the first row's unknown)"
+        ));
+    }
+    Ok(r)
+}
+
 /// Whether two paths name the same file.
 fn same_file(a: &Path, b: &Path) -> bool {
     match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
@@ -261,7 +298,8 @@ fn run(
     outside: Vec<OutsideLimits>,
     mut warnings: Vec<String>,
 ) -> PyResult<Outcome> {
-    let robot = &nominal.inner;
+    let mut data = data;
+    let robot = &fit_to_data(&nominal.inner, &mut data, &mut warnings)?;
     let settings = &opts.settings;
     let started = std::time::Instant::now();
     let cal = py

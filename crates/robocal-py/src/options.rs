@@ -8,7 +8,7 @@ use robocal_core::identification::{
     AutoFamilies, CalibrationSettings, IdentifiabilityOptions, ModelChoice, Objective, RobustLoss,
     SolverOptions, DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
 };
-use robocal_core::model::family::{compliance, transmission};
+use robocal_core::model::family::{backlash, compliance, thermal, transmission};
 use robocal_core::observations::{TrackerSigma, Weighting};
 use robocal_core::{Param, Robot};
 
@@ -43,6 +43,8 @@ const KNOWN: &[&str] = &[
     "compliance",
     "payload_kg",
     "harmonics",
+    "backlash",
+    "thermal",
     "model",
     "affine",
     "rank_tol",
@@ -287,6 +289,24 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
     let all: Vec<usize> = (0..robot.dof()).collect();
     transmission::enable(robot, &all, harmonics as usize)
         .map_err(|e| usage(crate::errors::message(&e)))?;
+    // The real cell's families (the CLI's --backlash and --thermal); the thermal reference is
+    // set from the data when the calibration runs.
+    let backlash_joints = match joint_selection(d, "backlash")?.trim() {
+        "none" | "" => Vec::new(),
+        "auto" => all.clone(),
+        list => joint_numbers(robot, list, "backlash", "`auto`, `none`")?,
+    };
+    backlash::enable(robot, &backlash_joints).map_err(|e| usage(crate::errors::message(&e)))?;
+    match opt::<String>(d, "thermal", "a str")?.as_deref() {
+        None | Some("none") => {}
+        Some("auto") => thermal::enable(robot, thermal::DEFAULT_REFERENCE_C)
+            .map_err(|e| usage(crate::errors::message(&e)))?,
+        Some(other) => {
+            return Err(usage(format!(
+                "thermal: {other:?}: expected \"auto\" or \"none\""
+            )))
+        }
+    }
 
     let fix = param_list(robot, &names(d, "fix")?, "fix")?;
     let free = param_list(robot, &names(d, "free")?, "free")?;
@@ -360,8 +380,8 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
         "auto" => ModelChoice::Auto(AutoFamilies {
             harmonics: !given("harmonics")?,
             compliance: !given("compliance")?,
-            backlash: true,
-            thermal: true,
+            backlash: !given("backlash")?,
+            thermal: !given("thermal")?,
         }),
         "geometric" => ModelChoice::Given,
         other => {

@@ -13,8 +13,9 @@ use pyo3::prelude::*;
 use robocal_core::io::measurements::{read_measurements, Measurement, MeasurementSet, Positions};
 use robocal_core::io::result::FrameVec;
 use robocal_core::simulation::{
-    check_truth_matches, simulate, simulate_joints, GeometricErrors, GravityModel, OutlierModel,
-    Simulation, SimulationConfig, TargetMeasurement, TruthFile, TruthSpec,
+    check_truth_matches, simulate, simulate_joints, BacklashModel, GeometricErrors, GravityModel,
+    OutlierModel, RepeatabilityModel, Simulation, SimulationConfig, TargetMeasurement,
+    ThermalModel, TruthFile, TruthSpec,
 };
 use robocal_core::Robot;
 use std::path::{Path, PathBuf};
@@ -77,6 +78,75 @@ fn truth_arg(
     Ok((TruthSpec::Robot(robot), None))
 }
 
+/// `repeatability_deg` (the CLI's `--repeatability-deg`): `"default"` (the class default) or
+/// one standard deviation for all joints or one per joint (deg, mm for a prismatic joint).
+fn repeatability_arg(
+    v: Option<&Bound<'_, PyAny>>,
+    nominal: &Robot,
+) -> PyResult<Option<RepeatabilityModel>> {
+    let Some(v) = v else { return Ok(None) };
+    if let Ok(s) = v.extract::<String>() {
+        return match s.as_str() {
+            "default" => Ok(Some(RepeatabilityModel::default_for(nominal))),
+            _ => Err(usage(format!(
+                "repeatability_deg: {s:?}: expected \"default\", a number or one number per joint"
+            ))),
+        };
+    }
+    Ok(Some(RepeatabilityModel {
+        std_deg: per_joint(v, "repeatability_deg", nominal.dof())?,
+    }))
+}
+
+/// `backlash_deg` (the CLI's `--backlash-deg`): `"auto"` (the class default) or half the play of
+/// all joints or of each (deg, mm for a prismatic joint).
+fn backlash_arg(v: Option<&Bound<'_, PyAny>>, nominal: &Robot) -> PyResult<Option<BacklashModel>> {
+    let Some(v) = v else { return Ok(None) };
+    if let Ok(s) = v.extract::<String>() {
+        return match s.as_str() {
+            "auto" => Ok(Some(BacklashModel::for_robot(nominal))),
+            _ => Err(usage(format!(
+                "backlash_deg: {s:?}: expected \"auto\", a number or one number per joint"
+            ))),
+        };
+    }
+    Ok(Some(BacklashModel {
+        half_play_deg: per_joint(v, "backlash_deg", nominal.dof())?,
+    }))
+}
+
+/// `thermal` (the CLI's `--thermal auto|none`) and the settings that shape it, which need it
+/// (as the CLI's flags require `--thermal`).
+fn thermal_arg(
+    thermal: Option<&str>,
+    shape: [(&str, Option<f64>); 3],
+    nominal: &Robot,
+) -> PyResult<Option<ThermalModel>> {
+    if thermal.is_none() {
+        if let Some((name, _)) = shape.iter().find(|(_, v)| v.is_some()) {
+            return Err(usage(format!(
+                "{name} shapes the thermal growth: give thermal=\"auto\" too"
+            )));
+        }
+    }
+    match thermal {
+        None | Some("none") => Ok(None),
+        Some("auto") => {
+            let d = ThermalModel::for_robot(nominal);
+            let [(_, rise), (_, start), (_, per_pose)] = shape;
+            Ok(Some(ThermalModel {
+                rise_c: rise.unwrap_or(d.rise_c),
+                start_s: start.unwrap_or(d.start_s),
+                seconds_per_pose: per_pose.unwrap_or(d.seconds_per_pose),
+                ..d
+            }))
+        }
+        Some(other) => Err(usage(format!(
+            "thermal: {other:?}: expected \"auto\" or \"none\""
+        ))),
+    }
+}
+
 fn random_only() -> PyErr {
     usage("length_error_mm, angle_error_deg and tilt_parallel_axes apply only to truth=\"random\"")
 }
@@ -121,7 +191,8 @@ fn joints_arg(robot: &PyRobot, joints: &Bound<'_, PyAny>) -> PyResult<Measuremen
     length_error_mm = None, angle_error_deg = None, tilt_parallel_axes = false, floor_mm = 0.0,
     footprint_mm = None, compliance = None, link_masses_kg = None, payload_kg = None,
     outlier_fraction = None, outlier_min_mm = None, outlier_max_mm = None, all_targets = false,
-    orientation_sigma_deg = None
+    orientation_sigma_deg = None, repeatability_deg = None, backlash_deg = None, thermal = None,
+    thermal_rise_c = None, thermal_start_s = None, seconds_per_pose = None, station = 0
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_session(
@@ -150,6 +221,13 @@ pub fn simulate_session(
     outlier_max_mm: Option<f64>,
     all_targets: bool,
     orientation_sigma_deg: Option<f64>,
+    repeatability_deg: Option<&Bound<'_, PyAny>>,
+    backlash_deg: Option<&Bound<'_, PyAny>>,
+    thermal: Option<String>,
+    thermal_rise_c: Option<f64>,
+    thermal_start_s: Option<f64>,
+    seconds_per_pose: Option<f64>,
+    station: u32,
 ) -> PyResult<PySimulation> {
     let nominal = &robot.inner;
     let dof = nominal.dof();
@@ -266,10 +344,18 @@ pub fn simulate_session(
         noise_per_m,
         gravity,
         outliers,
-        repeatability: None,
-        backlash: None,
-        thermal: None,
-        station: 0,
+        repeatability: repeatability_arg(none(repeatability_deg), nominal)?,
+        backlash: backlash_arg(none(backlash_deg), nominal)?,
+        thermal: thermal_arg(
+            thermal.as_deref(),
+            [
+                ("thermal_rise_c", thermal_rise_c),
+                ("thermal_start_s", thermal_start_s),
+                ("seconds_per_pose", seconds_per_pose),
+            ],
+            nominal,
+        )?,
+        station,
     };
     cfg.validate(nominal).py_err()?;
     if let TruthSpec::Robot(t) = &truth {

@@ -216,3 +216,37 @@ def test_tracker_weighting_default_and_off_are_the_cli(cli, tmp_path):
         assert cli_res["settings"]["weighting"]["source"] == source
         assert res.data["settings"]["weighting"]["source"] == source
         compare(res.data, cli_res)
+
+
+def test_real_cell_session_and_families_are_the_cli(cli, tmp_path):
+    """The real cell's effects (repeatability, backlash, thermal growth, another station) as the
+    CLI's flags, and a calibration with the backlash and thermal families as the CLI's."""
+    kr = robocal.Robot.preset(KR)
+    sim, c, p = run_both(cli, tmp_path, KR, kr,
+                         ["--truth", "kuka-kr480-r3330-table3", "--poses", "60", "--seed", "3",
+                          "--repeatability-deg", "default", "--backlash-deg", "auto",
+                          "--thermal", "auto", "--thermal-rise-c", "6", "--thermal-start-s", "600",
+                          "--seconds-per-pose", "30", "--station", "2"],
+                         truth="kuka-kr480-r3330-table3", poses=60, seed=3,
+                         repeatability_deg="default", backlash_deg="auto", thermal="auto",
+                         thermal_rise_c=6, thermal_start_s=600, seconds_per_pose=30, station=2)
+    same_files(c, p)
+    same_files(c.with_suffix(".truth.json"), p.with_suffix(".truth.json"))
+    header, _ = read_csv(c)
+    for col in ["temperature_c", "time_s"] + [f"dir{j}" for j in range(1, 7)]:
+        assert col in header, col
+        assert col in sim.columns, col
+    out = tmp_path / "cli.json"
+    cli("calibrate", "--robot", KR, "--data", str(c), "--model", "geometric", "--backlash", "auto",
+        "--thermal", "auto", "--out", str(out))
+    with pytest.warns(RuntimeWarning, match="thermal expansion referred to"):
+        res = robocal.calibrate_files(kr, c, model="geometric", backlash="auto", thermal="auto")
+    compare(res.data, read_json(out))
+    assert "thermal_k" in res.parameters and "backlash1" in res.parameters
+    # Settings the CLI refuses.
+    with pytest.raises(robocal.UsageError, match="thermal"):
+        robocal.simulate(kr, "random", 10, thermal_rise_c=5)
+    with pytest.raises(robocal.UsageError, match="backlash_deg"):
+        robocal.simulate(kr, "random", 10, backlash_deg="some")
+    with pytest.raises((robocal.UsageError, robocal.InputError), match="station"):
+        robocal.simulate(kr, "random", 10, station=100000)

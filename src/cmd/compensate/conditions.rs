@@ -51,3 +51,40 @@ pub(super) fn fold(calibrated: &Robot, temperature_c: Option<f64>) -> anyhow::Re
     }
     Ok(calibrated.at_conditions(&c)?)
 }
+
+/// Whether the commanded joints of `calibrated` assume every pose approached from below: the
+/// calibration models backlash (see [`fold`]).
+pub(super) fn approached_from_below(calibrated: &Robot) -> bool {
+    !backlash::joints(calibrated).is_empty()
+}
+
+/// The output's further columns: the input's, and with `from_below` the approach directions
+/// `dir1..dirN` the commanded joints assume, unless the input has them; the count of columns
+/// added (each row's value +1).
+pub(super) fn direction_columns(
+    extra: &[String],
+    dof: usize,
+    from_below: bool,
+) -> (Vec<String>, usize) {
+    let mut columns = extra.to_vec();
+    if from_below {
+        for j in 0..dof {
+            let name = robocal_core::simulation::direction_column(j);
+            if !columns.contains(&name) {
+                columns.push(name);
+            }
+        }
+    }
+    let added = columns.len() - extra.len();
+    (columns, added)
+}
+
+/// A row's further values with `added` approach directions (+1) appended.
+pub(super) fn with_directions(extra: &[String], added: usize) -> std::borrow::Cow<'_, [String]> {
+    if added == 0 {
+        return std::borrow::Cow::Borrowed(extra);
+    }
+    let mut v = extra.to_vec();
+    v.resize(extra.len() + added, "1".to_owned());
+    std::borrow::Cow::Owned(v)
+}

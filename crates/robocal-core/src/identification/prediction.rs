@@ -8,11 +8,14 @@
 //! and the expected error norm at q is `E|e|`, computed from `Sigma`'s eigenvalues (closed form)
 //! by a fixed Gauss quadrature over the sphere (deterministic; exact to about 1e-6).
 //! Averaged over the calibration poses, that is the expected mean error at new poses spread like
-//! them ([`Prediction::mean_mm`]), the figure a validation set measures.
+//! them ([`Prediction::mean_mm`]), the figure a validation set measures. Each pose's `J(q)` is
+//! taken under its row's conditions (temperature, approach directions), as the fit took it: the
+//! thermal and backlash families' columns vanish without them.
 
 use crate::identification::covariance::Covariance;
 use crate::identification::simd::with_avx;
 use crate::identification::system::add_gram;
+use crate::kinematics::Conditions;
 use crate::model::{Param, Robot};
 use crate::observations::Observations;
 use crate::simulation::{random_poses, PoseSampler};
@@ -307,17 +310,24 @@ impl<'a> Predictor<'a> {
             .mean_norm(&(model + Matrix3::identity() * (self.sigma * self.sigma)))
     }
 
-    /// Tool point of target `t` and `J C J^T` at joints `q`.
+    /// Tool point of target `t` and `J C J^T` at joints `q` under conditions `c` (the row's
+    /// temperature and approach directions, which the thermal and backlash columns need).
     #[inline(always)]
-    fn model_at(&self, s: &mut Scratch, q: &[f64], t: usize) -> (Vector3<f64>, Matrix3<f64>) {
-        let p = target_jacobian(self.robot, &self.index, q, t, &mut s.jp, &mut s.j);
+    fn model_at(
+        &self,
+        s: &mut Scratch,
+        q: &[f64],
+        t: usize,
+        c: &Conditions,
+    ) -> (Vector3<f64>, Matrix3<f64>) {
+        let p = target_jacobian(self.robot, &self.index, q, t, c, &mut s.jp, &mut s.j);
         (p, self.model_covariance(&s.j, &mut s.x))
     }
 
     /// At joints `q`: the tool point, the covariance of the model's error `J C J^T` (mm^2) and
     /// the expected error norm of a measurement.
     pub fn at(&self, q: &[f64]) -> (Vector3<f64>, Matrix3<f64>, f64) {
-        let (p, model) = self.model_at(&mut self.scratch(), q, 0);
+        let (p, model) = self.model_at(&mut self.scratch(), q, 0, &Conditions::UNKNOWN);
         (p, model, self.mean_norm(&model))
     }
 
@@ -357,7 +367,7 @@ impl<'a> Predictor<'a> {
         let models = map_poses(
             picked.len(),
             || self.scratch(),
-            |s, i| self.model_at(s, qs[picked[i]], 0).1,
+            |s, i| self.model_at(s, qs[picked[i]], 0, &Conditions::UNKNOWN).1,
         );
         self.predict_from(&models, floor_z_mm, true)
     }
@@ -379,7 +389,7 @@ impl<'a> Predictor<'a> {
             qs.len(),
             || self.scratch(),
             |s, i| {
-                let (position, model) = self.model_at(s, &qs[i], 0);
+                let (position, model) = self.model_at(s, &qs[i], 0, &Conditions::UNKNOWN);
                 MapPoint {
                     position,
                     mean_mm: self.mean_norm(&model),
@@ -390,17 +400,22 @@ impl<'a> Predictor<'a> {
     }
 }
 
-/// [`point_jacobian`] for target `t` (0-based) of the robot's targets.
+/// [`point_jacobian`] for target `t` (0-based) of the robot's targets, under conditions `c`.
 fn target_jacobian(
     robot: &Robot,
     index: &[usize],
     q: &[f64],
     t: usize,
+    c: &Conditions,
     jp: &mut [Vector3<f64>],
     out: &mut [f64],
 ) -> Vector3<f64> {
     let k = index.len();
-    let (p, _) = robot.target_screws(q, t, None, Some(jp), None);
+    let (p, _) = if c.is_unknown() {
+        robot.target_screws(q, t, None, Some(jp), None)
+    } else {
+        robot.target_screws_in(q, t, c, None, Some(jp), None)
+    };
     for (c, &i) in index.iter().enumerate() {
         for r in 0..3 {
             out[r * k + c] = jp[i][r];
@@ -548,6 +563,7 @@ pub(crate) fn predict_with(
                     &pred.index,
                     calibration.q(i),
                     calibration.target(i),
+                    &calibration.conditions(i),
                     &mut s.jp,
                     out,
                 )
@@ -568,7 +584,8 @@ pub(crate) fn predict_with(
         n,
         || f64::INFINITY,
         |lowest, i| {
-            let p = calibrated.target_position(calibration.q(i), calibration.target(i));
+            let c = calibration.conditions(i);
+            let p = calibrated.target_position_in(calibration.q(i), calibration.target(i), &c);
             *lowest = lowest.min(p.z);
         },
         f64::min,
@@ -581,7 +598,11 @@ pub(crate) fn predict_with(
             let i = picked[i];
             with_avx(
                 #[inline(always)]
-                || pred.model_at(s, calibration.q(i), calibration.target(i)).1,
+                || {
+                    let c = calibration.conditions(i);
+                    pred.model_at(s, calibration.q(i), calibration.target(i), &c)
+                        .1
+                },
             )
         },
     );

@@ -312,6 +312,8 @@ def calibrate(
     compliance: Optional[Joints] = None,
     payload_kg: Optional[float] = None,
     harmonics: Optional[int] = None,
+    backlash: Optional[Joints] = None,
+    thermal: Optional[str] = None,
     model: str = "auto",
     affine: bool = False,
     rank_tol: Optional[float] = None,
@@ -333,8 +335,11 @@ def calibrate(
     "cauchy" or "huber"); ``fix``/``free`` parameter names; ``beta`` "parallel", "none" or joint
     numbers; ``model`` "auto" (default: the families the data support, by cross-validation;
     ``result`` records the choice in ``model_selection``) or "geometric"; ``compliance`` "auto",
-    "none" or joint numbers, with ``payload_kg``, and ``harmonics`` 0..8 fix that family (None:
-    chosen by ``model="auto"``, none with "geometric"); ``tracker_sigma=(fixed_mm, per_m_mm)``; and so on.
+    "none" or joint numbers, with ``payload_kg``, ``harmonics`` 0..8, ``backlash`` "auto", "none"
+    or joint numbers (against each row's approach direction: a file's ``dir1..dirN``, else the
+    row order) and ``thermal`` "auto" or "none" (against a file's ``temperature_c``, referred to
+    the calibration rows' mean temperature) fix that family (None: chosen by ``model="auto"``,
+    none with "geometric"); ``tracker_sigma=(fixed_mm, per_m_mm)``; and so on.
 
     Rows outside the joint limits raise :class:`InputError` unless ``nominal_limits``. A solver
     that does not converge raises :class:`NumericalError` (``keep_partial=True``: a result marked
@@ -352,6 +357,8 @@ def calibrate(
         compliance=compliance,
         payload_kg=payload_kg,
         harmonics=harmonics,
+        backlash=backlash,
+        thermal=thermal,
         model=model,
         affine=affine,
         rank_tol=rank_tol,
@@ -433,6 +440,13 @@ def simulate(
     outlier_max_mm: Optional[float] = None,
     all_targets: bool = False,
     orientation_sigma_deg: Optional[float] = None,
+    repeatability_deg: Optional[Union[str, PerJoint]] = None,
+    backlash_deg: Optional[Union[str, PerJoint]] = None,
+    thermal: Optional[str] = None,
+    thermal_rise_c: Optional[float] = None,
+    thermal_start_s: Optional[float] = None,
+    seconds_per_pose: Optional[float] = None,
+    station: int = 0,
 ) -> Simulation:
     """Measures a virtual robot with a virtual laser tracker: the CLI's ``robocal simulate``.
 
@@ -452,8 +466,13 @@ def simulate(
     ``floor_mm`` and ``footprint_mm``, gravity deflection (``compliance`` in rad/(N m), and
     ``link_masses_kg``, one value or one per joint, ``payload_kg``), gross outliers
     (``outlier_fraction`` of the readings displaced by ``outlier_min_mm``..``outlier_max_mm``),
-    ``all_targets`` (every reflector of the robot file's ``tools``, a ``target`` per row) and
-    ``orientation_sigma_deg`` (6-DoF readings: ``abc``).
+    ``all_targets`` (every reflector of the robot file's ``tools``, a ``target`` per row),
+    ``orientation_sigma_deg`` (6-DoF readings: ``abc``), and the real cell's effects:
+    ``repeatability_deg`` (a random error per joint and move, 1-sigma deg; ``"default"`` for the
+    class default), ``backlash_deg`` (half the gear play per joint, deg; ``"auto"`` for the
+    class default; writes ``dir1..dirN``), ``thermal="auto"`` (the arm warming up over the
+    session, shaped by ``thermal_rise_c``, ``thermal_start_s`` and ``seconds_per_pose``; writes
+    ``temperature_c`` and ``time_s``) and ``station`` (a fresh tracker set-up, 1, 2, ..).
 
     Returns a :class:`Simulation` whose arrays hold the values ``robocal simulate --out`` writes
     for the same arguments (joint values to 1e-9 degree, readings to 1e-6 mm), so calibrating
@@ -486,6 +505,13 @@ def simulate(
         outlier_max_mm=outlier_max_mm,
         all_targets=all_targets,
         orientation_sigma_deg=orientation_sigma_deg,
+        repeatability_deg=repeatability_deg,
+        backlash_deg=backlash_deg,
+        thermal=thermal,
+        thermal_rise_c=thermal_rise_c,
+        thermal_start_s=thermal_start_s,
+        seconds_per_pose=seconds_per_pose,
+        station=station,
     )
     for w in sim.warnings:
         warnings.warn(w, RuntimeWarning, stacklevel=2)

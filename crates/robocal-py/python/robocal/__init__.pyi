@@ -165,6 +165,8 @@ def calibrate(
     compliance: Optional[Joints] = None,
     payload_kg: Optional[float] = None,
     harmonics: Optional[int] = None,
+    backlash: Optional[Joints] = None,
+    thermal: Optional[str] = None,
     model: str = "auto",
     affine: bool = False,
     rank_tol: Optional[float] = None,
@@ -336,6 +338,13 @@ def simulate(
     outlier_max_mm: Optional[float] = None,
     all_targets: bool = False,
     orientation_sigma_deg: Optional[float] = None,
+    repeatability_deg: Optional[Union[str, PerJoint]] = None,
+    backlash_deg: Optional[Union[str, PerJoint]] = None,
+    thermal: Optional[str] = None,
+    thermal_rise_c: Optional[float] = None,
+    thermal_start_s: Optional[float] = None,
+    seconds_per_pose: Optional[float] = None,
+    station: int = 0,
 ) -> Simulation:
     """The CLI's ``robocal simulate``: random poses (``poses``, ``validation``, the plane
     points) or ``joints`` measured on ``truth`` by a virtual tracker."""

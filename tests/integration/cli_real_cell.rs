@@ -1,0 +1,153 @@
+//! The real cell's families on the command line: a simulated session with backlash and thermal
+//! growth calibrated with `--backlash auto --thermal auto`; `evaluate` reads the data's
+//! temperature and approach directions; `compensate --temperature-c` folds the arm's
+//! temperature and the approach from below into the commanded joints and writes the directions
+//! it assumes (`dir1..dirN`).
+
+use crate::util::*;
+use std::path::Path;
+
+/// `evaluate --json` of `res` on `data`.
+fn evaluated(res: &Path, data: &Path) -> serde_json::Value {
+    let o = ok(&[
+        "evaluate",
+        "--robot",
+        KUKA,
+        "--params",
+        p(res),
+        "--data",
+        p(data),
+        "--json",
+    ]);
+    serde_json::from_str(&o.stdout()).unwrap()
+}
+
+#[test]
+fn evaluate_reads_the_conditions_and_compensate_folds_them_and_writes_the_approach() {
+    let dir = Dir::new();
+    let (cell, val) = (dir.join("cell.csv"), dir.join("val.csv"));
+    ok(&[
+        "simulate",
+        "--robot",
+        KUKA,
+        "--truth",
+        TRUTH,
+        "--poses",
+        "60",
+        "--validation",
+        "40",
+        "--seed",
+        "5",
+        "--backlash-deg",
+        "auto",
+        "--thermal",
+        "auto",
+        "--out",
+        p(&cell),
+        "--validation-out",
+        p(&val),
+    ]);
+    let (fam, geo) = (dir.join("fam.json"), dir.join("geo.json"));
+    let calibrate = |out: &Path, families: &[&str]| {
+        let mut a = vec![
+            "calibrate",
+            "--robot",
+            KUKA,
+            "--data",
+            p(&cell),
+            "--model",
+            "geometric",
+            "--out",
+            p(out),
+        ];
+        a.extend_from_slice(families);
+        ok(&a);
+    };
+    calibrate(&fam, &["--backlash", "auto", "--thermal", "auto"]);
+    calibrate(&geo, &[]);
+
+    // evaluate under each row's temperature and approach: the families follow the cell, the
+    // geometric model cannot.
+    let (vf, vg) = (evaluated(&fam, &val), evaluated(&geo, &val));
+    let mean = |v: &serde_json::Value| v["calibrated"]["mean_mm"].as_f64().unwrap();
+    let (f, g) = (mean(&vf), mean(&vg));
+    eprintln!("validation by evaluate: families {f:.4} mm, geometric {g:.4} mm");
+    assert!(f < 0.6 * g && f < 0.08, "families {f} vs geometric {g}");
+    // What each family explains: the calibrated model without it is worse on these data; the
+    // geometric result has nothing to take away.
+    let without = |k: &str| vf["calibrated_without"][k]["mean_mm"].as_f64().unwrap();
+    let (t, b) = (without("thermal"), without("backlash"));
+    eprintln!("families without the temperature {t:.4} mm, without the directions {b:.4} mm");
+    assert!(t > f && b > f, "{t} {b} vs {f}");
+    assert!(vg.get("calibrated_without").is_none());
+
+    // The desired poses: the validation joints alone.
+    let (h, rows) = read_csv(&val);
+    let desired = dir.join("desired.csv");
+    let mut text = String::from("q1,q2,q3,q4,q5,q6\n");
+    for r in &rows {
+        let q: Vec<&str> = (1..=6)
+            .map(|j| r[col(&h, &format!("q{j}"))].as_str())
+            .collect();
+        text.push_str(&q.join(","));
+        text.push('\n');
+    }
+    std::fs::write(&desired, text).unwrap();
+    let compensate = |res: &Path, t: Option<&str>, out: &Path| {
+        let mut a = vec![
+            "compensate",
+            "--robot",
+            KUKA,
+            "--params",
+            p(res),
+            "--joints",
+            p(&desired),
+            "--position-only",
+            "--out",
+            p(out),
+        ];
+        if let Some(t) = t {
+            a.extend_from_slice(&["--temperature-c", t]);
+        }
+        robocal(&a)
+    };
+    let (warm, reference) = (dir.join("warm.csv"), dir.join("reference.csv"));
+    compensate(&fam, Some("27.5"), &warm).assert_ok();
+    let o = compensate(&fam, None, &reference);
+    o.assert_ok();
+    assert!(
+        o.stderr().contains("reference temperature"),
+        "{}",
+        o.stderr()
+    );
+    // The approach the commanded joints assume is written beside them.
+    let (hw, warm_rows) = read_csv(&warm);
+    for j in 1..=6 {
+        let k = col(&hw, &format!("dir{j}"));
+        assert!(warm_rows.iter().all(|r| r[k] == "1"), "dir{j}");
+    }
+    // The warm arm is longer: its commanded joints differ from those at the reference.
+    let (hr, ref_rows) = read_csv(&reference);
+    let mut most = 0.0_f64;
+    for (a, b) in warm_rows.iter().zip(&ref_rows) {
+        for j in 1..=6 {
+            let q = format!("q{j}");
+            most = most.max((num(&a[col(&hw, &q)]) - num(&b[col(&hr, &q)])).abs());
+        }
+    }
+    eprintln!("largest joint change, 27.5 deg C against the reference: {most:.5} deg");
+    assert!(most > 5e-4, "{most}");
+
+    // A temperature no robot has, and one for a calibration without thermal expansion: usage
+    // errors naming the flag, nothing written.
+    for (res, t, needle) in [
+        (&fam, "500", "--temperature-c 500"),
+        (&geo, "25", "no thermal expansion"),
+    ] {
+        let out = dir.join("never.csv");
+        let o = compensate(res, Some(t), &out);
+        o.assert_code(2);
+        assert!(o.stderr().contains(needle), "{}", o.stderr());
+        assert!(!out.exists());
+    }
+}
