@@ -281,9 +281,17 @@ impl CalibrationResult {
     /// robocal writes, robocal reads. A result its readers would refuse (a value outside its
     /// range) is not written: [`Error::Implausible`] names the field.
     pub fn write(&self, path: &Path) -> Result<()> {
-        let mut s = serde_json::to_string_pretty(self)
+        // Sized for the per-point entries (about 130 bytes each, pretty), so that a million
+        // points' text is not copied as it grows.
+        let points = self.points.as_ref().map_or(0, |p| {
+            p.calibration.len() + p.validation.as_ref().map_or(0, Vec::len)
+        });
+        let mut buf = Vec::with_capacity((1 << 17) + 140 * points);
+        serde_json::to_writer_pretty(&mut buf, self)
             .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
-        s.push('\n');
+        buf.push(b'\n');
+        let s = String::from_utf8(buf)
+            .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
         let readable =
             Self::parse_with_nominal(&s, path).and_then(|(back, nominal)| match nominal {
                 Some(nominal) => back.calibrated_robot(&nominal, path).map(|_| ()),
