@@ -7,11 +7,12 @@ use super::io_plan::IoPlan;
 use crate::exit;
 use clap::{Args, Subcommand};
 use robocal_core::frame::TrackerFrame;
-use robocal_core::io::write_atomic;
+use robocal_core::io::{write_all_atomic, write_atomic};
 use robocal_core::iso9283::{
-    evaluate, make_plan, plan_csv, read_plan, read_test_data, Evaluation, PlanSettings, Spec,
-    TrackerMpe, CYCLE_ORDER, DEFAULT_CYCLES,
+    evaluate, make_plan, plan_csv, plan_program, read_plan, read_test_data, Evaluation,
+    PlanSettings, Spec, TrackerMpe, CYCLE_ORDER, DEFAULT_CYCLES, DEFAULT_DWELL_S,
 };
+use robocal_core::programs::Format;
 use std::path::PathBuf;
 
 #[derive(Subcommand, Debug)]
@@ -49,9 +50,66 @@ pub struct PlanArgs {
     /// away from singularities].
     #[arg(long, value_name = "A,B,C", allow_hyphen_values = true)]
     orientation: Option<String>,
+    /// The floor (mm, base frame): no point of the cube below it [default: 0, the base plane
+    /// the robot is mounted on].
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    floor_mm: f64,
+    /// The robot's footprint: the cube keeps this far (mm) from the base z axis [default: 15 %
+    /// of the robot's chain length, as simulate's poses; 0 allows a cube above the robot].
+    #[arg(long, value_name = "MM")]
+    footprint_mm: Option<f64>,
     /// The plan CSV to write (cycle,pose,q1..qn,x_c,y_c,z_c,a_c,b_c,c_c).
     #[arg(long)]
     out: PathBuf,
+    /// Also write the plan as a robot program: the cycles' joint motions (the plan's joints as
+    /// controller axis values), an exact stop and a dwell at each pose.
+    #[arg(long, value_name = "FILE")]
+    program: Option<PathBuf>,
+    /// The program's language [default: from --program's extension: .src KRL, .mod RAPID,
+    /// .script URScript].
+    #[arg(long, value_parser = ["krl", "rapid", "urscript"], requires = "program")]
+    program_format: Option<String>,
+    /// The program's dwell at each pose (s): the robot settles and the tracker measures.
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = DEFAULT_DWELL_S,
+        requires = "program",
+        allow_hyphen_values = true
+    )]
+    dwell_s: f64,
+}
+
+/// The program format of `--program-format`, or of the program's extension; a format that
+/// contradicts a known extension is refused (the controller reads a file by its extension).
+fn program_format(given: Option<&str>, path: &std::path::Path) -> anyhow::Result<Format> {
+    let by_ext = Format::from_path(path).ok();
+    let format = match given {
+        Some("krl") => Format::Krl,
+        Some("rapid") => Format::Rapid,
+        Some(_) => Format::UrScript,
+        None => by_ext.ok_or_else(|| {
+            exit::usage(format!(
+                "--program {}: give --program-format krl|rapid|urscript (the extension is \
+                 none of .src, .mod, .script)",
+                path.display()
+            ))
+        })?,
+    };
+    match by_ext {
+        Some(e) if e != format => Err(exit::usage(format!(
+            "--program {}: the extension says {}, --program-format says {}",
+            path.display(),
+            e.name(),
+            format.name()
+        ))),
+        _ => Ok(format),
+    }
 }
 
 #[derive(Args, Debug)]
@@ -111,6 +169,14 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
     io.robot_opt("--robot", a.robot.as_deref())
         .input_opt("--params", a.params.as_deref())
         .output("--out", &a.out, "the plan is a file");
+    if let Some(p) = &a.program {
+        io.output("--program", p, "the program is a file");
+    }
+    let format = a
+        .program
+        .as_deref()
+        .map(|p| program_format(a.program_format.as_deref(), p))
+        .transpose()?;
     io.check()?;
     let settings = PlanSettings {
         cycles: a.cycles,
@@ -125,6 +191,8 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
             .as_deref()
             .map(|s| triple("--orientation", s))
             .transpose()?,
+        floor_z_mm: a.floor_mm,
+        footprint_radius_mm: a.footprint_mm,
         ..PlanSettings::default()
     };
     settings.validate()?;
@@ -134,7 +202,17 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
     }
     let calibrated = model.calibrated.as_ref().map(|c| &c.0);
     let plan = make_plan(&model.nominal, calibrated, &settings)?;
-    write_atomic(&a.out, &plan_csv(&plan, &model.nominal))?;
+    let csv = plan_csv(&plan, &model.nominal);
+    match (&a.program, format) {
+        (Some(path), Some(format)) => {
+            let prog = plan_program(&plan, &model.nominal, format, a.dwell_s)?;
+            write_all_atomic(&[
+                (a.out.as_path(), &csv),
+                (path.as_path(), prog.text.as_bytes()),
+            ])?;
+        }
+        _ => write_atomic(&a.out, &csv)?,
+    }
 
     let c = plan.cube.centre;
     outln!(
@@ -191,6 +269,14 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         plan.cycles,
         order.join(", ")
     )?;
+    if let (Some(path), Some(format)) = (&a.program, format) {
+        outln!(
+            "wrote {} ({} program: the same cycles as joint motions, {} s dwell at each pose)",
+            path.display(),
+            format.name(),
+            a.dwell_s
+        )?;
+    }
     Ok(())
 }
 
@@ -222,6 +308,19 @@ fn evaluate_cmd(a: EvaluateArgs) -> anyhow::Result<()> {
         outln!("{}", serde_json::to_string_pretty(&ev)?)?;
     } else {
         print_table(&ev, a.params.is_some())?;
+    }
+    if ev.pass == Some(false) {
+        let failed: Vec<String> = ev
+            .poses
+            .iter()
+            .filter(|p| p.pass == Some(false))
+            .map(|p| format!("P{}", p.pose))
+            .collect();
+        return Err(exit::rejected(format!(
+            "the test fails the spec {} at {}",
+            a.spec.as_deref().unwrap_or_default(),
+            failed.join(", ")
+        )));
     }
     Ok(())
 }

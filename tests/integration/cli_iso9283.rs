@@ -113,25 +113,44 @@ fn plan_simulate_evaluate_before_and_after_calibration() {
 
     // A spec between the two: the test fails before and passes after calibration.
     let spec = format!("ap={:.3},rp={:.3}", 0.5 * (ap0 + ap1), 3.0 * rp0.max(rp1));
-    let eval = |plan: &str, meas: &str| {
-        ok(&[
-            "iso9283",
-            "evaluate",
-            "--plan",
-            &d.join(plan).to_string_lossy(),
-            "--data",
-            &d.join(meas).to_string_lossy(),
-            "--params",
-            p(&c.result),
-            "--spec",
-            &spec,
-        ])
-        .stdout()
+    let eval = |plan: &str, meas: &str, json: bool| {
+        let mut args = vec![
+            "iso9283".to_owned(),
+            "evaluate".to_owned(),
+            "--plan".to_owned(),
+            d.join(plan).to_string_lossy().into_owned(),
+            "--data".to_owned(),
+            d.join(meas).to_string_lossy().into_owned(),
+            "--params".to_owned(),
+            p(&c.result).to_owned(),
+            "--spec".to_owned(),
+            spec.clone(),
+        ];
+        if json {
+            args.push("--json".to_owned());
+        }
+        robocal(&args)
     };
-    let text = eval("before-plan.csv", "before-meas.csv");
+    // A failed acceptance is a valid measurement: the table (or JSON) printed in full, exit 7.
+    let o = eval("before-plan.csv", "before-meas.csv", false);
+    o.assert_code(7);
+    let text = o.stdout();
     assert!(text.contains("FAIL") && text.contains("MPE"), "{text}");
-    let text = eval("after-plan.csv", "after-meas.csv");
+    assert!(text.contains("distance P1-P2"), "{text}");
+    assert!(o.stderr().contains("fails the spec"), "{}", o.stderr());
+    let o = eval("before-plan.csv", "before-meas.csv", true);
+    o.assert_code(7);
+    let v: Value = serde_json::from_str(&o.stdout()).expect("JSON of a failed test");
+    assert_eq!(v["pass"], Value::Bool(false));
+    assert_eq!(v["poses"].as_array().unwrap().len(), 5);
+    let o = eval("after-plan.csv", "after-meas.csv", false);
+    o.assert_code(0);
+    let text = o.stdout();
     assert!(text.contains("PASS") && !text.contains("FAIL"), "{text}");
+    let o = eval("after-plan.csv", "after-meas.csv", true);
+    o.assert_code(0);
+    let v: Value = serde_json::from_str(&o.stdout()).expect("JSON");
+    assert_eq!(v["pass"], Value::Bool(true));
 
     // The report shows both tests: the cube and poses, a table each.
     let out = d.join("report");
@@ -505,4 +524,141 @@ fn data_in_the_base_frame() {
     ]);
     o.assert_code(2);
     assert!(o.stderr().contains("--robot"), "{}", o.stderr());
+}
+
+/// The plan in the usable workspace and as a robot program: every corner of the cube above the
+/// floor (`--floor-mm`), the program beside the CSV with the cycle's five joint motions; a
+/// program the robot cannot take, or a format its extension contradicts, is refused with
+/// nothing written.
+#[test]
+fn plan_floor_and_program() {
+    let d = Dir::new();
+    let plan = d.join("plan.csv");
+    let prog = d.join("iso.src");
+    let o = ok(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        KUKA,
+        "--cycles",
+        "3",
+        "--floor-mm",
+        "1200",
+        "--out",
+        p(&plan),
+        "--program",
+        p(&prog),
+        "--dwell-s",
+        "3",
+    ]);
+    assert!(o.stdout().contains("KUKA KRL program"), "{}", o.stdout());
+    let (h, rows) = read_csv(&plan);
+    let col = |n: &str| h.iter().position(|c| c == n).unwrap();
+    let (cx, cz) = (col("x_c"), col("z_c"));
+    let zs: Vec<f64> = rows.iter().map(|r| r[cz].parse().unwrap()).collect();
+    assert!(zs.iter().all(|z| *z >= 1200.0), "{zs:?}");
+    // The cube's edge from P2..P5 (at 80 % of the half diagonal): its lowest corner too.
+    let x: Vec<f64> = rows[..5].iter().map(|r| r[cx].parse().unwrap()).collect();
+    let half_edge = (x[1] - x[0]).abs() / 0.8;
+    assert!(zs[0] - half_edge >= 1200.0 - 1e-6, "{zs:?} {half_edge}");
+    let text = std::fs::read_to_string(&prog).unwrap();
+    assert!(text.contains("FOR CYCLE = 1 TO 3"), "{text}");
+    assert_eq!(text.matches("PTP {AXIS:").count(), 5, "{text}");
+    assert_eq!(text.matches("WAIT SEC 3").count(), 5, "{text}");
+
+    // RAPID by its extension, URScript by the flag.
+    let rapid = d.join("iso.mod");
+    ok(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        KUKA,
+        "--cycles",
+        "2",
+        "--out",
+        p(&plan),
+        "--program",
+        p(&rapid),
+    ]);
+    assert!(std::fs::read_to_string(&rapid)
+        .unwrap()
+        .contains("MoveAbsJ p1, v100, fine, tool0;"));
+    let ur = d.join("iso.txt");
+    ok(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        &example("ur5.toml"),
+        "--cycles",
+        "2",
+        "--out",
+        p(&plan),
+        "--program",
+        p(&ur),
+        "--program-format",
+        "urscript",
+    ]);
+    assert!(std::fs::read_to_string(&ur).unwrap().contains("movej(p1)"));
+
+    // Refused, nothing written: a format the extension contradicts (usage), an extension that
+    // names none and no format (usage), a robot without six joints (bad input).
+    let (plan2, prog2) = (d.join("p2.csv"), d.join("p2.mod"));
+    let o = robocal(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        KUKA,
+        "--out",
+        p(&plan2),
+        "--program",
+        p(&prog2),
+        "--program-format",
+        "krl",
+    ]);
+    o.assert_code(2);
+    assert!(o.stderr().contains("--program-format"), "{}", o.stderr());
+    let prog3 = d.join("p2.txt");
+    let o = robocal(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        KUKA,
+        "--out",
+        p(&plan2),
+        "--program",
+        p(&prog3),
+    ]);
+    o.assert_code(2);
+    let prog4 = d.join("p2.src");
+    let o = robocal(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        &example("kr480-track.toml"),
+        "--cycles",
+        "2",
+        "--out",
+        p(&plan2),
+        "--program",
+        p(&prog4),
+    ]);
+    o.assert_code(3);
+    assert!(o.stderr().contains("--program-format"), "{}", o.stderr());
+    let o = robocal(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        KUKA,
+        "--out",
+        p(&plan2),
+        "--program",
+        p(&prog4),
+        "--dwell-s",
+        "-1",
+    ]);
+    o.assert_code(3);
+    assert!(o.stderr().contains("--dwell-s"), "{}", o.stderr());
+    for f in [&plan2, &prog2, &prog3, &prog4] {
+        assert!(!f.exists(), "{}", f.display());
+    }
 }
