@@ -50,6 +50,10 @@ pub struct PlanArgs {
     /// away from singularities].
     #[arg(long, value_name = "A,B,C", allow_hyphen_values = true)]
     orientation: Option<String>,
+    /// The cube, poses and tool orientation of an earlier plan (the test before calibration):
+    /// with --params, the same test with the compensated joints.
+    #[arg(long, value_name = "PLAN.csv", conflicts_with_all = ["cube_mm", "center", "orientation"])]
+    poses_from: Option<PathBuf>,
     /// The floor (mm, base frame): no point of the cube below it [default: 0, the base plane
     /// the robot is mounted on].
     #[arg(
@@ -168,6 +172,7 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
     let mut io = IoPlan::new();
     io.robot_opt("--robot", a.robot.as_deref())
         .input_opt("--params", a.params.as_deref())
+        .input_opt("--poses-from", a.poses_from.as_deref())
         .output("--out", &a.out, "the plan is a file");
     if let Some(p) = &a.program {
         io.output("--program", p, "the program is a file");
@@ -178,7 +183,7 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         .map(|p| program_format(a.program_format.as_deref(), p))
         .transpose()?;
     io.check()?;
-    let settings = PlanSettings {
+    let mut settings = PlanSettings {
         cycles: a.cycles,
         edge_mm: a.cube_mm,
         centre_mm: a
@@ -201,6 +206,12 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         common::warn_not_calibrated(res, p)?;
     }
     let calibrated = model.calibrated.as_ref().map(|c| &c.0);
+    if let Some(path) = &a.poses_from {
+        let (cube, abc) = read_plan(path, &model.nominal, calibrated)?.cube()?;
+        settings.centre_mm = Some(cube.centre.into());
+        settings.edge_mm = Some(cube.edge_mm);
+        settings.orientation_deg = Some(abc);
+    }
     let plan = make_plan(&model.nominal, calibrated, &settings)?;
     let csv = plan_csv(&plan, &model.nominal);
     match (&a.program, format) {
@@ -221,10 +232,12 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         c.x,
         c.y,
         c.z,
-        if a.cube_mm.is_none() {
-            ", the largest that fits"
+        if let Some(p) = &a.poses_from {
+            format!(", as {}", p.display())
+        } else if a.cube_mm.is_none() {
+            ", the largest that fits".to_owned()
         } else {
-            ""
+            String::new()
         }
     )?;
     let o = plan.pose_vector_deg(1);
@@ -477,16 +490,21 @@ pub(super) fn demo_table(exp: &robocal_core::experiment::Experiment) -> anyhow::
     let repeat = RepeatabilityModel::default_for(nominal);
     cfg.repeatability = Some(repeat.clone());
     let frame = exp.result.tracker_frame.to_tracker_frame();
-    let settings = PlanSettings::default();
+    let before = make_plan(nominal, None, &PlanSettings::default())?;
+    // After calibration the same cube and poses (as `plan --poses-from`), compensated.
+    let v = before.pose_vector_deg(1);
+    let same = PlanSettings {
+        centre_mm: Some(before.cube.centre.into()),
+        edge_mm: Some(before.cube.edge_mm),
+        orientation_deg: Some([v[3], v[4], v[5]]),
+        ..PlanSettings::default()
+    };
+    let after = make_plan(nominal, Some(&exp.calibrated), &same)?;
     let mut figures = Vec::new();
-    for (label, calibrated) in [
-        ("before calibration (nominal joints)", None),
-        (
-            "after calibration (compensated joints)",
-            Some(&exp.calibrated),
-        ),
+    for (label, plan) in [
+        ("before calibration (nominal joints)", before),
+        ("after calibration (compensated joints)", after),
     ] {
-        let plan = make_plan(nominal, calibrated, &settings)?;
         let ev = simulate_test(
             nominal,
             &truth,

@@ -431,6 +431,36 @@ fn readme_figures() {
     };
     let before = test(false, "iso-plan.csv", "iso-before.csv");
     let after = test(true, "iso-plan-cal.csv", "iso-after.csv");
+    // The README: the largest nominal cube does not fit after calibration (`--poses-from`
+    // refuses it at P3, near a singularity); the searched plan after it is 1 % smaller.
+    let o = robocal(&[
+        "iso9283",
+        "plan",
+        "--params",
+        p(&result),
+        "--poses-from",
+        p(&d.join("iso-plan.csv")),
+        "--out",
+        p(&d.join("same.csv")),
+    ]);
+    o.assert_code(3);
+    assert!(
+        o.stderr().contains("P3 singular on the calibrated model"),
+        "{}",
+        o.stderr()
+    );
+    let edge = |plan: &str| {
+        let (h, rows) = read_csv(&d.join(plan));
+        let x = h.iter().position(|c| c == "x_c").unwrap();
+        let at = |pose: &str| -> f64 {
+            rows.iter().find(|r| r[1] == pose).unwrap()[x]
+                .parse()
+                .unwrap()
+        };
+        2.0 * (at("1") - at("2")) / 0.8
+    };
+    let ratio = edge("iso-plan-cal.csv") / edge("iso-plan.csv");
+    assert!((0.985..0.995).contains(&ratio), "{ratio}");
     let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
     let quoted = format!(
         "AP {:.3} mm before calibration, {:.3} mm after; RP {:.3} mm before, {:.3} mm after",
@@ -661,4 +691,80 @@ fn plan_floor_and_program() {
     for f in [&plan2, &prog2, &prog3, &prog4] {
         assert!(!f.exists(), "{}", f.display());
     }
+}
+
+/// `--poses-from`: the test after calibration commands the poses of the plan before it (the
+/// cube, P1..P5, the tool orientation), with the compensated joints.
+#[test]
+fn plan_poses_from_an_earlier_plan() {
+    let d = Dir::new();
+    let c = cell();
+    let before = d.join("before.csv");
+    let after = d.join("after.csv");
+    ok(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        KUKA,
+        "--cycles",
+        "2",
+        "--out",
+        p(&before),
+    ]);
+    let o = ok(&[
+        "iso9283",
+        "plan",
+        "--params",
+        p(&c.result),
+        "--cycles",
+        "3",
+        "--poses-from",
+        p(&before),
+        "--out",
+        p(&after),
+    ]);
+    assert!(o.stdout().contains(", as "), "{}", o.stdout());
+    let (h, b) = read_csv(&before);
+    let (_, a) = read_csv(&after);
+    assert_eq!(a.len(), 15);
+    let cols: Vec<usize> = ["x_c", "y_c", "z_c", "a_c", "b_c", "c_c"]
+        .iter()
+        .map(|n| h.iter().position(|c| c == n).unwrap())
+        .collect();
+    let q1 = h.iter().position(|c| c == "q1").unwrap();
+    for (ra, rb) in a.iter().zip(&b) {
+        assert_eq!(ra[1], rb[1], "the same pose order");
+        for k in &cols {
+            let (x, y): (f64, f64) = (ra[*k].parse().unwrap(), rb[*k].parse().unwrap());
+            assert!((x - y).abs() < 1e-9, "{} {x} vs {y}", h[*k]);
+        }
+        assert_ne!(ra[q1], rb[q1], "compensated joints");
+    }
+    // Not with a cube of its own; not a file that is no plan.
+    let none = d.join("none.csv");
+    let o = robocal(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        KUKA,
+        "--poses-from",
+        p(&before),
+        "--center",
+        "1,2,3",
+        "--out",
+        p(&none),
+    ]);
+    o.assert_code(2);
+    let o = robocal(&[
+        "iso9283",
+        "plan",
+        "--robot",
+        KUKA,
+        "--poses-from",
+        p(&c.truth),
+        "--out",
+        p(&none),
+    ]);
+    o.assert_code(3);
+    assert!(!none.exists());
 }

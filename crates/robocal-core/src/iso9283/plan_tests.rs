@@ -233,6 +233,29 @@ fn compensated_plan_and_csv_round_trip() {
     for (k, f) in back.poses.iter().enumerate() {
         assert!((f.translation.vector - plan.poses[k].translation.vector).norm() < 1e-9);
     }
+    // The plan's cube and orientation read back: a plan made with them commands the same
+    // poses (the test after calibration planned like the one before).
+    let (cube, abc) = back.cube().unwrap();
+    assert!((cube.centre - plan.cube.centre).norm() < 1e-9);
+    assert!((cube.edge_mm - plan.cube.edge_mm).abs() < 1e-9);
+    let again = make_plan(
+        &robot,
+        Some(&cal),
+        &PlanSettings {
+            centre_mm: Some(cube.centre.into()),
+            edge_mm: Some(cube.edge_mm),
+            orientation_deg: Some(abc),
+            ..s.clone()
+        },
+    )
+    .unwrap();
+    for (a, b) in again.poses.iter().zip(&plan.poses) {
+        assert!((a.translation.vector - b.translation.vector).norm() < 1e-9);
+        let turned = crate::compensation::rotation_angle(
+            &(a.rotation.matrix() * b.rotation.matrix().transpose()),
+        );
+        assert!(turned < 1e-12, "{turned}");
+    }
     // Read without the calibrated model, the compensated joints do not reach the commanded
     // poses on the nominal one: refused as a plan for another robot.
     let e = read_plan(&path, &robot, None).unwrap_err().to_string();
