@@ -202,9 +202,11 @@ pub fn make_plan<'a>(
         None => nominal.tool_pose(&reference).rotation,
     };
     let rotation = Rotation3::from_matrix_unchecked(*rotation.matrix());
-    // The cube is searched on the nominal model (the same cube before and after calibration);
-    // the compensated joints on the calibrated model are then checked, and a searched cube
-    // shrunk in 1 % steps in the rare case that they leave the limits at its boundary.
+    // The cube is searched on the nominal model (the same search before and after
+    // calibration); the compensated joints on the calibrated model are then checked, and a
+    // searched cube shrunk in 1 % steps where they fail at its boundary (out of the limits or
+    // near a singularity). To keep the cube of the plan before calibration, give it
+    // ([`super::PlanFile::cube`]): then a pose that fails is an error.
     let footprint = settings.footprint_radius(nominal);
     let rules = |mut r: Reach<'a>| {
         r.floor_z_mm = settings.floor_z_mm;
