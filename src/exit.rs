@@ -15,6 +15,9 @@ pub const NUMERICAL: i32 = 5;
 /// A fit that converged but cannot be right (the plausibility gate: units, handedness, wrong
 /// robot, parameter moves beyond calibration): nothing written unless explicitly accepted.
 pub const IMPLAUSIBLE: i32 = 6;
+/// A measurement that is valid but fails the acceptance limits it was given (`iso9283 evaluate
+/// --spec`): its figures are printed as on a pass, and the code says it failed.
+pub const REJECTED: i32 = 7;
 /// Interrupted by SIGINT/SIGTERM (128 + signal number for SIGINT, as shells report it).
 #[cfg_attr(not(unix), allow(dead_code))]
 pub const INTERRUPTED: i32 = 130;
@@ -69,6 +72,15 @@ pub fn numerical(message: impl Into<String>) -> anyhow::Error {
 pub fn implausible(message: impl Into<String>) -> anyhow::Error {
     CliError {
         code: IMPLAUSIBLE,
+        message: message.into(),
+    }
+    .into()
+}
+
+/// A test that failed its acceptance limits (exit code 7).
+pub fn rejected(message: impl Into<String>) -> anyhow::Error {
+    CliError {
+        code: REJECTED,
         message: message.into(),
     }
     .into()

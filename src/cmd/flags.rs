@@ -32,6 +32,8 @@ const FLAGS: &[(&str, &str)] = &[
     ("edge_mm", "--cube-mm"),
     ("centre_mm", "--center"),
     ("orientation_deg", "--orientation"),
+    ("program_format", "--program-format"),
+    ("dwell_s", "--dwell-s"),
     ("spec", "--spec"),
     ("tracker_mpe", "--tracker-mpe"),
     // identification::CalibrationSettings

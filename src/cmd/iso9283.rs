@@ -7,11 +7,12 @@ use super::io_plan::IoPlan;
 use crate::exit;
 use clap::{Args, Subcommand};
 use robocal_core::frame::TrackerFrame;
-use robocal_core::io::write_atomic;
+use robocal_core::io::{write_all_atomic, write_atomic};
 use robocal_core::iso9283::{
-    evaluate, make_plan, plan_csv, read_plan, read_test_data, Evaluation, PlanSettings, Spec,
-    TrackerMpe, CYCLE_ORDER, DEFAULT_CYCLES,
+    evaluate, make_plan, plan_csv, plan_program, read_plan, read_test_data, Evaluation,
+    PlanSettings, Spec, TrackerMpe, CYCLE_ORDER, DEFAULT_CYCLES, DEFAULT_DWELL_S,
 };
+use robocal_core::programs::Format;
 use std::path::PathBuf;
 
 #[derive(Subcommand, Debug)]
@@ -49,9 +50,70 @@ pub struct PlanArgs {
     /// away from singularities].
     #[arg(long, value_name = "A,B,C", allow_hyphen_values = true)]
     orientation: Option<String>,
+    /// The cube, poses and tool orientation of an earlier plan (the test before calibration):
+    /// with --params, the same test with the compensated joints.
+    #[arg(long, value_name = "PLAN.csv", conflicts_with_all = ["cube_mm", "center", "orientation"])]
+    poses_from: Option<PathBuf>,
+    /// The floor (mm, base frame): no point of the cube below it [default: 0, the base plane
+    /// the robot is mounted on].
+    #[arg(
+        long,
+        value_name = "MM",
+        default_value_t = 0.0,
+        allow_hyphen_values = true
+    )]
+    floor_mm: f64,
+    /// The robot's footprint: the cube keeps this far (mm) from the base z axis [default: 15 %
+    /// of the robot's chain length, as simulate's poses; 0 allows a cube above the robot].
+    #[arg(long, value_name = "MM")]
+    footprint_mm: Option<f64>,
     /// The plan CSV to write (cycle,pose,q1..qn,x_c,y_c,z_c,a_c,b_c,c_c).
     #[arg(long)]
     out: PathBuf,
+    /// Also write the plan as a robot program: the cycles' joint motions (the plan's joints as
+    /// controller axis values), an exact stop and a dwell at each pose.
+    #[arg(long, value_name = "FILE")]
+    program: Option<PathBuf>,
+    /// The program's language [default: from --program's extension: .src KRL, .mod RAPID,
+    /// .script URScript].
+    #[arg(long, value_parser = ["krl", "rapid", "urscript"], requires = "program")]
+    program_format: Option<String>,
+    /// The program's dwell at each pose (s): the robot settles and the tracker measures.
+    #[arg(
+        long,
+        value_name = "S",
+        default_value_t = DEFAULT_DWELL_S,
+        requires = "program",
+        allow_hyphen_values = true
+    )]
+    dwell_s: f64,
+}
+
+/// The program format of `--program-format`, or of the program's extension; a format that
+/// contradicts a known extension is refused (the controller reads a file by its extension).
+fn program_format(given: Option<&str>, path: &std::path::Path) -> anyhow::Result<Format> {
+    let by_ext = Format::from_path(path).ok();
+    let format = match given {
+        Some("krl") => Format::Krl,
+        Some("rapid") => Format::Rapid,
+        Some(_) => Format::UrScript,
+        None => by_ext.ok_or_else(|| {
+            exit::usage(format!(
+                "--program {}: give --program-format krl|rapid|urscript (the extension is \
+                 none of .src, .mod, .script)",
+                path.display()
+            ))
+        })?,
+    };
+    match by_ext {
+        Some(e) if e != format => Err(exit::usage(format!(
+            "--program {}: the extension says {}, --program-format says {}",
+            path.display(),
+            e.name(),
+            format.name()
+        ))),
+        _ => Ok(format),
+    }
 }
 
 #[derive(Args, Debug)]
@@ -110,9 +172,18 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
     let mut io = IoPlan::new();
     io.robot_opt("--robot", a.robot.as_deref())
         .input_opt("--params", a.params.as_deref())
+        .input_opt("--poses-from", a.poses_from.as_deref())
         .output("--out", &a.out, "the plan is a file");
+    if let Some(p) = &a.program {
+        io.output("--program", p, "the program is a file");
+    }
+    let format = a
+        .program
+        .as_deref()
+        .map(|p| program_format(a.program_format.as_deref(), p))
+        .transpose()?;
     io.check()?;
-    let settings = PlanSettings {
+    let mut settings = PlanSettings {
         cycles: a.cycles,
         edge_mm: a.cube_mm,
         centre_mm: a
@@ -125,6 +196,8 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
             .as_deref()
             .map(|s| triple("--orientation", s))
             .transpose()?,
+        floor_z_mm: a.floor_mm,
+        footprint_radius_mm: a.footprint_mm,
         ..PlanSettings::default()
     };
     settings.validate()?;
@@ -133,8 +206,24 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         common::warn_not_calibrated(res, p)?;
     }
     let calibrated = model.calibrated.as_ref().map(|c| &c.0);
+    if let Some(path) = &a.poses_from {
+        let (cube, abc) = read_plan(path, &model.nominal, calibrated)?.cube()?;
+        settings.centre_mm = Some(cube.centre.into());
+        settings.edge_mm = Some(cube.edge_mm);
+        settings.orientation_deg = Some(abc);
+    }
     let plan = make_plan(&model.nominal, calibrated, &settings)?;
-    write_atomic(&a.out, &plan_csv(&plan, &model.nominal))?;
+    let csv = plan_csv(&plan, &model.nominal);
+    match (&a.program, format) {
+        (Some(path), Some(format)) => {
+            let prog = plan_program(&plan, &model.nominal, format, a.dwell_s)?;
+            write_all_atomic(&[
+                (a.out.as_path(), &csv),
+                (path.as_path(), prog.text.as_bytes()),
+            ])?;
+        }
+        _ => write_atomic(&a.out, &csv)?,
+    }
 
     let c = plan.cube.centre;
     outln!(
@@ -143,10 +232,12 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         c.x,
         c.y,
         c.z,
-        if a.cube_mm.is_none() {
-            ", the largest that fits"
+        if let Some(p) = &a.poses_from {
+            format!(", as {}", p.display())
+        } else if a.cube_mm.is_none() {
+            ", the largest that fits".to_owned()
         } else {
-            ""
+            String::new()
         }
     )?;
     let o = plan.pose_vector_deg(1);
@@ -191,6 +282,14 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         plan.cycles,
         order.join(", ")
     )?;
+    if let (Some(path), Some(format)) = (&a.program, format) {
+        outln!(
+            "wrote {} ({} program: the same cycles as joint motions, {} s dwell at each pose)",
+            path.display(),
+            format.name(),
+            a.dwell_s
+        )?;
+    }
     Ok(())
 }
 
@@ -222,6 +321,19 @@ fn evaluate_cmd(a: EvaluateArgs) -> anyhow::Result<()> {
         outln!("{}", serde_json::to_string_pretty(&ev)?)?;
     } else {
         print_table(&ev, a.params.is_some())?;
+    }
+    if ev.pass == Some(false) {
+        let failed: Vec<String> = ev
+            .poses
+            .iter()
+            .filter(|p| p.pass == Some(false))
+            .map(|p| format!("P{}", p.pose))
+            .collect();
+        return Err(exit::rejected(format!(
+            "the test fails the spec {} at {}",
+            a.spec.as_deref().unwrap_or_default(),
+            failed.join(", ")
+        )));
     }
     Ok(())
 }
@@ -378,16 +490,21 @@ pub(super) fn demo_table(exp: &robocal_core::experiment::Experiment) -> anyhow::
     let repeat = RepeatabilityModel::default_for(nominal);
     cfg.repeatability = Some(repeat.clone());
     let frame = exp.result.tracker_frame.to_tracker_frame();
-    let settings = PlanSettings::default();
+    let before = make_plan(nominal, None, &PlanSettings::default())?;
+    // After calibration the same cube and poses (as `plan --poses-from`), compensated.
+    let v = before.pose_vector_deg(1);
+    let same = PlanSettings {
+        centre_mm: Some(before.cube.centre.into()),
+        edge_mm: Some(before.cube.edge_mm),
+        orientation_deg: Some([v[3], v[4], v[5]]),
+        ..PlanSettings::default()
+    };
+    let after = make_plan(nominal, Some(&exp.calibrated), &same)?;
     let mut figures = Vec::new();
-    for (label, calibrated) in [
-        ("before calibration (nominal joints)", None),
-        (
-            "after calibration (compensated joints)",
-            Some(&exp.calibrated),
-        ),
+    for (label, plan) in [
+        ("before calibration (nominal joints)", before),
+        ("after calibration (compensated joints)", after),
     ] {
-        let plan = make_plan(nominal, calibrated, &settings)?;
         let ev = simulate_test(
             nominal,
             &truth,

@@ -113,25 +113,44 @@ fn plan_simulate_evaluate_before_and_after_calibration() {
 
     // A spec between the two: the test fails before and passes after calibration.
     let spec = format!("ap={:.3},rp={:.3}", 0.5 * (ap0 + ap1), 3.0 * rp0.max(rp1));
-    let eval = |plan: &str, meas: &str| {
-        ok(&[
-            "iso9283",
-            "evaluate",
-            "--plan",
-            &d.join(plan).to_string_lossy(),
-            "--data",
-            &d.join(meas).to_string_lossy(),
-            "--params",
-            p(&c.result),
-            "--spec",
-            &spec,
-        ])
-        .stdout()
+    let eval = |plan: &str, meas: &str, json: bool| {
+        let mut args = vec![
+            "iso9283".to_owned(),
+            "evaluate".to_owned(),
+            "--plan".to_owned(),
+            d.join(plan).to_string_lossy().into_owned(),
+            "--data".to_owned(),
+            d.join(meas).to_string_lossy().into_owned(),
+            "--params".to_owned(),
+            p(&c.result).to_owned(),
+            "--spec".to_owned(),
+            spec.clone(),
+        ];
+        if json {
+            args.push("--json".to_owned());
+        }
+        robocal(&args)
     };
-    let text = eval("before-plan.csv", "before-meas.csv");
+    // A failed acceptance is a valid measurement: the table (or JSON) printed in full, exit 7.
+    let o = eval("before-plan.csv", "before-meas.csv", false);
+    o.assert_code(7);
+    let text = o.stdout();
     assert!(text.contains("FAIL") && text.contains("MPE"), "{text}");
-    let text = eval("after-plan.csv", "after-meas.csv");
+    assert!(text.contains("distance P1-P2"), "{text}");
+    assert!(o.stderr().contains("fails the spec"), "{}", o.stderr());
+    let o = eval("before-plan.csv", "before-meas.csv", true);
+    o.assert_code(7);
+    let v: Value = serde_json::from_str(&o.stdout()).expect("JSON of a failed test");
+    assert_eq!(v["pass"], Value::Bool(false));
+    assert_eq!(v["poses"].as_array().unwrap().len(), 5);
+    let o = eval("after-plan.csv", "after-meas.csv", false);
+    o.assert_code(0);
+    let text = o.stdout();
     assert!(text.contains("PASS") && !text.contains("FAIL"), "{text}");
+    let o = eval("after-plan.csv", "after-meas.csv", true);
+    o.assert_code(0);
+    let v: Value = serde_json::from_str(&o.stdout()).expect("JSON");
+    assert_eq!(v["pass"], Value::Bool(true));
 
     // The report shows both tests: the cube and poses, a table each.
     let out = d.join("report");
@@ -412,6 +431,36 @@ fn readme_figures() {
     };
     let before = test(false, "iso-plan.csv", "iso-before.csv");
     let after = test(true, "iso-plan-cal.csv", "iso-after.csv");
+    // The README: the largest nominal cube does not fit after calibration (`--poses-from`
+    // refuses it at P3, near a singularity); the searched plan after it is 1 % smaller.
+    let o = robocal(&[
+        "iso9283",
+        "plan",
+        "--params",
+        p(&result),
+        "--poses-from",
+        p(&d.join("iso-plan.csv")),
+        "--out",
+        p(&d.join("same.csv")),
+    ]);
+    o.assert_code(3);
+    assert!(
+        o.stderr().contains("P3 singular on the calibrated model"),
+        "{}",
+        o.stderr()
+    );
+    let edge = |plan: &str| {
+        let (h, rows) = read_csv(&d.join(plan));
+        let x = h.iter().position(|c| c == "x_c").unwrap();
+        let at = |pose: &str| -> f64 {
+            rows.iter().find(|r| r[1] == pose).unwrap()[x]
+                .parse()
+                .unwrap()
+        };
+        2.0 * (at("1") - at("2")) / 0.8
+    };
+    let ratio = edge("iso-plan-cal.csv") / edge("iso-plan.csv");
+    assert!((0.985..0.995).contains(&ratio), "{ratio}");
     let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
     let quoted = format!(
         "AP {:.3} mm before calibration, {:.3} mm after; RP {:.3} mm before, {:.3} mm after",

@@ -31,6 +31,7 @@ mod cli_evaluate;
 mod cli_import;
 mod cli_interrupted;
 mod cli_iso9283;
+mod cli_iso9283_plan;
 mod cli_joints;
 mod cli_plan;
 mod cli_programs;

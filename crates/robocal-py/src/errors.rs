@@ -84,6 +84,10 @@ const KEYWORDS: &[(&str, &str)] = &[
     ("time_tolerance_s", "time_tolerance"),
     ("dwell.still_deg", "still_deg"),
     ("dwell.min_s", "dwell_min_s"),
+    // iso9283::PlanSettings, plan_program (robocal.iso9283_plan)
+    ("edge_mm", "cube_mm"),
+    ("centre_mm", "center"),
+    ("orientation_deg", "orientation"),
 ];
 
 /// Phrases the library uses for a setting that is no field of its settings structs.

@@ -13,6 +13,7 @@ mod compensate;
 mod errors;
 mod evaluate;
 mod import;
+mod iso9283;
 mod options;
 mod plan;
 mod result;
@@ -42,6 +43,9 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(result::write_result, m)?)?;
     m.add_function(wrap_pyfunction!(result::result_robots, m)?)?;
     m.add_function(wrap_pyfunction!(import::import_measurements, m)?)?;
+    m.add_class::<iso9283::PyIsoPlan>()?;
+    m.add_function(wrap_pyfunction!(iso9283::iso9283_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(iso9283::iso9283_evaluate, m)?)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

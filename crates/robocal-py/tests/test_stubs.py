@@ -38,14 +38,15 @@ def test_every_public_name_has_a_stub(stub):
     assert not missing, missing
 
 
-@pytest.mark.parametrize("name", ["calibrate", "calibrate_files", "evaluate", "compensate", "simulate", "plan"])
+@pytest.mark.parametrize("name", ["calibrate", "calibrate_files", "evaluate", "compensate", "simulate", "plan",
+                                  "iso9283_plan", "iso9283_evaluate"])
 def test_function_signatures_match(stub, name):
     fn = stub_functions(stub)[name]
     runtime = [p for p in inspect.signature(getattr(robocal, name)).parameters]
     assert params(fn) + ([fn.args.kwarg.arg] if fn.args.kwarg else []) == runtime
 
 
-@pytest.mark.parametrize("name", ["Simulation", "Plan", "PlanQuality"])
+@pytest.mark.parametrize("name", ["Simulation", "Plan", "PlanQuality", "Iso9283Plan"])
 def test_class_members_match(stub, name):
     cls = stub_classes(stub)[name]
     members = set()
@@ -59,9 +60,9 @@ def test_class_members_match(stub, name):
 
 
 def test_docstrings(stub):
-    for f in (robocal.simulate, robocal.plan):
+    for f in (robocal.simulate, robocal.plan, robocal.iso9283_plan):
         assert "CLI" in f.__doc__ and len(f.__doc__) > 500
-    for cls in (robocal.Simulation, robocal.Plan, robocal.PlanQuality):
+    for cls in (robocal.Simulation, robocal.Plan, robocal.PlanQuality, robocal.Iso9283Plan):
         assert cls.__doc__
         for m in dir(cls):
             if not m.startswith("_"):

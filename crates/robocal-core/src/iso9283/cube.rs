@@ -9,14 +9,18 @@
 //! from C1, C2, C3, C4: `P = c + 0.8 (C - c)` (a diagonal is `2 |C - c|` long). P2 and P4, P3 and
 //! P5 face each other across the centre.
 //!
-//! A cube *fits* when every test point is reached by the robot at the tool orientation with all
+//! A cube *fits* when it lies whole above the floor ([`Reach::floor_z_mm`]: by default the base
+//! plane z = 0, the surface the robot is mounted on) and outside the robot's footprint (the
+//! cylinder of [`Reach::footprint_radius_mm`] about the base z axis: its base and column), and
+//! every test point is reached by the robot at the tool orientation with all
 //! joints within their limits (by [`Reach::limit_margin`]), on one configuration (P2..P5 solved
 //! from P1's joints and on its branch), every solution at least [`Reach::singular_margin`] away
 //! from a singularity; with a calibrated model, the compensated joints must reach the poses on
 //! it within the limits and half that margin from a singularity. The largest cube: for a
 //! centre, the largest edge that fits (bisection, then grown in 1 % steps while it still fits);
-//! without a given centre, a pattern search over centres (from the tool point of the reference
-//! configuration) for the largest such edge.
+//! without a given centre, a pattern search over centres (from the better of the reference
+//! configuration's tool point and that point moved into the free space) for the largest such
+//! edge.
 
 use crate::compensation::{configuration, Compensator, DampedLeastSquares, IkStatus};
 use crate::frame::Frame;
@@ -75,14 +79,51 @@ impl Cube {
 
 /// Why a cube does not fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Miss {
-    /// The test pose (1..5) that failed.
-    pub pose: usize,
-    /// How its solve ended (`Singular` also when the margin is below
-    /// [`Reach::singular_margin`]).
-    pub status: IkStatus,
-    /// On the calibrated model (compensation) rather than the nominal.
-    pub calibrated: bool,
+pub enum Miss {
+    /// The cube reaches below the floor: the height of its lowest corner (mm, base frame).
+    Floor {
+        /// The lowest corner's z (mm).
+        z_mm: f64,
+    },
+    /// The cube reaches into the robot's footprint: the distance of its nearest point from the
+    /// base z axis (mm).
+    Footprint {
+        /// The distance (mm).
+        distance_mm: f64,
+    },
+    /// A test pose is not reached.
+    Pose {
+        /// The test pose (1..5) that failed.
+        pose: usize,
+        /// How its solve ended (`Singular` also when the margin is below
+        /// [`Reach::singular_margin`]).
+        status: IkStatus,
+        /// On the calibrated model (compensation) rather than the nominal.
+        calibrated: bool,
+    },
+}
+
+impl std::fmt::Display for Miss {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Miss::Floor { z_mm } => {
+                write!(f, "its lowest corner (z = {z_mm} mm) is below the floor")
+            }
+            Miss::Footprint { distance_mm } => write!(
+                f,
+                "it comes within {distance_mm} mm of the base z axis, inside the robot's footprint"
+            ),
+            Miss::Pose {
+                pose,
+                status,
+                calibrated,
+            } => write!(
+                f,
+                "P{pose} {status} on the {} model",
+                if *calibrated { "calibrated" } else { "nominal" }
+            ),
+        }
+    }
 }
 
 /// The joints of a fitting cube's test poses.
@@ -109,6 +150,12 @@ pub struct Reach<'a> {
     /// revolute joint, mm for a prismatic one), so that the compensated joints, which differ by
     /// a calibration's corrections, stay inside too. Default 1 degree (1 mm).
     pub limit_margin: f64,
+    /// Lowest z (mm, base frame) of any point of the cube: the floor, or the surface the robot
+    /// is mounted on (its base plane, z = 0, whatever the mounting). Default 0.
+    pub floor_z_mm: f64,
+    /// The cube keeps at least this far (mm) from the base z axis: the robot's own base and
+    /// column. Default 0.
+    pub footprint_radius_mm: f64,
 }
 
 impl<'a> Reach<'a> {
@@ -128,6 +175,8 @@ impl<'a> Reach<'a> {
             reference,
             singular_margin,
             limit_margin: 1f64.to_radians(),
+            floor_z_mm: 0.0,
+            footprint_radius_mm: 0.0,
         }
     }
 
@@ -158,13 +207,31 @@ impl<'a> Reach<'a> {
             })
     }
 
-    /// Solves the test poses of `cube`, or says which pose fails first.
+    /// Whether the whole cube lies above the floor and outside the footprint cylinder.
+    pub fn clear_of_base(&self, cube: &Cube) -> Result<(), Miss> {
+        let h = 0.5 * cube.edge_mm;
+        let z = cube.centre.z - h;
+        if z < self.floor_z_mm {
+            return Err(Miss::Floor { z_mm: z });
+        }
+        let dx = (cube.centre.x.abs() - h).max(0.0);
+        let dy = (cube.centre.y.abs() - h).max(0.0);
+        let d = dx.hypot(dy);
+        if d < self.footprint_radius_mm {
+            return Err(Miss::Footprint { distance_mm: d });
+        }
+        Ok(())
+    }
+
+    /// Solves the test poses of `cube`, or says why it does not fit (the floor, the footprint,
+    /// or the first pose that fails).
     pub fn solve(&self, cube: &Cube) -> Result<Solution, Miss> {
         let nom = Compensator::new(self.nominal, self.nominal, DampedLeastSquares::default())
             .expect("same robot");
         let n = self.nominal.dof();
         let poses = cube.test_poses(&self.rotation);
-        let miss = |pose: usize, status: IkStatus, calibrated: bool| Miss {
+        self.clear_of_base(cube)?;
+        let miss = |pose: usize, status: IkStatus, calibrated: bool| Miss::Pose {
             pose,
             status,
             calibrated,
@@ -262,15 +329,29 @@ impl<'a> Reach<'a> {
         lo
     }
 
-    /// The centre (mm, base frame) of the largest fitting cube found by a pattern search from
-    /// `start` (steps along the base axes from `max_edge_mm / 8`, halved when no step improves,
-    /// down to `resolution_mm`), with its edge.
-    pub fn largest_cube(&self, start: &Vector3<f64>, max_edge_mm: f64, resolution_mm: f64) -> Cube {
+    /// The largest fitting cube found by a pattern search: from the best of `starts` (centres,
+    /// mm, base frame), steps along the base axes from `max_edge_mm / 8`, halved when no step
+    /// improves, down to `resolution_mm`.
+    pub fn largest_cube(
+        &self,
+        starts: &[Vector3<f64>],
+        max_edge_mm: f64,
+        resolution_mm: f64,
+    ) -> Cube {
         let edge = |c: &Vector3<f64>| self.largest_edge(c, max_edge_mm, resolution_mm);
         let mut best = Cube {
-            centre: *start,
-            edge_mm: edge(start),
+            centre: Vector3::zeros(),
+            edge_mm: f64::NEG_INFINITY,
         };
+        for s in starts {
+            let e = edge(s);
+            if e > best.edge_mm {
+                best = Cube {
+                    centre: *s,
+                    edge_mm: e,
+                };
+            }
+        }
         let mut step = max_edge_mm / 8.0;
         let dirs = [
             Vector3::x(),
@@ -298,5 +379,25 @@ impl<'a> Reach<'a> {
             }
         }
         best
+    }
+
+    /// `p` (mm, base frame) moved into the free workspace: lifted to `clearance_mm` above the
+    /// floor and pushed out radially to `clearance_mm` beyond the footprint (along x when it is
+    /// on the axis), where it was closer.
+    pub fn into_free_space(&self, p: &Vector3<f64>, clearance_mm: f64) -> Vector3<f64> {
+        let mut q = *p;
+        q.z = q.z.max(self.floor_z_mm + clearance_mm);
+        let r = p.x.hypot(p.y);
+        let want = self.footprint_radius_mm + clearance_mm;
+        if self.footprint_radius_mm > 0.0 && r < want {
+            let (ux, uy) = if r > 1e-9 {
+                (p.x / r, p.y / r)
+            } else {
+                (1.0, 0.0)
+            };
+            q.x = want * ux;
+            q.y = want * uy;
+        }
+        q
     }
 }

@@ -6,7 +6,7 @@
 use super::metrics::{PoseSamples, Sample};
 use super::plan::{Plan, CYCLE_ORDER};
 use crate::error::{Error, Result};
-use crate::frame::{pose, Frame, TrackerFrame};
+use crate::frame::{frame_vector, pose, Frame, TrackerFrame};
 use crate::io::measurements::{read_measurements, Measurement, MeasurementSet, Positions};
 use crate::io::row_extras::ExtrasLayout;
 use crate::model::Robot;
@@ -72,6 +72,54 @@ pub struct PlanFile {
     pub poses: Vec<Frame>,
     /// Number of cycles.
     pub cycles: usize,
+}
+
+impl PlanFile {
+    /// The cube and the tool orientation (A, B, C in degrees, base frame) whose test poses the
+    /// plan commands (P1 the centre, P2 at 80 % of the half diagonal towards (-,-,-)), so that
+    /// another plan ([`super::make_plan`] with them given) commands the same poses: the test
+    /// after calibration planned like the one before. Fails, naming the file, when the poses
+    /// are not a cube's test poses at one orientation (within 1e-6 mm and 1e-6 degrees).
+    pub fn cube(&self) -> Result<(super::Cube, [f64; 3])> {
+        let c = self.poses[0].translation.vector;
+        let p2 = self.poses[1].translation.vector;
+        let h = (c.x - p2.x) / (1.0 - 2.0 * super::CORNER_FRACTION);
+        let cube = super::Cube {
+            centre: c,
+            edge_mm: 2.0 * h,
+        };
+        let bad = |why: String| {
+            Error::parse(
+                &self.path,
+                None,
+                Some("x_c"),
+                format!("{why}: not the test poses of a cube (robocal iso9283 plan)"),
+            )
+        };
+        if h.is_nan() || h <= 0.0 {
+            return Err(bad(format!(
+                "P2 is not below P1 in x (P1 {c:?}, P2 {p2:?})"
+            )));
+        }
+        for (k, (p, f)) in cube.test_points().iter().zip(&self.poses).enumerate() {
+            let d = (p - f.translation.vector).norm();
+            let turned = crate::compensation::rotation_angle(
+                &(f.rotation.matrix() * self.poses[0].rotation.matrix().transpose()),
+            );
+            if d > 1e-6 || turned.to_degrees() > 1e-6 {
+                return Err(bad(format!(
+                    "P{} is {d:.3e} mm and {:.3e} deg from the cube's test pose",
+                    k + 1,
+                    turned.to_degrees()
+                )));
+            }
+        }
+        let v = frame_vector(&self.poses[0]);
+        Ok((
+            cube,
+            [v[3].to_degrees(), v[4].to_degrees(), v[5].to_degrees()],
+        ))
+    }
 }
 
 fn column(set: &MeasurementSet, name: &str) -> Result<usize> {

@@ -8,6 +8,7 @@ use crate::error::{Error, Result};
 use crate::frame::{frame_vector, pose, Frame};
 use crate::model::Robot;
 use crate::ranges::{self, in_range};
+use crate::simulation::FOOTPRINT_FRACTION;
 use nalgebra::{Rotation3, Vector3};
 
 /// The order the poses are visited in each cycle (ISO 9283, 7.2.1).
@@ -34,6 +35,14 @@ pub struct PlanSettings {
     pub singular_margin: f64,
     /// Resolution of the cube search (mm). Default 0.5.
     pub resolution_mm: f64,
+    /// The floor (mm, base frame): no point of the cube below it. Default 0, the base plane:
+    /// the surface the robot stands on (or hangs from, on a wall or ceiling: its base frame's z
+    /// points away from it whatever the mounting).
+    pub floor_z_mm: f64,
+    /// The robot's footprint: the cube keeps this far (mm) from the base z axis; `None`:
+    /// [`FOOTPRINT_FRACTION`] of the chain's length, as the simulated poses do (0 allows a cube
+    /// about the axis, e.g. above the robot).
+    pub footprint_radius_mm: Option<f64>,
 }
 
 impl Default for PlanSettings {
@@ -45,6 +54,8 @@ impl Default for PlanSettings {
             orientation_deg: None,
             singular_margin: 0.05,
             resolution_mm: 0.5,
+            floor_z_mm: 0.0,
+            footprint_radius_mm: None,
         }
     }
 }
@@ -83,6 +94,10 @@ impl PlanSettings {
                 format!("{} is not in [0, 1)", self.singular_margin),
             ));
         }
+        in_range("floor_z_mm", self.floor_z_mm, &ranges::LENGTH)?;
+        if let Some(r) = self.footprint_radius_mm {
+            in_range("footprint_radius_mm", r, &ranges::SIZE_MM)?;
+        }
         if !(self.resolution_mm.is_finite() && self.resolution_mm > 0.0) {
             return Err(Error::invalid(
                 "resolution_mm",
@@ -90,6 +105,13 @@ impl PlanSettings {
             ));
         }
         Ok(())
+    }
+
+    /// The footprint radius used (mm): the given one, or [`FOOTPRINT_FRACTION`] of `robot`'s
+    /// chain length ([`Robot::reach_mm`]).
+    pub fn footprint_radius(&self, robot: &Robot) -> f64 {
+        self.footprint_radius_mm
+            .unwrap_or_else(|| FOOTPRINT_FRACTION * robot.reach_mm())
     }
 }
 
@@ -158,9 +180,9 @@ pub fn reference_configuration(robot: &Robot, margin: f64) -> Vec<f64> {
 /// Makes the plan for `nominal` (compensated on `calibrated` when given): the cube (searched,
 /// or as given), its five poses and their joints. Fails, naming the pose and why, when the
 /// given cube does not fit or no cube fits.
-pub fn make_plan(
-    nominal: &Robot,
-    calibrated: Option<&Robot>,
+pub fn make_plan<'a>(
+    nominal: &'a Robot,
+    calibrated: Option<&'a Robot>,
     settings: &PlanSettings,
 ) -> Result<Plan> {
     settings.validate()?;
@@ -180,23 +202,31 @@ pub fn make_plan(
         None => nominal.tool_pose(&reference).rotation,
     };
     let rotation = Rotation3::from_matrix_unchecked(*rotation.matrix());
-    // The cube is searched on the nominal model (the same cube before and after calibration);
-    // the compensated joints on the calibrated model are then checked, and a searched cube
-    // shrunk in 1 % steps in the rare case that they leave the limits at its boundary.
-    let search = Reach::new(
+    // The cube is searched on the nominal model (the same search before and after
+    // calibration); the compensated joints on the calibrated model are then checked, and a
+    // searched cube shrunk in 1 % steps where they fail at its boundary (out of the limits or
+    // near a singularity). To keep the cube of the plan before calibration, give it
+    // ([`super::PlanFile::cube`]): then a pose that fails is an error.
+    let footprint = settings.footprint_radius(nominal);
+    let rules = |mut r: Reach<'a>| {
+        r.floor_z_mm = settings.floor_z_mm;
+        r.footprint_radius_mm = footprint;
+        r
+    };
+    let search = rules(Reach::new(
         nominal,
         None,
         rotation,
         reference.clone(),
         settings.singular_margin,
-    );
-    let reach = Reach::new(
+    ));
+    let reach = rules(Reach::new(
         nominal,
         calibrated,
         rotation,
         reference,
         settings.singular_margin,
-    );
+    ));
     let max_edge = nominal.reach_mm();
     let res = settings.resolution_mm;
     let mut cube = match (settings.centre_mm, settings.edge_mm) {
@@ -213,7 +243,8 @@ pub fn make_plan(
         }
         (None, e) => {
             let start = nominal.tool_position(search.reference());
-            let best = search.largest_cube(&start, max_edge, res);
+            let starts = [start, search.into_free_space(&start, max_edge / 8.0)];
+            let best = search.largest_cube(&starts, max_edge, res);
             match e {
                 Some(edge_mm) if edge_mm <= best.edge_mm => Cube {
                     centre: best.centre,
@@ -236,8 +267,9 @@ pub fn make_plan(
     if cube.edge_mm <= 0.0 {
         return Err(Error::invalid(
             "centre_mm",
-            "no cube fits there: the robot does not reach the centre with the tool orientation \
-             (within the joint limits, away from singularities)",
+            "no cube fits there: the centre is below the floor or inside the robot's footprint, \
+             or the robot does not reach it with the tool orientation (within the joint limits, \
+             away from singularities)",
         ));
     }
     if calibrated.is_some() && settings.edge_mm.is_none() {
@@ -256,18 +288,8 @@ pub fn make_plan(
                 "centre_mm"
             },
             format!(
-                "the cube of {} mm at ({}, {}, {}) mm does not fit: P{} {} on the {} model",
-                cube.edge_mm,
-                cube.centre.x,
-                cube.centre.y,
-                cube.centre.z,
-                m.pose,
-                m.status,
-                if m.calibrated {
-                    "calibrated"
-                } else {
-                    "nominal"
-                }
+                "the cube of {} mm at ({}, {}, {}) mm does not fit: {m}",
+                cube.edge_mm, cube.centre.x, cube.centre.y, cube.centre.z,
             ),
         )
     })?;

@@ -64,27 +64,50 @@ fn check_reached(robot: &Robot, plan: &Plan, joints: &[Vec<f64>]) {
     }
 }
 
-#[test]
-fn largest_cube_kr480() {
-    let robot = kr480();
-    let s = PlanSettings::default();
-    let plan = make_plan(&robot, None, &s).unwrap();
+/// The plan's cube is in the usable workspace (whole above the floor, outside the footprint),
+/// its poses reached, and it is the largest at its centre within 5 % (grown in 1 % steps until a
+/// pose fails, the floor or footprint included).
+fn check_largest(robot: &Robot, s: &PlanSettings) -> Plan {
+    let plan = make_plan(robot, None, s).unwrap();
     assert!(!plan.compensated);
-    assert!(plan.cube.edge_mm > 300.0, "{:?}", plan.cube);
-    check_reached(&robot, &plan, &plan.nominal_joints);
+    check_reached(robot, &plan, &plan.nominal_joints);
     assert_eq!(plan.joints, plan.nominal_joints);
+    let footprint = s.footprint_radius(robot);
+    for c in plan.cube.corners() {
+        assert!(
+            c.z >= s.floor_z_mm,
+            "corner {c:?} below the floor, {:?}",
+            plan.cube
+        );
+    }
+    let h = 0.5 * plan.cube.edge_mm;
+    let (cx, cy) = (plan.cube.centre.x, plan.cube.centre.y);
+    // The square of the cube's xy extent keeps clear of the footprint's disc: its nearest
+    // point to the axis, sampled densely.
+    for i in 0..=100 {
+        for j in 0..=100 {
+            let x = cx - h + 2.0 * h * f64::from(i) / 100.0;
+            let y = cy - h + 2.0 * h * f64::from(j) / 100.0;
+            assert!(
+                x.hypot(y) >= footprint - 1e-9,
+                "({x}, {y}) in the footprint"
+            );
+        }
+    }
     for (k, p) in plan.cube.test_points().iter().enumerate() {
         assert!((plan.poses[k].translation.vector - p).norm() < 1e-12);
+        assert!(p.z >= s.floor_z_mm);
     }
-    // Grow the cube at the same centre in 1 % steps until a pose fails: within 5 %.
     let rotation = nalgebra::Rotation3::from_matrix_unchecked(*plan.poses[0].rotation.matrix());
-    let reach = Reach::new(
-        &robot,
+    let mut reach = Reach::new(
+        robot,
         None,
         rotation,
-        reference_configuration(&robot, s.singular_margin),
+        reference_configuration(robot, s.singular_margin),
         s.singular_margin,
     );
+    reach.floor_z_mm = s.floor_z_mm;
+    reach.footprint_radius_mm = footprint;
     let mut edge = plan.cube.edge_mm;
     loop {
         edge *= 1.01;
@@ -98,12 +121,61 @@ fn largest_cube_kr480() {
         assert!(edge < 1.05 * plan.cube.edge_mm, "a cube of {edge} mm fits");
     }
     assert!(edge <= 1.05 * plan.cube.edge_mm);
+    plan
+}
+
+#[test]
+fn largest_cube_kr480() {
+    let robot = kr480();
+    let s = PlanSettings::default();
+    let plan = check_largest(&robot, &s);
+    assert!(plan.cube.edge_mm > 300.0, "{:?}", plan.cube);
     // Rows: cycle by cycle, P1, P5, P4, P3, P2.
     let rows: Vec<PlanRow> = plan.rows().collect();
     assert_eq!(rows.len(), 5 * DEFAULT_CYCLES);
     let order: Vec<usize> = rows[..10].iter().map(|r| r.pose).collect();
     assert_eq!(order, [1, 5, 4, 3, 2, 1, 5, 4, 3, 2]);
     assert_eq!((rows[5].cycle, rows[149].cycle), (2, 30));
+    // A raised floor (a 1.5 m pedestal in front of the robot, say) lifts the cube.
+    let high = PlanSettings {
+        floor_z_mm: 1500.0,
+        ..PlanSettings::default()
+    };
+    let lifted = check_largest(&robot, &high);
+    assert!(lifted.cube.edge_mm > 100.0, "{:?}", lifted.cube);
+}
+
+/// The UR5 (base plane at z = 0, the plate it is bolted to): the cube above it.
+#[test]
+fn largest_cube_ur5_above_its_base_plane() {
+    let robot = crate::model::robot_file::parse_robot_toml(
+        include_str!("../../../../examples/ur5.toml"),
+        std::path::Path::new("examples/ur5.toml"),
+    )
+    .unwrap();
+    let plan = check_largest(&robot, &PlanSettings::default());
+    assert!(plan.cube.edge_mm > 100.0, "{:?}", plan.cube);
+    // A given cube through the base plane, or about the base's axis: refused, saying why.
+    let low = PlanSettings {
+        centre_mm: Some([400.0, 0.0, 50.0]),
+        edge_mm: Some(200.0),
+        ..PlanSettings::default()
+    };
+    let e = make_plan(&robot, None, &low).unwrap_err().to_string();
+    assert!(e.contains("below the floor"), "{e}");
+    let axis = PlanSettings {
+        centre_mm: Some([0.0, 0.0, 600.0]),
+        edge_mm: Some(100.0),
+        ..PlanSettings::default()
+    };
+    let e = make_plan(&robot, None, &axis).unwrap_err().to_string();
+    assert!(e.contains("footprint"), "{e}");
+    let bad = PlanSettings {
+        footprint_radius_mm: Some(-1.0),
+        ..PlanSettings::default()
+    };
+    let e = make_plan(&robot, None, &bad).unwrap_err().to_string();
+    assert!(e.starts_with("footprint_radius_mm"), "{e}");
 }
 
 #[test]
@@ -160,6 +232,29 @@ fn compensated_plan_and_csv_round_trip() {
     assert_eq!((back.cycles, back.rows.len()), (4, 20));
     for (k, f) in back.poses.iter().enumerate() {
         assert!((f.translation.vector - plan.poses[k].translation.vector).norm() < 1e-9);
+    }
+    // The plan's cube and orientation read back: a plan made with them commands the same
+    // poses (the test after calibration planned like the one before).
+    let (cube, abc) = back.cube().unwrap();
+    assert!((cube.centre - plan.cube.centre).norm() < 1e-9);
+    assert!((cube.edge_mm - plan.cube.edge_mm).abs() < 1e-9);
+    let again = make_plan(
+        &robot,
+        Some(&cal),
+        &PlanSettings {
+            centre_mm: Some(cube.centre.into()),
+            edge_mm: Some(cube.edge_mm),
+            orientation_deg: Some(abc),
+            ..s.clone()
+        },
+    )
+    .unwrap();
+    for (a, b) in again.poses.iter().zip(&plan.poses) {
+        assert!((a.translation.vector - b.translation.vector).norm() < 1e-9);
+        let turned = crate::compensation::rotation_angle(
+            &(a.rotation.matrix() * b.rotation.matrix().transpose()),
+        );
+        assert!(turned < 1e-12, "{turned}");
     }
     // Read without the calibrated model, the compensated joints do not reach the commanded
     // poses on the nominal one: refused as a plan for another robot.

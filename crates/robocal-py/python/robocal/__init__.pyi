@@ -389,3 +389,54 @@ def import_measurements(
     dwell_min_s: Optional[float] = None,
     time_tolerance: float = 0.2,
 ) -> Imported: ...
+
+class Iso9283Plan:
+    """An ISO 9283 test plan (:func:`iso9283_plan`): what ``robocal iso9283 plan`` writes."""
+
+    @property
+    def edge_mm(self) -> float:
+        """The cube's edge (mm)."""
+    @property
+    def centre(self) -> Tuple[float, float, float]:
+        """The cube's centre (mm, base frame): P1."""
+    @property
+    def poses(self) -> FloatArray:
+        """(5, 6) the commanded poses P1..P5: x, y, z (mm), A, B, C (deg), base frame."""
+    @property
+    def joints(self) -> FloatArray:
+        """(5, dof) the joints sent to the robot (deg): compensated with a result."""
+    @property
+    def nominal_joints(self) -> FloatArray:
+        """(5, dof) the joints that reach P1..P5 on the nominal model (deg)."""
+    @property
+    def compensated(self) -> bool: ...
+    @property
+    def cycles(self) -> int: ...
+    def to_csv(self) -> str: ...
+    def write(self, path: PathLike) -> None:
+        """Writes the plan CSV as ``robocal iso9283 plan --out`` does."""
+    def program(self, program_format: str, dwell_s: float = 2.0) -> str:
+        """The plan as a KRL, RAPID or URScript program (``--program``)."""
+
+def iso9283_plan(
+    robot: Optional[Robot] = None,
+    result: Optional[Result] = None,
+    *,
+    cycles: int = 30,
+    cube_mm: Optional[float] = None,
+    center: Optional[Sequence[float]] = None,
+    orientation: Optional[Sequence[float]] = None,
+    floor_mm: float = 0.0,
+    footprint_mm: Optional[float] = None,
+    poses_from: Optional[Iso9283Plan] = None,
+) -> Iso9283Plan: ...
+def iso9283_evaluate(
+    plan: PathLike,
+    data: PathLike,
+    result: Optional[Result] = None,
+    *,
+    robot: Optional[Robot] = None,
+    frame: Optional[str] = None,
+    spec: Optional[str] = None,
+    tracker_mpe: Optional[str] = None,
+) -> Dict[str, Any]: ...
