@@ -34,6 +34,7 @@ mod cli_iso9283;
 mod cli_joints;
 mod cli_plan;
 mod cli_programs;
+mod cli_programs_uses;
 mod cli_report;
 mod cli_result_self_contained;
 mod cli_robot;
