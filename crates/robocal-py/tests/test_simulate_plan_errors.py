@@ -197,13 +197,7 @@ def test_simulate_refuses_as_the_cli(kr, cli, tmp_path, flags, kw, flag, keyword
     assert as_keywords(line) == str(e.value).replace("`", ""), (line, str(e.value))
 
 
-PLAN_def as_keywords(cli_line):
-    """A CLI message with each flag (`--outlier-max-mm`) written as its keyword (`outlier_max_mm`)
-    and no backticks: the two messages then read the same."""
-    return re.sub(r"--([a-z][a-z0-9-]*)", lambda m: m.group(1).replace("-", "_"), cli_line).replace("`", "")
-
-
-SAME = [
+PLAN_SAME = [
     (["--poses", "0"], dict(poses=0), "--poses", "poses"),
     (["--poses", "300000"], dict(poses=300_000), "--poses", "poses"),
     (["--poses", "75", "--candidates", "50"], dict(poses=75, candidates=50), "--candidates", "candidates"),
