@@ -58,7 +58,7 @@ def kr():
         (dict(poses=10, outlier_fraction=0.1, orientation_sigma_deg=0.01), robocal.UsageError,
          "outliers are drawn for single points"),
         (dict(poses=10, orientation_sigma_deg=20.0), robocal.InputError, "orientation_sigma_deg: 20: not an angle noise"),
-        (dict(poses=10, all_targets=True), robocal.InputError, "all_targets: robot `"),
+        (dict(poses=10, all_targets=True), robocal.UsageError, "all_targets: robot `"),
         (dict(poses=10, joints=np.zeros((2, 6))), robocal.UsageError, "poses: not with given joints"),
         (dict(joints=np.zeros((2, 6)), validation=3), robocal.UsageError, "validation: not with given joints"),
     ],

@@ -304,8 +304,9 @@ impl SimulationBuilder {
                 ));
             }
         }
+        // A setting that does not apply to this robot: a usage error.
         if self.all_targets && nominal.target_count() < 2 {
-            return Err(Error::invalid(
+            return Err(Error::usage(
                 "targets",
                 format!(
                     "robot `{}` has one target; give its reflectors' nominal tools in the robot \

@@ -110,7 +110,7 @@ fn each_bad_setting_is_refused_naming_it() {
             },
             TruthSource::Random,
             "targets: robot `",
-            false,
+            true,
         ),
         (
             SimulationBuilder {
