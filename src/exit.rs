@@ -119,7 +119,7 @@ pub fn code_for(e: &anyhow::Error) -> i32 {
                 | E::Invalid { .. }
                 | E::UnknownParameter { .. }
                 | E::JointCount { .. } => INPUT,
-                E::UnknownPreset { .. } => USAGE,
+                E::UnknownPreset { .. } | E::Usage { .. } => USAGE,
                 E::Numerical(_) => NUMERICAL,
                 E::Implausible(_) => IMPLAUSIBLE,
             };

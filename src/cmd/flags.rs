@@ -17,6 +17,13 @@ const FLAGS: &[(&str, &str)] = &[
     ("plane_z_mm", "--plane-z-mm"),
     ("plane_points", "--no-plane"),
     ("poses", "--poses"),
+    ("validation_poses", "--validation"),
+    ("truth.tilt_parallel_axes", "--tilt-parallel-axes"),
+    ("backlash.half_play_deg", "--backlash-deg"),
+    ("thermal.rise_c", "--thermal-rise-c"),
+    ("thermal.start_s", "--thermal-start-s"),
+    ("thermal.seconds_per_pose", "--seconds-per-pose"),
+    ("station", "--station"),
     ("truth", "--truth"),
     ("truth.length_sigma_mm", "--length-error-mm"),
     ("truth.angle_sigma_deg", "--angle-error-deg"),
@@ -128,10 +135,16 @@ pub fn cli_text(e: &(dyn std::error::Error + 'static)) -> String {
         return e.to_string();
     };
     let text = match core {
-        E::Invalid { field, message } => match flag_for(field) {
-            Some(flag) => format!("{flag}: {}", with_flags(message)),
-            None => format!("{field}: {}", with_flags(message)),
-        },
+        E::Invalid { field, message } | E::Usage { field, message } => {
+            // `setting (joint 2)`: the flag, and which of its values.
+            let (head, tail) = field
+                .split_once(" (")
+                .map_or((field.as_str(), ""), |(h, _)| (h, &field[h.len()..]));
+            match flag_for(head) {
+                Some(flag) => format!("{flag}{tail}: {}", with_flags(message)),
+                None => format!("{field}: {}", with_flags(message)),
+            }
+        }
         E::Numerical(m) | E::Implausible(m) => with_flags(m),
         other => other.to_string(),
     };

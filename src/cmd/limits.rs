@@ -2,16 +2,11 @@
 //! `--poses 18446744073709551615` parses; unchecked it would overflow a capacity computation (a
 //! panic) or ask for an allocation the machine cannot give (an abort). These limits keep every run
 //! within a machine of 2 cores and 24 GiB, the size robocal is built and tested on, with a clear
-//! usage error beyond them. Lengths of the CLI's own settings are held to the library's plausible
+//! usage error beyond them (`simulate`'s and `plan`'s counts are checked by the library's
+//! settings builders). Lengths of the CLI's own settings are held to the library's plausible
 //! length (`robocal_core::ranges::LENGTH`); the library checks the settings it is given itself.
 
 use crate::exit;
-
-/// Most poses one `simulate` run draws (calibration + validation). Measured: 1,000,000 poses take
-/// 0.5 GB of memory and 9 s and write a 139 MB CSV, so 10,000,000 need about 5 GB, 1.5 minutes
-/// and 1.4 GB of disk: still a fraction of the machine, and far beyond any real calibration
-/// (the paper uses 75 + 73). Larger sets: several runs with different seeds.
-pub const MAX_POSES: usize = 10_000_000;
 
 /// Most solver iterations of `calibrate`. It converges in 5 to 350 iterations (README,
 /// "Calibrating"); a million iterations of a 75-point problem already run for tens of minutes,
@@ -64,8 +59,8 @@ mod tests {
 
     #[test]
     fn counts_outside_their_limits_are_usage_errors_naming_flag_and_limit() {
-        assert!(count("--poses", 10_000_000, 0, MAX_POSES, "memory").is_ok());
-        let e = count("--poses", usize::MAX, 0, MAX_POSES, "memory").unwrap_err();
+        assert!(count("--poses", 10_000_000, 0, 10_000_000, "memory").is_ok());
+        let e = count("--poses", usize::MAX, 0, 10_000_000, "memory").unwrap_err();
         assert_eq!(crate::exit::code_for(&e), crate::exit::USAGE);
         let m = e.to_string();
         assert!(

@@ -1,21 +1,18 @@
 //! `robocal plan`: the poses worth measuring (I- or D-optimal selection from random candidates).
 
+use super::common;
 use super::io_plan::IoPlan;
-use super::{common, limits};
 use crate::exit;
 use clap::Args;
 use robocal_core::io::{
     read_measurements, write_measurements, Measurement, MeasurementSet, Positions,
 };
 use robocal_core::planning::{
-    plan_observed, tracker_range, Criterion, Plan, PlanSettings, DEFAULT_CANDIDATES,
+    plan_observed, Criterion, Plan, PlanBuilder, PlanSettings, DEFAULT_CANDIDATES,
 };
-use robocal_core::simulation::{SimulationConfig, DEFAULT_NOISE_MM, DEFAULT_NOISE_PER_M};
-use robocal_core::{Robot, TrackerFrame};
+use robocal_core::simulation::{DEFAULT_NOISE_MM, DEFAULT_NOISE_PER_M};
+use robocal_core::Robot;
 use std::path::PathBuf;
-
-/// Most candidates: 200,000 take about 150 MB for a six-joint robot and a few seconds.
-const MAX_CANDIDATES: usize = 200_000;
 
 #[derive(Args, Debug)]
 pub struct PlanArgs {
@@ -76,7 +73,7 @@ enum CriterionArg {
     DOptimal,
 }
 
-/// Two numbers `MIN,MAX`.
+/// Two numbers `MIN,MAX` (the library checks them as a range).
 fn range_arg(s: &str) -> anyhow::Result<(f64, f64)> {
     let v: Vec<f64> = s
         .split(',')
@@ -89,12 +86,6 @@ fn range_arg(s: &str) -> anyhow::Result<(f64, f64)> {
             v.len()
         )));
     };
-    if !(a >= 0.0 && b > a && b <= limits::MAX_LENGTH_MM) {
-        return Err(exit::usage(format!(
-            "--range-mm {s}: not a range of distances (0 <= MIN < MAX <= {} mm)",
-            limits::MAX_LENGTH_MM
-        )));
-    }
     Ok((a, b))
 }
 
@@ -109,57 +100,28 @@ impl TryFrom<&PlanArgs> for Settings {
     type Error = anyhow::Error;
 
     fn try_from(a: &PlanArgs) -> anyhow::Result<Settings> {
-        limits::count(
-            "--poses",
-            a.poses,
-            1,
-            MAX_CANDIDATES,
-            "no calibration measures more",
-        )?;
-        limits::count(
-            "--candidates",
-            a.candidates,
-            a.poses,
-            MAX_CANDIDATES,
-            "memory and time grow with the candidates",
-        )?;
-        limits::magnitude("--floor-mm", a.floor_mm, limits::MAX_LENGTH_MM, "mm")?;
-        if let Some(f) = a.footprint_mm {
-            limits::magnitude("--footprint-mm", f, limits::MAX_LENGTH_MM, "mm")?;
-        }
-        if !(a.noise_mm > 0.0 && a.noise_mm <= 1000.0) {
-            return Err(exit::usage(format!(
-                "--noise-mm {}: must be a positive length up to 1000 mm",
-                a.noise_mm
-            )));
-        }
-        if !(a.noise_per_m >= 0.0 && a.noise_per_m <= 1000.0) {
-            return Err(exit::usage(format!(
-                "--noise-per-m {}: must be within 0..1000 mm/m",
-                a.noise_per_m
-            )));
-        }
-        let robot = common::robot(&a.robot)?;
-        let cfg = SimulationConfig {
+        let builder = PlanBuilder {
+            poses: a.poses,
+            candidates: a.candidates,
+            seed: a.seed,
+            criterion: match a.criterion {
+                CriterionArg::Workspace => Criterion::IOptimal,
+                CriterionArg::DOptimal => Criterion::DOptimal,
+            },
+            tracker_frame: a
+                .tracker
+                .as_deref()
+                .map(super::simulate::tracker_arg)
+                .transpose()?,
+            tracker_range: a.range_mm.as_deref().map(range_arg).transpose()?,
+            include: Vec::new(),
             floor_z_mm: a.floor_mm,
             footprint_radius_mm: a.footprint_mm,
-            ..SimulationConfig::default()
+            noise_mm: a.noise_mm,
+            noise_per_m: a.noise_per_m,
         };
-        cfg.validate(&robot)?;
-        let tracker = match &a.tracker {
-            Some(s) => super::simulate::tracker_arg(s)?,
-            None => cfg.tracker_frame,
-        };
-        let frame = TrackerFrame::from_vector_deg(&[
-            tracker.x, tracker.y, tracker.z, tracker.a, tracker.b, tracker.c,
-        ]);
-        let tracker_range = match &a.range_mm {
-            Some(r) => {
-                let (min, max) = range_arg(r)?;
-                Some(tracker_range(&frame, min, max)?)
-            }
-            None => None,
-        };
+        let robot = common::robot(&a.robot)?;
+        let plan = builder.build(&robot)?;
         IoPlan::new()
             .robot("--robot", &a.robot)
             .input_opt("--include", a.include.as_deref())
@@ -170,21 +132,7 @@ impl TryFrom<&PlanArgs> for Settings {
             )
             .check()?;
         Ok(Settings {
-            plan: PlanSettings {
-                poses: a.poses,
-                candidates: a.candidates,
-                seed: a.seed,
-                sampler: cfg.sampler(&robot),
-                tracker_range,
-                include: Vec::new(),
-                noise_mm: a.noise_mm,
-                noise_per_m: a.noise_per_m,
-                tracker_origin: a.tracker.is_some().then(|| frame.origin()),
-                criterion: match a.criterion {
-                    CriterionArg::Workspace => Criterion::IOptimal,
-                    CriterionArg::DOptimal => Criterion::DOptimal,
-                },
-            },
+            plan,
             robot,
             include: a.include.clone(),
             out: a.out.clone(),

@@ -1,7 +1,7 @@
 //! `robocal simulate`: measure a virtual robot with a virtual laser tracker.
 
+use super::common;
 use super::io_plan::IoPlan;
-use super::{common, limits};
 use crate::exit;
 use anyhow::Context;
 use clap::Args;
@@ -9,9 +9,8 @@ use robocal_core::io::measurements::{measurements_csv, read_measurements, Positi
 use robocal_core::io::result::FrameVec;
 use robocal_core::io::write_all_atomic;
 use robocal_core::simulation::{
-    check_truth_matches, simulate, simulate_joints, BacklashModel, GeometricErrors, GravityModel,
-    OutlierModel, RepeatabilityModel, SimulationConfig, TargetMeasurement, ThermalModel, TruthFile,
-    TruthSpec, SET_VALIDATION,
+    simulate, simulate_joints, PerJoint, SimulationBuilder, SimulationConfig, SimulationSettings,
+    TargetMeasurement, TruthSource, TruthSpec, SET_VALIDATION,
 };
 use robocal_core::Robot;
 use std::path::{Path, PathBuf};
@@ -150,22 +149,26 @@ pub struct SimulateArgs {
     station: u32,
 }
 
-/// A list of numbers: one value for every joint, or one per joint.
-fn per_joint(name: &str, s: &str, dof: usize) -> anyhow::Result<Vec<f64>> {
-    let mut v = Vec::new();
-    for (i, part) in s.split(',').enumerate() {
-        let part = part.trim();
-        v.push(part.parse::<f64>().map_err(|_| {
-            exit::usage(format!("{name}: value {} `{part}` is not a number", i + 1))
-        })?);
+/// A list of numbers `V` or `V1,..,Vn` (the library spreads one value to every joint and
+/// checks the count).
+fn numbers(name: &str, s: &str) -> anyhow::Result<Vec<f64>> {
+    s.split(',')
+        .enumerate()
+        .map(|(i, part)| {
+            let part = part.trim();
+            part.parse::<f64>().map_err(|_| {
+                exit::usage(format!("{name}: value {} `{part}` is not a number", i + 1))
+            })
+        })
+        .collect()
+}
+
+/// `auto` (or `word`): the robot class's default; else numbers.
+fn per_joint(name: &str, s: &str, word: &str) -> anyhow::Result<PerJoint> {
+    if s == word {
+        return Ok(PerJoint::ClassDefault);
     }
-    match v.len() {
-        1 => Ok(vec![v[0]; dof]),
-        n if n == dof => Ok(v),
-        n => Err(exit::usage(format!(
-            "{name}: {n} values; give one for all joints or one per joint ({dof})"
-        ))),
-    }
+    Ok(PerJoint::Values(numbers(name, s)?))
 }
 
 pub(crate) fn tracker_arg(s: &str) -> anyhow::Result<FrameVec> {
@@ -183,140 +186,49 @@ pub(crate) fn tracker_arg(s: &str) -> anyhow::Result<FrameVec> {
     Ok(FrameVec { x, y, z, a, b, c })
 }
 
-/// The truth robot and, for a truth file, its tracker frame.
-fn truth_arg(a: &SimulateArgs, nominal: &Robot) -> anyhow::Result<(TruthSpec, Option<FrameVec>)> {
-    let random = a.truth == "random";
-    if !random
-        && (a.length_error_mm.is_some() || a.angle_error_deg.is_some() || a.tilt_parallel_axes)
-    {
-        return Err(exit::usage(
-            "--length-error-mm, --angle-error-deg and --tilt-parallel-axes apply only to --truth random",
-        ));
-    }
-    if random {
-        let d = GeometricErrors::default();
-        let e = GeometricErrors {
-            length_sigma_mm: a.length_error_mm.unwrap_or(d.length_sigma_mm),
-            angle_sigma_deg: a.angle_error_deg.unwrap_or(d.angle_sigma_deg),
-            tilt_parallel_axes: a.tilt_parallel_axes,
-        };
-        return Ok((TruthSpec::Random(e), None));
-    }
-    if a.truth.ends_with(".json") {
-        let p = Path::new(&a.truth);
-        let tf = TruthFile::read(p)?;
-        let robot = tf.truth_robot(nominal, p)?;
-        return Ok((TruthSpec::Robot(robot), Some(tf.tracker_frame)));
-    }
-    let robot =
-        robocal_core::load_robot(&a.truth).with_context(|| format!("--truth {}", a.truth))?;
-    Ok((TruthSpec::Robot(robot), None))
-}
-
-fn config(
-    a: &SimulateArgs,
-    nominal: &Robot,
-    truth_tracker: Option<FrameVec>,
-) -> anyhow::Result<SimulationConfig> {
-    let d = SimulationConfig::default();
-    let gravity = match &a.compliance {
-        None => None,
-        Some(c) => {
-            let dof = nominal.dof();
-            Some(GravityModel::new(
-                per_joint("--compliance", c, dof)?,
-                match &a.link_masses_kg {
-                    Some(m) => per_joint("--link-masses-kg", m, dof)?,
-                    None => vec![0.0; dof],
-                },
-                a.payload_kg.unwrap_or(0.0),
-            ))
-        }
-    };
-    let outliers = a.outlier_fraction.map(|fraction| {
-        let o = OutlierModel::default();
-        OutlierModel {
-            fraction,
-            min_mm: a.outlier_min_mm.unwrap_or(o.min_mm),
-            max_mm: a.outlier_max_mm.unwrap_or(o.max_mm),
-        }
-    });
-    let tracker_frame = match &a.tracker {
-        Some(s) => tracker_arg(s)?,
-        None => truth_tracker.unwrap_or(d.tracker_frame),
-    };
-    let repeatability = match a.repeatability_deg.as_deref() {
-        None => None,
-        Some("default") => Some(RepeatabilityModel::default_for(nominal)),
-        Some(v) => Some(RepeatabilityModel {
-            std_deg: per_joint("--repeatability-deg", v, nominal.dof())?,
-        }),
-    };
-    let joints = a.joints.is_some();
-    let (backlash, thermal) = real_cell_args(a, nominal)?;
-    Ok(SimulationConfig {
+/// The flags as the library's settings, parsed but not checked ([`SimulationBuilder::build`]
+/// checks them).
+fn builder(a: &SimulateArgs) -> anyhow::Result<SimulationBuilder> {
+    let list = |name: &str, v: &Option<String>| v.as_deref().map(|s| numbers(name, s)).transpose();
+    Ok(SimulationBuilder {
         seed: a.seed,
-        poses: a.poses.unwrap_or(0),
+        poses: a.poses,
         validation_poses: a.validation,
-        plane_points: !a.no_plane && !joints,
+        joints_given: a.joints.is_some(),
+        plane_points: !a.no_plane,
         plane_z_mm: a.plane_z_mm,
-        floor_z_mm: a.floor_mm,
-        footprint_radius_mm: a.footprint_mm,
-        tracker_frame,
+        tracker_frame: a.tracker.as_deref().map(tracker_arg).transpose()?,
         noise_mm: a.noise_mm,
         noise_per_m: a.noise_per_m,
-        gravity,
-        outliers,
-        repeatability,
-        backlash,
-        thermal,
+        length_sigma_mm: a.length_error_mm,
+        angle_sigma_deg: a.angle_error_deg,
+        tilt_parallel_axes: a.tilt_parallel_axes,
+        floor_z_mm: a.floor_mm,
+        footprint_radius_mm: a.footprint_mm,
+        compliance_rad_per_nm: list("--compliance", &a.compliance)?,
+        link_masses_kg: list("--link-masses-kg", &a.link_masses_kg)?,
+        payload_kg: a.payload_kg,
+        outlier_fraction: a.outlier_fraction,
+        outlier_min_mm: a.outlier_min_mm,
+        outlier_max_mm: a.outlier_max_mm,
+        all_targets: a.all_targets,
+        orientation_sigma_deg: a.orientation_sigma_deg,
+        repeatability: a
+            .repeatability_deg
+            .as_deref()
+            .map(|s| per_joint("--repeatability-deg", s, "default"))
+            .transpose()?,
+        backlash: a
+            .backlash_deg
+            .as_deref()
+            .map(|s| per_joint("--backlash-deg", s, "auto"))
+            .transpose()?,
+        thermal: a.thermal.as_deref() == Some("auto"),
+        thermal_rise_c: a.thermal_rise_c,
+        thermal_start_s: a.thermal_start_s,
+        seconds_per_pose: a.seconds_per_pose,
         station: a.station,
     })
-}
-
-/// The backlash and thermal growth of the flags (checked by the library with the rest).
-fn real_cell_args(
-    a: &SimulateArgs,
-    nominal: &Robot,
-) -> anyhow::Result<(Option<BacklashModel>, Option<ThermalModel>)> {
-    let backlash = match a.backlash_deg.as_deref() {
-        None => None,
-        Some("auto") => Some(BacklashModel::for_robot(nominal)),
-        Some(s) => Some(BacklashModel {
-            half_play_deg: per_joint("--backlash-deg", s, nominal.dof())?,
-        }),
-    };
-    let thermal = match a.thermal.as_deref() {
-        Some("auto") => {
-            let d = ThermalModel::for_robot(nominal);
-            Some(ThermalModel {
-                rise_c: a.thermal_rise_c.unwrap_or(d.rise_c),
-                start_s: a.thermal_start_s.unwrap_or(d.start_s),
-                seconds_per_pose: a.seconds_per_pose.unwrap_or(d.seconds_per_pose),
-                ..d
-            })
-        }
-        _ => None,
-    };
-    Ok((backlash, thermal))
-}
-
-/// The pose counts within [`limits::MAX_POSES`].
-fn check_counts(a: &SimulateArgs) -> anyhow::Result<()> {
-    let why = "about 5 GB of memory and a 1.4 GB file at the limit; draw larger sets in several \
-               runs with different seeds";
-    let poses = a.poses.unwrap_or(0);
-    limits::count("--poses", poses, 0, limits::MAX_POSES, why)?;
-    limits::count("--validation", a.validation, 0, limits::MAX_POSES, why)?;
-    if poses + a.validation > limits::MAX_POSES {
-        return Err(exit::usage(format!(
-            "--poses {poses} and --validation {}: {} poses in all, at most {} ({why})",
-            a.validation,
-            poses + a.validation,
-            limits::MAX_POSES
-        )));
-    }
-    Ok(())
 }
 
 /// `FILE.truth.json` beside `FILE.csv`.
@@ -348,7 +260,7 @@ impl TryFrom<&SimulateArgs> for Settings {
             ));
         }
         let truth_out = truth_path(&a.out);
-        check_counts(a)?;
+        let builder = builder(a)?;
         let mut plan = IoPlan::new();
         plan.robot("--robot", &a.robot);
         if a.truth != "random" {
@@ -375,27 +287,13 @@ impl TryFrom<&SimulateArgs> for Settings {
         }
         plan.check()?;
         let nominal = common::robot(&a.robot)?;
-        let (truth, truth_tracker) = truth_arg(a, &nominal)?;
-        let cfg = config(a, &nominal, truth_tracker)?;
-        cfg.validate(&nominal)?;
-        match &truth {
-            TruthSpec::Random(e) => e.validate()?,
-            TruthSpec::Robot(t) => check_truth_matches(&nominal, t)?,
-        }
-        if let Some(s) = a.orientation_sigma_deg {
-            if !(0.0..=10.0).contains(&s) {
-                return Err(exit::usage(format!(
-                    "--orientation-sigma-deg {s}: not an angle noise in [0, 10] deg"
-                )));
-            }
-        }
-        if a.all_targets && nominal.target_count() < 2 {
-            return Err(exit::usage(format!(
-                "--all-targets: {} has one target; give its reflectors' nominal tools in the \
-                 robot file (`tools = [[x, y, z, a, b, c], ...]`)",
-                a.robot
-            )));
-        }
+        let truth = TruthSource::from_arg(&a.truth, &nominal)
+            .with_context(|| format!("--truth {}", a.truth))?;
+        let SimulationSettings {
+            truth,
+            config: cfg,
+            targets,
+        } = builder.build(&nominal, truth)?;
         Ok(Settings {
             nominal,
             truth,
@@ -404,10 +302,7 @@ impl TryFrom<&SimulateArgs> for Settings {
             out: a.out.clone(),
             truth_out,
             validation_out: a.validation_out.clone(),
-            targets: TargetMeasurement {
-                all_targets: a.all_targets,
-                orientation_sigma_deg: a.orientation_sigma_deg,
-            },
+            targets,
         })
     }
 }

@@ -105,7 +105,7 @@ fn planned_poses_simulate_and_calibrate_with_a_prediction() {
 }
 
 #[test]
-fn bad_plan_flags_are_usage_errors_and_write_nothing() {
+fn bad_plan_flags_are_refused_and_write_nothing() {
     let d = Dir::new();
     let out = d.join("poses.csv");
     let run = |extra: &[&str]| {
@@ -115,7 +115,8 @@ fn bad_plan_flags_are_usage_errors_and_write_nothing() {
     };
     run(&["--poses", "0"]).assert_code(2);
     run(&["--poses", "50", "--candidates", "10"]).assert_code(2);
-    run(&["--poses", "30", "--range-mm", "5,1"]).assert_code(2);
+    // A range that is none: a setting outside its plausible range, checked by the library.
+    run(&["--poses", "30", "--range-mm", "5,1"]).assert_code(3);
     run(&["--poses", "30", "--range-mm", "abc"]).assert_code(2);
     run(&["--poses", "30", "--tracker", "1,2,3"]).assert_code(2);
     // Fewer poses than identifiable parameters: a setting the library rejects.

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 /// The nominal robot of a shipped program, its calibrated model (KUKA: Table III; the others:
 /// random geometric errors of 0.5 mm and 0.05 deg) and a result file for them in `dir`.
-fn models(dir: &Dir, program: &str) -> (Robot, Robot, PathBuf) {
+pub(crate) fn models(dir: &Dir, program: &str) -> (Robot, Robot, PathBuf) {
     let (nom, cal) = match program {
         "kr480.src" => (preset(KUKA).unwrap(), preset(TRUTH).unwrap()),
         _ => {
@@ -45,7 +45,7 @@ fn models(dir: &Dir, program: &str) -> (Robot, Robot, PathBuf) {
     (nom, cal, res)
 }
 
-fn shipped(name: &str) -> PathBuf {
+pub(crate) fn shipped(name: &str) -> PathBuf {
     root().join("examples/programs").join(name)
 }
 
@@ -259,7 +259,8 @@ fn a_target_that_cannot_be_compensated_stops_the_run_unless_keep_going() {
             "verified_deg",
             "old",
             "new",
-            "reason"
+            "reason",
+            "file"
         ]
     );
     // Six targets, the one out of reach, and its motion.
@@ -277,7 +278,9 @@ fn a_target_that_cannot_be_compensated_stops_the_run_unless_keep_going() {
     assert_eq!(far[9], "9000 0 1000 0 90 0");
     assert_eq!(far[9], far[10]);
     for r in &rows[1..7] {
-        assert_eq!(r.len(), 12, "{r:?}");
+        assert_eq!(r.len(), 13, "{r:?}");
+        // One file: the program.
+        assert_eq!(r[12], "far.src", "{r:?}");
         assert_eq!(r[4], "true", "{r:?}");
         let corr: f64 = r[5].parse().unwrap();
         let verified: f64 = r[7].parse().unwrap();
@@ -387,7 +390,7 @@ fn position_only_applies_to_programs() {
 }
 
 /// Runs `compensate --program` on `input` (result `res`) with `extra` flags.
-fn compensate_program(res: &Path, input: &Path, out: &Path, extra: &[&str]) -> Outcome {
+pub(crate) fn compensate_program(res: &Path, input: &Path, out: &Path, extra: &[&str]) -> Outcome {
     let mut v = vec![
         "compensate".to_owned(),
         "--params".to_owned(),
@@ -488,7 +491,7 @@ fn every_motion_is_accounted_for() {
 
 /// A real cell's shape: a .src whose inline forms (folds) name points of its .dat, tools and
 /// bases from the controller's $config.dat, 120 points.
-fn cell(dir: &Dir, nom: &Robot, n: usize) -> (PathBuf, PathBuf) {
+pub(crate) fn cell(dir: &Dir, nom: &Robot, n: usize) -> (PathBuf, PathBuf) {
     cell_named(dir, nom, n, "cell", "$config.dat")
 }
 

@@ -341,8 +341,8 @@ fn bad_input_is_rejected_and_nothing_is_written() {
         (
             format!("{kr} --poses 0"),
             vec![],
-            3,
-            "--poses: must be at least 1",
+            2,
+            "--poses: at least 1, got 0",
         ),
         (
             format!("{kr} --poses 5 --outlier-fraction 1.5"),

@@ -35,6 +35,7 @@ mod cli_iso9283_plan;
 mod cli_joints;
 mod cli_plan;
 mod cli_programs;
+mod cli_programs_uses;
 mod cli_real_cell;
 mod cli_report;
 mod cli_result_self_contained;

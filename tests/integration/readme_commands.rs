@@ -1,7 +1,8 @@
 //! README.md as a new user reads it: every ```sh block runs as written, in order, in a directory
 //! holding what a fresh clone has (`examples/`), with `robocal` on the PATH; every in-page link
 //! has its heading; every command has a worked example; every flag of every command is
-//! documented; every exit code is listed.
+//! documented; every exit code is listed. The blocks write only into `out/`: nothing else is
+//! left in the root, no temporary, no shipped example changed.
 
 use crate::util::*;
 use std::path::Path;
@@ -43,6 +44,19 @@ fn copy_dir(from: &Path, to: &Path) {
     }
 }
 
+/// The files of `a` that differ from (or are missing in) `b`, recursively.
+fn same_files(a: &Path, b: &Path, changed: &mut Vec<String>) {
+    for e in std::fs::read_dir(a).unwrap() {
+        let e = e.unwrap();
+        let (pa, pb) = (e.path(), b.join(e.file_name()));
+        if pa.is_dir() {
+            same_files(&pa, &pb, changed);
+        } else if std::fs::read(&pa).ok() != std::fs::read(&pb).ok() {
+            changed.push(pa.display().to_string());
+        }
+    }
+}
+
 #[test]
 fn every_sh_block_runs_as_written() {
     let text = readme();
@@ -77,13 +91,51 @@ fn every_sh_block_runs_as_written() {
     eprintln!("{} README blocks ran in {:.1?}", sh.len(), start.elapsed());
     // What the quick start promises is there.
     for f in [
-        "ur5-result.json",
-        "ur5-commanded.csv",
-        "ur5-verify.csv",
-        "ur5-report/report.html",
+        "out/ur5-result.json",
+        "out/ur5-commanded.csv",
+        "out/ur5-verify.csv",
+        "out/ur5-report/report.html",
     ] {
         assert!(clone.join(f).is_file(), "the quick start did not make {f}");
     }
+    // The examples write only into `out/` (which .gitignore lists): nothing else is left in the
+    // clone's root, and no temporary anywhere.
+    let mut left: Vec<String> = std::fs::read_dir(clone.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(
+        left,
+        ["examples", "out"],
+        "the README's examples left these in the root"
+    );
+    let ignore = std::fs::read_to_string(root().join(".gitignore")).unwrap();
+    assert!(
+        ignore.lines().any(|l| l == "/out/"),
+        ".gitignore does not list /out/"
+    );
+    fn temporaries(dir: &Path, found: &mut Vec<String>) {
+        for e in std::fs::read_dir(dir).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                temporaries(&p, found);
+            } else if p.extension().is_some_and(|x| x == "tmp") {
+                found.push(p.display().to_string());
+            }
+        }
+    }
+    let mut tmp = Vec::new();
+    temporaries(clone.path(), &mut tmp);
+    assert!(tmp.is_empty(), "temporaries left: {tmp:?}");
+    // Nor did they change a shipped example.
+    let mut changed = Vec::new();
+    same_files(
+        &root().join("examples"),
+        &clone.join("examples"),
+        &mut changed,
+    );
+    assert!(changed.is_empty(), "the examples changed: {changed:?}");
 }
 
 /// GitHub's anchor of a heading: lower case, punctuation other than `-` and `_` dropped, spaces

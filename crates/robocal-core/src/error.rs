@@ -34,6 +34,16 @@ pub enum Error {
         /// What is wrong.
         message: String,
     },
+    /// A setting given where it does not apply (a random truth's error sizes with a truth
+    /// robot), or a count outside what one run may ask: the call itself is wrong, as a
+    /// command line's usage error.
+    #[error("{field}: {message}")]
+    Usage {
+        /// The offending setting.
+        field: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A preset name that does not exist.
     #[error("unknown robot preset `{name}` (known presets: {known}); or give a path to a TOML robot file")]
     UnknownPreset {
@@ -94,6 +104,29 @@ impl Error {
             field: field.into(),
             message: message.into(),
         }
+    }
+
+    /// Shorthand for [`Error::Usage`].
+    pub fn usage(field: impl Into<String>, message: impl Into<String>) -> Self {
+        Error::Usage {
+            field: field.into(),
+            message: message.into(),
+        }
+    }
+
+    /// A count `value` of setting `field` outside `min..=max` as an [`Error::Usage`] (`why` says
+    /// what the upper limit protects); `Ok` within.
+    pub fn check_count(field: &str, value: u64, min: u64, max: u64, why: &str) -> Result<()> {
+        if value < min {
+            return Err(Error::usage(field, format!("at least {min}, got {value}")));
+        }
+        if value > max {
+            return Err(Error::usage(
+                field,
+                format!("at most {max} ({why}), got {value}"),
+            ));
+        }
+        Ok(())
     }
 
     /// Shorthand for [`Error::Parse`].

@@ -1,16 +1,13 @@
-//! Scalar arguments of `simulate` and `plan` checked as the CLI checks its flags: counts
+//! Scalar arguments of `simulate` and `plan` parsed as the CLI parses its flags: counts
 //! (refusing negative numbers, bools and floats with a `UsageError` naming the argument rather
-//! than an `OverflowError`), per-joint lists, frame vectors and ranges.
+//! than an `OverflowError`), per-joint lists, frame vectors and ranges. The settings are checked
+//! by the library (`SimulationBuilder`, `PlanBuilder`), for both.
 
 use crate::errors::usage;
 use crate::options::describe;
 use pyo3::prelude::*;
 use pyo3::types::PyBool;
 use robocal_core::io::result::FrameVec;
-
-/// The largest length accepted for a length setting (mm): the library's plausible length (1 km),
-/// as the CLI's `limits::MAX_LENGTH_MM`.
-pub const MAX_LENGTH_MM: f64 = robocal_core::ranges::LENGTH.max;
 
 /// An optional argument, `None` when absent or None.
 pub fn given<'a, 'py>(v: Option<&'a Bound<'py, PyAny>>) -> Option<&'a Bound<'py, PyAny>> {
@@ -44,36 +41,15 @@ pub fn count(v: &Bound<'_, PyAny>, name: &str, min: u64, max: u64, why: &str) ->
     Ok(value as u64)
 }
 
-/// Argument `name`, a finite length (mm) of at most [`MAX_LENGTH_MM`] in magnitude, as the CLI's
-/// `limits::magnitude`; non-finite and negative values are left to the setting's own check.
-pub fn magnitude(name: &str, value: f64) -> PyResult<()> {
-    if value.is_finite() && value.abs() > MAX_LENGTH_MM {
-        let shown = if value.abs() >= 1e15 {
-            format!("{value:e}")
-        } else {
-            format!("{value}")
-        };
-        return Err(usage(format!(
-            "{name} {shown}: at most {MAX_LENGTH_MM} mm in magnitude"
-        )));
-    }
-    Ok(())
-}
-
-/// A list of numbers: one value for every joint (a number), or one per joint (a sequence).
-pub fn per_joint(v: &Bound<'_, PyAny>, name: &str, dof: usize) -> PyResult<Vec<f64>> {
+/// A list of numbers: a number (one value for every joint) or a sequence (the library's
+/// settings builder spreads one value to every joint and checks the count).
+pub fn per_joint(v: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<f64>> {
     if !v.is_instance_of::<PyBool>() {
         if let Ok(x) = v.extract::<f64>() {
-            return Ok(vec![x; dof]);
+            return Ok(vec![x]);
         }
         if let Ok(xs) = v.extract::<Vec<f64>>() {
-            return match xs.len() {
-                1 => Ok(vec![xs[0]; dof]),
-                n if n == dof => Ok(xs),
-                n => Err(usage(format!(
-                    "{name}: {n} values; give one for all joints or one per joint ({dof})"
-                ))),
-            };
+            return Ok(xs);
         }
     }
     Err(usage(format!(
@@ -99,7 +75,8 @@ pub fn frame(v: &Bound<'_, PyAny>, name: &str) -> PyResult<FrameVec> {
     Ok(FrameVec { x, y, z, a, b, c })
 }
 
-/// Two numbers (min, max) of a range of distances (mm), as the CLI's `--range-mm`.
+/// Two numbers (min, max) of a range of distances (mm), as the CLI's `--range-mm` (the library
+/// checks the range).
 pub fn range_mm(v: &Bound<'_, PyAny>, name: &str) -> PyResult<(f64, f64)> {
     let xs: Vec<f64> = v.extract().map_err(|_| {
         usage(format!(
@@ -113,11 +90,6 @@ pub fn range_mm(v: &Bound<'_, PyAny>, name: &str) -> PyResult<(f64, f64)> {
             xs.len()
         )));
     };
-    if !(a >= 0.0 && b > a && b <= MAX_LENGTH_MM) {
-        return Err(usage(format!(
-            "{name} ({a}, {b}): not a range of distances (0 <= min < max <= {MAX_LENGTH_MM} mm)"
-        )));
-    }
     Ok((a, b))
 }
 

@@ -68,6 +68,7 @@ const KEYWORDS: &[(&str, &str)] = &[
     ("footprint_radius_mm", "footprint_mm"),
     ("plane_points", "plane"),
     ("validation_poses", "validation"),
+    ("truth.tilt_parallel_axes", "tilt_parallel_axes"),
     ("truth.length_sigma_mm", "length_error_mm"),
     ("truth.angle_sigma_deg", "angle_error_deg"),
     ("gravity.compliance_rad_per_nm", "compliance"),
@@ -108,7 +109,7 @@ pub fn with_keywords(text: &str) -> String {
 /// The message of a library error as a Python user should read it (see the module docs).
 pub fn message(e: &E) -> String {
     let text = match e {
-        E::Invalid { field, message } => {
+        E::Invalid { field, message } | E::Usage { field, message } => {
             let f = KEYWORDS
                 .iter()
                 .find(|(s, _)| s == field)
@@ -130,7 +131,7 @@ pub fn exit_code(e: &E) -> i32 {
         E::Parse { .. } | E::Invalid { .. } | E::UnknownParameter { .. } | E::JointCount { .. } => {
             3
         }
-        E::UnknownPreset { .. } => 2,
+        E::UnknownPreset { .. } | E::Usage { .. } => 2,
         E::Numerical(_) => 5,
         E::Implausible(_) => 6,
     }

@@ -1,8 +1,8 @@
 //! `robocal.plan`: the poses worth measuring, through the library's `planning::plan` with the
-//! settings `robocal plan` builds from its flags (src/cmd/plan.rs), checked the same way; the
+//! settings checked by the library's `PlanBuilder`, as `robocal plan`'s flags are; the
 //! poses as the CLI writes them (`written`), so a plan made in Python is the CLI's file.
 
-use crate::args::{count, frame, magnitude, range_mm as range_arg};
+use crate::args::{count, frame, range_mm as range_arg};
 use crate::errors::{raise, usage, IntoPy};
 use crate::robot::PyRobot;
 use crate::written::{csv_bytes, read_back, Written};
@@ -10,15 +10,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use robocal_core::io::measurements::{read_measurements, Measurement, MeasurementSet, Positions};
 use robocal_core::io::write_all_atomic;
-use robocal_core::planning::{
-    plan, tracker_range, Criterion, Plan, PlanSettings, DEFAULT_CANDIDATES,
-};
-use robocal_core::simulation::{SimulationConfig, DEFAULT_NOISE_MM, DEFAULT_NOISE_PER_M};
-use robocal_core::TrackerFrame;
+use robocal_core::planning::{plan, Criterion, Plan, PlanBuilder, PlanSettings};
+use robocal_core::simulation::{DEFAULT_NOISE_MM, DEFAULT_NOISE_PER_M};
 use std::path::PathBuf;
-
-/// Most candidates (and poses), as the CLI: 200,000 take about 150 MB for a six-joint robot.
-const MAX_CANDIDATES: u64 = 200_000;
 
 /// How well a set of poses identifies the parameters (`planning::Quality`), in interface units.
 #[pyclass(name = "PlanQuality", module = "robocal", frozen, get_all)]
@@ -122,31 +116,14 @@ pub fn plan_poses(
 ) -> PyResult<(PyPlan, Vec<String>)> {
     let none = crate::args::given;
     let r = &robot.inner;
-    // As the CLI's `Settings` (src/cmd/plan.rs), in its order.
-    let poses = match none(poses) {
-        Some(v) => count(
-            v,
-            "poses",
-            1,
-            MAX_CANDIDATES,
-            "no calibration measures more",
-        )?,
-        None => 75,
+    // Parsing only (Python types to numbers); the library's `PlanBuilder` checks the settings,
+    // as it does the CLI's flags.
+    let counted = |v: Option<&Bound<'_, PyAny>>, name: &str| {
+        none(v)
+            .map(|v| count(v, name, 0, u64::MAX, "a 64-bit count"))
+            .transpose()
     };
-    let candidates = match none(candidates) {
-        Some(v) => count(
-            v,
-            "candidates",
-            poses,
-            MAX_CANDIDATES,
-            "memory and time grow with the candidates",
-        )?,
-        None => DEFAULT_CANDIDATES as u64,
-    };
-    let seed = match none(seed) {
-        Some(v) => count(v, "seed", 0, u64::MAX, "a 64-bit seed")?,
-        None => 1,
-    };
+    let as_usize = |v: u64| usize::try_from(v).unwrap_or(usize::MAX);
     let criterion = match criterion.replace('_', "-").as_str() {
         "workspace" => Criterion::IOptimal,
         "d-optimal" => Criterion::DOptimal,
@@ -157,55 +134,33 @@ pub fn plan_poses(
             )))
         }
     };
-    magnitude("floor_mm", floor_mm)?;
-    if let Some(f) = footprint_mm {
-        magnitude("footprint_mm", f)?;
-    }
-    if !(noise_mm > 0.0 && noise_mm <= 1000.0) {
-        return Err(usage(format!(
-            "noise_mm {noise_mm}: must be a positive length up to 1000 mm"
-        )));
-    }
-    if !(0.0..=1000.0).contains(&noise_per_m) {
-        return Err(usage(format!(
-            "noise_per_m {noise_per_m}: must be within 0..1000 mm/m"
-        )));
-    }
-    let cfg = SimulationConfig {
+    let d = PlanBuilder::default();
+    let mut builder = PlanBuilder {
+        poses: counted(poses, "poses")?.map_or(d.poses, as_usize),
+        candidates: counted(candidates, "candidates")?.map_or(d.candidates, as_usize),
+        seed: counted(seed, "seed")?.unwrap_or(d.seed),
+        criterion,
+        tracker_frame: none(tracker).map(|t| frame(t, "tracker")).transpose()?,
+        tracker_range: none(range_mm)
+            .map(|v| range_arg(v, "range_mm"))
+            .transpose()?,
+        include: Vec::new(),
         floor_z_mm: floor_mm,
         footprint_radius_mm: footprint_mm,
-        ..SimulationConfig::default()
-    };
-    cfg.validate(r).py_err()?;
-    let tracker = none(tracker);
-    let t = match tracker {
-        Some(v) => frame(v, "tracker")?,
-        None => cfg.tracker_frame,
-    };
-    let tf = TrackerFrame::from_vector_deg(&[t.x, t.y, t.z, t.a, t.b, t.c]);
-    let tracker_range = match none(range_mm) {
-        Some(v) => {
-            let (min, max) = range_arg(v, "range_mm")?;
-            Some(tracker_range(&tf, min, max).py_err()?)
-        }
-        None => None,
-    };
-    let (include, warnings) = match none(include) {
-        Some(v) => include_arg(robot, v)?,
-        None => (Vec::new(), Vec::new()),
-    };
-    let settings = PlanSettings {
-        poses: poses as usize,
-        candidates: candidates as usize,
-        seed,
-        sampler: cfg.sampler(r),
-        tracker_range,
-        include,
         noise_mm,
         noise_per_m,
-        tracker_origin: tracker.is_some().then(|| tf.origin()),
-        criterion,
     };
+    // The settings are checked before the included poses are read, as by the CLI.
+    builder.clone().build(r).py_err()?;
+    let warnings = match none(include) {
+        Some(v) => {
+            let (poses, warnings) = include_arg(robot, v)?;
+            builder.include = poses;
+            warnings
+        }
+        None => Vec::new(),
+    };
+    let settings = builder.build(r).py_err()?;
     let p = py.detach(|| plan(r, &settings)).py_err()?;
     // The poses as `robocal plan --out` writes them.
     let set = MeasurementSet {

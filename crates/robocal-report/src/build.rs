@@ -152,14 +152,28 @@ pub fn before_after_histogram(
 
 /// Where a parameter goes in a table by joint: `(joint, kind)` for `alpha`, `d`, `a`, `phi`,
 /// `beta` of a joint (in that order), then the base and the tool frame's x, y, z, A, B, C.
-fn display_order(name: &str) -> (usize, usize) {
+/// The reflector (1-based) whose tool parameter `name` is (`tool_x`: 1, `tool2_x`: 2), and its
+/// axis (`x`).
+pub(crate) fn reflector(name: &str) -> Option<(usize, &str)> {
+    let rest = name.strip_prefix("tool")?;
+    let (j, axis) = rest.split_once('_')?;
+    match j {
+        "" => Some((1, axis)),
+        j if j.bytes().all(|b| b.is_ascii_digit()) => j.parse().ok().map(|j| (j, axis)),
+        _ => None,
+    }
+}
+
+pub(crate) fn display_order(name: &str) -> (usize, usize) {
     const AXES: [&str; 6] = ["x", "y", "z", "a", "b", "c"];
     let axis = |rest: &str| AXES.iter().position(|a| *a == rest).unwrap_or(AXES.len());
     if let Some(rest) = name.strip_prefix("base_") {
         return (usize::MAX - 1, axis(rest));
     }
-    if let Some(rest) = name.strip_prefix("tool_") {
-        return (usize::MAX, axis(rest));
+    // The tool of reflector 1 (`tool_x`), then each further reflector's (`tool2_x`, ...), each
+    // in axis order.
+    if let Some((j, rest)) = reflector(name) {
+        return (usize::MAX, (AXES.len() + 1) * j + axis(rest));
     }
     let digits = name.trim_start_matches(|c: char| !c.is_ascii_digit());
     let kind = &name[..name.len() - digits.len()];
@@ -301,14 +315,14 @@ mod tests {
     fn parameters_by_joint_then_base_and_tool() {
         let mut names = vec![
             "tool_x", "alpha1", "alpha2", "d1", "d2", "a1", "a2", "phi1", "phi2", "base_c",
-            "base_x", "beta2", "tool_a",
+            "base_x", "beta2", "tool_a", "tool3_x", "tool2_y", "tool2_x", "tool3_a",
         ];
         names.sort_by_key(|n| display_order(n));
         assert_eq!(
             names,
             vec![
                 "alpha1", "d1", "a1", "phi1", "alpha2", "d2", "a2", "phi2", "beta2", "base_x",
-                "base_c", "tool_x", "tool_a"
+                "base_c", "tool_x", "tool_a", "tool2_x", "tool2_y", "tool3_x", "tool3_a"
             ]
         );
     }

@@ -165,10 +165,17 @@ pub(crate) fn parameters_section(page: &Page, h: &mut String) -> Result<bool> {
         h.push_str("<th class=\"num\">True</th><th class=\"num\">Cal. − true</th>");
     }
     h.push_str("</tr></thead>\n<tbody>\n");
+    let reflectors = data
+        .parameters
+        .iter()
+        .filter_map(|p| crate::build::reflector(&p.name))
+        .map(|(j, _)| j)
+        .max()
+        .unwrap_or(1);
     let groups: Vec<String> = data
         .parameters
         .iter()
-        .map(|p| param_group(&p.name))
+        .map(|p| param_group(&p.name, reflectors))
         .collect();
     let grouped = groups.windows(2).any(|w| w[0] != w[1]);
     for (i, p) in data.parameters.iter().enumerate() {
@@ -201,13 +208,19 @@ pub(crate) fn parameters_section(page: &Page, h: &mut String) -> Result<bool> {
     Ok(true)
 }
 
-/// The group a parameter belongs to, from its name: a joint, the base frame or the tool.
-fn param_group(name: &str) -> String {
+/// The group a parameter belongs to, from its name: a joint, the base frame or the tool; with
+/// several reflectors (`reflectors` > 1), each reflector's tool is a group of its own.
+fn param_group(name: &str, reflectors: usize) -> String {
     if name.starts_with("base_") {
         return "Base frame (column B)".into();
     }
-    if name.starts_with("tool_") {
-        return "Tool (column T)".into();
+    match crate::build::reflector(name) {
+        Some((1, _)) if reflectors == 1 => return "Tool (column T)".into(),
+        Some((1, _)) => return format!("Reflector 1 of {reflectors}: its tool (column T)"),
+        Some((j, _)) => {
+            return format!("Reflector {j} of {reflectors}: its tool (offset on the flange)")
+        }
+        None => {}
     }
     let digits = name.len() - name.trim_end_matches(|c: char| c.is_ascii_digit()).len();
     if digits > 0 && digits < name.len() {

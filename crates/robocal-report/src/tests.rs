@@ -453,3 +453,72 @@ mod runs {
         assert!(!caption.contains("Calibration poses"), "{caption}");
     }
 }
+
+/// Table III of a cell with three reflectors: each reflector's tool is a group of its own,
+/// headed by its number, its six offsets in axis order under it (not under `tool_x`); with one
+/// reflector the tool stays "Tool (column T)".
+#[test]
+fn each_reflector_has_its_own_rows_in_the_parameter_table() {
+    let row = |name: &str| ParamRow {
+        name: name.into(),
+        unit: robocal_core::Unit::Mm,
+        nominal: 1.0,
+        calibrated: 1.5,
+        std: Some(0.01),
+        fixed: false,
+        reason: None,
+        truth: None,
+    };
+    let axes = ["x", "y", "z", "a", "b", "c"];
+    // The result's (model) order: every reflector's x, then every reflector's y, ...
+    let mut names = vec!["d1".to_owned(), "base_x".to_owned()];
+    for a in axes {
+        names.push(format!("tool_{a}"));
+        for j in [2, 3] {
+            names.push(format!("tool{j}_{a}"));
+        }
+    }
+    let mut params: Vec<ParamRow> = names.iter().map(|n| row(n)).collect();
+    params.sort_by_key(|p| crate::build::display_order(&p.name));
+    let data = ReportData {
+        parameters: params,
+        ..ReportData::default()
+    };
+    let html = render(&data).unwrap().html;
+    xml_elements(&xmlish(&html));
+    let table = &html[html.find("<table class=\"params\">").unwrap()..];
+    let table = &table[..table.find("</table>").unwrap()];
+    let mut at = 0;
+    for (j, head) in [
+        (1, "Reflector 1 of 3: its tool (column T)"),
+        (2, "Reflector 2 of 3: its tool (offset on the flange)"),
+        (3, "Reflector 3 of 3: its tool (offset on the flange)"),
+    ] {
+        let h = table[at..].find(head).unwrap_or_else(|| panic!("{head}")) + at;
+        // The group's six rows follow its heading, before the next group's.
+        let next = table[h + 1..]
+            .find("class=\"group\"")
+            .map_or(table.len(), |n| n + h + 1);
+        let group = &table[h..next];
+        for a in axes {
+            let name = if j == 1 {
+                format!("tool_{a}")
+            } else {
+                format!("tool{j}_{a}")
+            };
+            assert!(
+                group.contains(&format!(">{name}<")),
+                "{name} not under {head}"
+            );
+        }
+        assert_eq!(group.matches("<tr>").count(), 6, "{head}: {group}");
+        at = h;
+    }
+    // One reflector: the paper's heading.
+    let one = ReportData {
+        parameters: ["d1", "tool_x"].iter().map(|n| row(n)).collect(),
+        ..ReportData::default()
+    };
+    let html = render(&one).unwrap().html;
+    assert!(html.contains("Tool (column T)") && !html.contains("Reflector 1"));
+}

@@ -56,7 +56,7 @@ fn read_text(flag: &str, path: &Path) -> anyhow::Result<String> {
 
 /// The header of the `--changes` CSV (README, "Robot programs").
 pub(super) const CHANGES_HEADER: &str = "name,line,kind,status,applied,correction_mm,\
-    correction_deg,verified_mm,verified_deg,old,new,reason";
+    correction_deg,verified_mm,verified_deg,old,new,reason,file";
 
 /// Targets listed one by one before the rest are counted.
 const LISTED: usize = 50;
@@ -91,11 +91,22 @@ pub(super) fn run(
     let res = compensate_program(&sources, r.format, config.as_ref(), comp, &settings);
     pb.finish_and_clear();
     let res = res?;
+    // Each line named with its file when there are two (a KRL .src and its .dat).
+    let names: Vec<String> = sources
+        .iter()
+        .map(|s| {
+            s.path.file_name().map_or_else(
+                || s.path.display().to_string(),
+                |n| n.to_string_lossy().into(),
+            )
+        })
+        .collect();
+    let at = Lines(&names);
     let failed: Vec<&Change> = res.changes.iter().filter(|c| !c.applied).collect();
     let motions: Vec<&MotionReport> = res.unchanged_motions().collect();
     if (!failed.is_empty() || !motions.is_empty()) && !r.keep_going {
-        let mut lines: Vec<String> = failed.iter().map(|c| describe(c)).collect();
-        lines.extend(motions.iter().map(|m| describe_motion(m)));
+        let mut lines: Vec<String> = failed.iter().map(|c| describe(c, at)).collect();
+        lines.extend(motions.iter().map(|m| describe_motion(m, at)));
         return Err(exit::numerical(format!(
             "{} of {} target(s) and {} of {} motion(s) of {} cannot be compensated; nothing \
              written (give --keep-going to leave them unchanged and write the rest):\n  {}",
@@ -112,22 +123,42 @@ pub(super) fn run(
         files.push(write(outputs, &dat_path(r.out), dat.as_bytes())?);
     }
     if let Some(p) = r.changes {
-        files.push(write(outputs, p, changes_csv(&res).as_bytes())?);
+        files.push(write(outputs, p, changes_csv(&res, at).as_bytes())?);
     }
     commit_all(files)?;
-    print_listing(r, &res, &settings)?;
+    print_listing(r, &res, &settings, at)?;
     Ok(())
 }
 
+/// Where a line is: with one file its number, with a KRL `.src` and its `.dat` the file too.
+#[derive(Clone, Copy)]
+struct Lines<'a>(&'a [String]);
+
+impl<'a> Lines<'a> {
+    /// `line 12`, or `kr480_cell.dat line 12`.
+    fn at(self, file: usize, line: usize) -> String {
+        match self.0.get(file) {
+            Some(f) if self.0.len() > 1 => format!("{f} line {line}"),
+            _ => format!("line {line}"),
+        }
+    }
+
+    /// The file's name for the `file` column.
+    fn file(self, file: usize) -> &'a str {
+        self.0.get(file).map_or("", String::as_str)
+    }
+}
+
 /// One line of a motion left unchanged.
-fn describe_motion(m: &MotionReport) -> String {
+fn describe_motion(m: &MotionReport, at: Lines<'_>) -> String {
     let why = match &m.outcome {
         MotionOutcome::Unchanged(w) => w.as_str(),
         MotionOutcome::Compensated => "compensated",
     };
     format!(
-        "motion {} (line {}): {why}",
-        m.motion.statement, m.motion.line
+        "motion {} ({}): {why}",
+        m.motion.statement,
+        at.at(m.motion.file, m.motion.line)
     )
 }
 
@@ -143,7 +174,7 @@ fn write(
 }
 
 /// One line of a target that could not be compensated.
-fn describe(c: &Change) -> String {
+fn describe(c: &Change, at: Lines<'_>) -> String {
     let why = match c.status {
         robocal_core::compensation::IkStatus::Converged => format!(
             "the written value misses the target by {:.4} mm, {:.4} deg after rounding",
@@ -152,7 +183,7 @@ fn describe(c: &Change) -> String {
         _ if c.skipped.is_some() => c.skipped.clone().unwrap_or_default(),
         s => s.to_string(),
     };
-    format!("{} (line {}): {why}", c.name, c.line)
+    format!("{} ({}): {why}", c.name, at.at(c.file, c.line))
 }
 
 fn kind(k: TargetKind) -> &'static str {
@@ -179,7 +210,7 @@ fn values(v: &[f64]) -> String {
 }
 
 /// The `--changes` CSV: one row per target, in file order.
-pub(super) fn changes_csv(res: &CompensatedProgram) -> String {
+fn changes_csv(res: &CompensatedProgram, at: Lines<'_>) -> String {
     let mut s = String::from(CHANGES_HEADER);
     s.push('\n');
     for c in &res.changes {
@@ -195,13 +226,17 @@ pub(super) fn changes_csv(res: &CompensatedProgram) -> String {
         } else {
             (String::new(), String::new())
         };
-        let status = if c.skipped.is_some() {
-            "frame_unknown".to_owned()
+        let status = if let Some(why) = &c.skipped {
+            if why.starts_with("frame unknown") {
+                "frame_unknown".to_owned()
+            } else {
+                "skipped".to_owned()
+            }
         } else {
             c.status.to_string()
         };
         s += &format!(
-            "{},{},{},{status},{},{cm},{cd},{},{},{},{},{}\n",
+            "{},{},{},{status},{},{cm},{cd},{},{},{},{},{},{}\n",
             field(&c.name),
             c.line,
             kind(c.kind),
@@ -210,7 +245,8 @@ pub(super) fn changes_csv(res: &CompensatedProgram) -> String {
             num(c.verified_deg),
             values(&c.old),
             values(&c.new),
-            field(c.skipped.as_deref().unwrap_or(""))
+            field(c.skipped.as_deref().unwrap_or("")),
+            field(at.file(c.file))
         );
     }
     for m in res.unchanged_motions() {
@@ -219,10 +255,11 @@ pub(super) fn changes_csv(res: &CompensatedProgram) -> String {
             MotionOutcome::Compensated => "",
         };
         s += &format!(
-            "{},{},motion,unchanged,false,,,,,,,{}\n",
+            "{},{},motion,unchanged,false,,,,,,,{},{}\n",
             field(&m.motion.statement),
             m.motion.line,
-            field(why)
+            field(why),
+            field(at.file(m.motion.file))
         );
     }
     s
@@ -232,6 +269,7 @@ fn print_listing(
     r: &ProgramRun<'_>,
     res: &CompensatedProgram,
     s: &ProgramSettings,
+    at: Lines<'_>,
 ) -> anyhow::Result<()> {
     let n = res.changes.len();
     let applied = res.changes.iter().filter(|c| c.applied).count();
@@ -251,11 +289,28 @@ fn print_listing(
         },
         r.params.display()
     )?;
+    // With a .src and its .dat: `line` is `FILE:LINE`.
+    let two = at.0.len() > 1;
+    let line_of = |file: usize, line: usize| {
+        if two {
+            format!("{}:{line}", at.file(file))
+        } else {
+            line.to_string()
+        }
+    };
+    let width = res
+        .changes
+        .iter()
+        .take(LISTED)
+        .map(|c| line_of(c.file, c.line).len())
+        .max()
+        .unwrap_or(0)
+        .max(6);
     if n > 0 {
         outln!(
-            "  {:<16} {:>6}  {:<6}  {:>11}  {:>11}  status",
+            "  {:<16} {:>width$}  {:<6}  {:>11}  {:>11}  status",
             "target",
-            "line",
+            if two { "file:line" } else { "line" },
             "kind",
             "corr. mm",
             "corr. deg"
@@ -271,9 +326,9 @@ fn print_listing(
             ("-".to_owned(), "-".to_owned())
         };
         outln!(
-            "  {:<16} {:>6}  {:<6}  {cm:>11}  {cd:>11}  {}{}",
+            "  {:<16} {:>width$}  {:<6}  {cm:>11}  {cd:>11}  {}{}",
             c.name,
-            c.line,
+            line_of(c.file, c.line),
             kind(c.kind),
             c.status,
             if c.applied { "" } else { " (left unchanged)" }
@@ -311,15 +366,15 @@ fn print_listing(
         errln!(
             "warning: {}: {}; left unchanged (--keep-going)",
             r.program.display(),
-            describe(c)
+            describe(c, at)
         )?;
     }
     for m in res.unchanged_motions() {
-        outln!("  unchanged: {}", describe_motion(m))?;
+        outln!("  unchanged: {}", describe_motion(m, at))?;
         errln!(
             "warning: {}: {}; left unchanged (--keep-going)",
             r.program.display(),
-            describe_motion(m)
+            describe_motion(m, at)
         )?;
     }
     let shown = super::super::io_plan::shown;

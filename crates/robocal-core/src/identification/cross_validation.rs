@@ -199,7 +199,7 @@ type Part = (usize, Observations, Accumulated);
 fn newton_step(h: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
     let k = b.len();
     let d: Vec<f64> = (0..k).map(|j| h[(j, j)]).collect();
-    if d.iter().any(|&v| !(v > 0.0) || !v.is_finite()) {
+    if d.iter().any(|&v| v.is_nan() || v <= 0.0 || !v.is_finite()) {
         return None;
     }
     let s: Vec<f64> = d.iter().map(|v| 1.0 / v.sqrt()).collect();

@@ -18,6 +18,7 @@
 //! deviations are `sigma sqrt(diag(M^-1))`, and the predicted workspace error is the RMS over the
 //! candidates of `sigma sqrt(tr(J_i M^-1 J_i^T))`.
 
+mod builder;
 pub mod design;
 pub mod pooled;
 pub mod select;
@@ -31,6 +32,7 @@ use crate::identification::{analyze, IdentifiabilityOptions, Observations};
 use crate::model::{Param, Robot};
 use crate::progress::{Observer, Stage};
 use crate::simulation::{random_poses_within, PoseSampler, TrackerRange};
+pub use builder::{PlanBuilder, MAX_CANDIDATES, MAX_PLAN_NOISE};
 pub use design::Criterion;
 use design::{log_det, Blocks, ROWS};
 use nalgebra::{DMatrix, Vector3};

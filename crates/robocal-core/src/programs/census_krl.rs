@@ -10,7 +10,7 @@
 //! `WHILE`, `LOOP`, `REPEAT`, `SWITCH`) is unknown after the block's end; an external TCP
 //! (`IPO_FRAME #TCP`, `$IPO_MODE = #TCP`) and any other expression are unknown.
 
-use super::census::{target_ref, Motion};
+use super::census::{target_ref, Motion, TargetRef};
 use super::frames::{krl_frame, FrameSpec, Frames, KrlConfig};
 use super::krl::parse_aggregate;
 use std::collections::HashMap;
@@ -285,13 +285,29 @@ pub fn motions(text: &str, dat: Option<&str>, config: Option<&KrlConfig>) -> Vec
         let n = if first.contains("CIRC") { 2 } else { 1 };
         let mut rest = args.trim_start();
         for _ in 0..n {
-            let end = if rest.starts_with('{') {
-                rest.find('}').map_or(rest.len(), |e| e + 1)
-            } else {
-                rest.find(|ch: char| ch.is_whitespace() || ch == ',')
-                    .unwrap_or(rest.len())
+            // A target, or frames joined by the geometric operator (`XP1:{X 100}`,
+            // `BASE_DATA[1]:XP1`): computed at run time.
+            let operand = |s: &str| {
+                if s.starts_with('{') {
+                    s.find('}').map_or(s.len(), |e| e + 1)
+                } else {
+                    s.find(|ch: char| ch.is_whitespace() || ch == ',' || ch == ':')
+                        .unwrap_or(s.len())
+                }
             };
-            m.refs.push(target_ref(&rest[..end], &["{"]));
+            let mut end = operand(rest);
+            let mut joined = false;
+            while let Some(r) = rest[end..].trim_start().strip_prefix(':') {
+                let r = r.trim_start();
+                let start = rest.len() - r.len();
+                end = start + operand(r);
+                joined = true;
+            }
+            m.refs.push(if joined {
+                TargetRef::Computed(rest[..end].to_owned())
+            } else {
+                target_ref(&rest[..end], &["{"])
+            });
             rest = rest[end..]
                 .trim_start()
                 .trim_start_matches(',')

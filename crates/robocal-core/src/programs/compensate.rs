@@ -101,7 +101,7 @@ pub fn compensate_program(
     let motions = motions
         .into_iter()
         .zip(links)
-        .map(|(m, l)| outcome(format, m, &l, &changes))
+        .map(|(m, l)| outcome(format, &names, m, &l, &changes))
         .collect();
     Ok(CompensatedProgram {
         texts,
@@ -199,18 +199,29 @@ fn target_frames(
             }
             out[*k] = match out[*k].take() {
                 None => Some(Ok((m.frames.clone(), m.line))),
-                Some(Ok((f, line))) if f != m.frames => Some(Err(format!(
-                    "frame unknown: used with different tools or bases (lines {line} and {})",
-                    m.line
-                ))),
+                Some(Ok((f, line))) if f != m.frames => Some(Err(two_uses(&f, line, m))),
                 other => other,
             };
         }
     }
     let sets_frames = motions.iter().any(|m| m.frames != Frames::default());
+    // An aggregate written inside an expression the controller computes (`{X 1, ..}:XP1`) is an
+    // operand, not where the robot goes.
+    let operand_of = |t: &ProgramTarget| {
+        let at = t.fields.first().map_or(0, |f| f.span.start);
+        motions.iter().find(|m| {
+            m.file == t.file
+                && m.span.contains(&at)
+                && m.refs.iter().any(|r| matches!(r, TargetRef::Computed(_)))
+        })
+    };
     out.into_iter()
         .zip(targets)
         .map(|(f, t)| match f {
+            None if operand_of(t).is_some() => Err(format!(
+                "part of an expression computed at run time (motion on line {})",
+                operand_of(t).map_or(0, |m| m.line)
+            )),
             Some(Ok((f, _))) => match f.unknown() {
                 Some(why) => Err(format!("frame unknown: {why}")),
                 None => Ok(f),
@@ -222,8 +233,47 @@ fn target_frames(
         .collect()
 }
 
+/// Why a target used by two motions with different frames (`first` at line `line`, then `m`)
+/// cannot be compensated for both.
+fn two_uses(first: &Frames, line: usize, m: &Motion) -> String {
+    let same_frames = first.tool == m.frames.tool && first.base == m.frames.base;
+    match (first.offset.is_some(), m.frames.offset.is_some()) {
+        (a, b) if same_frames && a != b => {
+            let (direct, offset) = if a { (m.line, line) } else { (line, m.line) };
+            format!(
+                "used both directly (line {direct}) and with an offset (line {offset}): one value \
+                 cannot be compensated for two poses; give the offset motion a target of its own"
+            )
+        }
+        _ if same_frames => format!(
+            "used with two different offsets (lines {line} and {}): one value cannot be \
+             compensated for two poses; give each motion a target of its own",
+            m.line
+        ),
+        _ => format!(
+            "frame unknown: used with different tools or bases (lines {line} and {})",
+            m.line
+        ),
+    }
+}
+
+/// The program target a computed expression is built on (`Offs(p10, 0, 0, 100)`: `p10`), if it
+/// names one.
+fn based_on(names: &Names, e: &str) -> Option<usize> {
+    e.split(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .filter(|w| !w.is_empty() && !w.as_bytes()[0].is_ascii_digit())
+        .find_map(|w| names.by_name.get(&names.key(w)).and_then(|v| v.first()))
+        .copied()
+}
+
 /// What became of a motion, from what became of its targets.
-fn outcome(format: Format, m: Motion, links: &[Option<usize>], changes: &[Change]) -> MotionReport {
+fn outcome(
+    format: Format,
+    names: &Names,
+    m: Motion,
+    links: &[Option<usize>],
+    changes: &[Change],
+) -> MotionReport {
     let mut why = None;
     if m.relative {
         why = Some("a relative motion: its target is an offset from where the robot is".to_owned());
@@ -244,7 +294,15 @@ fn outcome(format: Format, m: Motion, links: &[Option<usize>], changes: &[Change
                     c.name, c.line
                 ))
             }
-            (TargetRef::Computed(e), None) => Some(format!("target `{e}` computed at run time")),
+            (TargetRef::Computed(e), None) => Some(match based_on(names, e) {
+                // An offset of a program target: that target's correction is for its own pose.
+                Some(k) => format!(
+                    "target `{e}` computed at run time from {} (line {}): its correction is for \
+                     {}'s own pose, not for this one",
+                    changes[k].name, changes[k].line, changes[k].name
+                ),
+                None => format!("target `{e}` computed at run time"),
+            }),
             (TargetRef::Named(n), None) => Some(format!(
                 "`{n}`: no target of that name in the program{}",
                 if format == Format::Krl {

@@ -366,4 +366,6 @@ pub fn pose_distance(a: &Frame, b: &Frame) -> (f64, f64) {
 }
 
 #[cfg(test)]
+mod offset_tests;
+#[cfg(test)]
 mod tests;

@@ -6,6 +6,8 @@
 //!   [`Tracker`] (pose and noise), optional gravity deflection ([`GravityModel`]) and gross
 //!   outliers ([`OutlierModel`]); it draws poses ([`VirtualCell::random_poses`],
 //!   [`VirtualCell::plane_poses`]) and measures joint values ([`VirtualCell::measure_joints`]).
+//! - [`SimulationBuilder`]: a session's settings as a user gives them, checked once by its
+//!   `build` (the CLI and the Python bindings both use it).
 //! - [`SimulationConfig`]: the validated settings of a session; [`simulate`] runs the paper's
 //!   session (3 plane points, calibration and validation points) and [`simulate_joints`]
 //!   measures given joint values (the verification phase). [`Simulation::truth_file`] is the
@@ -47,6 +49,7 @@ mod plane;
 mod poses;
 mod repeatability;
 mod session;
+mod settings;
 mod station;
 mod targets;
 mod thermal;
@@ -69,6 +72,10 @@ pub use poses::{random_poses, random_poses_within, PoseSampler, TrackerRange};
 pub use repeatability::{RepeatabilityModel, DEFAULT_TOOL_MM};
 pub use session::{
     simulate, simulate_joints, Simulation, SET_CALIBRATION, SET_PLANE, SET_VALIDATION,
+};
+pub use settings::{
+    PerJoint, SimulationBuilder, SimulationSettings, TruthSource, MAX_ORIENTATION_SIGMA_DEG,
+    MAX_POSES,
 };
 pub use station::{station_frame, MAX_STATION};
 pub use targets::TargetMeasurement;

@@ -480,8 +480,10 @@ def simulate(
 
     Returns a :class:`Simulation` whose arrays hold the values ``robocal simulate --out`` writes
     for the same arguments (joint values to 1e-9 degree, readings to 1e-6 mm), so calibrating
-    them gives the CLI's result; :meth:`Simulation.write` writes the CLI's very files. Bad
-    arguments raise :class:`UsageError`, bad arrays :class:`InputError`. The GIL is released
+    them gives the CLI's result; :meth:`Simulation.write` writes the CLI's very files. The
+    settings are checked by the library as the CLI's flags are, with the same messages: a count
+    outside its limits or an argument given where it does not apply raises :class:`UsageError`,
+    a value outside its plausible range or a bad array :class:`InputError`. The GIL is released
     while the session runs.
     """
     sim = _robocal.simulate_session(
