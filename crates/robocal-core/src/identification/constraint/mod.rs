@@ -128,6 +128,11 @@ pub struct ConstraintCalibration {
     pub condition_number: f64,
     /// How the final fit ended.
     pub fit: FitReport,
+    /// The plausibility gate's failed checks, adapted to constraint data (empty: passed): a
+    /// parameter moved beyond its plausible range
+    /// ([`crate::model::family::plausible`]), a sphere's radius or a feature's distance from
+    /// the base beyond what the robot could touch.
+    pub implausible: Vec<String>,
 }
 
 /// What every result says about its frame.
@@ -264,6 +269,7 @@ pub fn calibrate_constraints(
             per_feature[r.feature].1 += 1;
         }
         let distance_residuals_mm = e.as_slice()[row..].to_vec();
+        let implausible = gate(&start_robot, &robot, &features);
         let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
         return Ok(ConstraintCalibration {
             robot,
@@ -281,8 +287,48 @@ pub fn calibrate_constraints(
             distance_residuals_mm,
             condition_number: cond,
             fit: report,
+            implausible,
         });
     }
+}
+
+/// The plausibility gate on constraint data: each identified parameter's move within its
+/// family's plausible range, each feature within twice the robot's reach of the base, each
+/// sphere's radius below the reach.
+fn gate(start: &Robot, robot: &Robot, features: &[FeatureEstimate]) -> Vec<String> {
+    let mut out = Vec::new();
+    for &p in start.param_list() {
+        let (was, now) = (start.get_display(p), robot.get_display(p));
+        let range = crate::model::family::plausible::of(start, p);
+        let u = p.unit().as_str();
+        if (now - was).abs() > range.max_move || !range.contains(now) {
+            out.push(format!(
+                "{} moved from {was:.4} to {now:.4} {u}, beyond its plausible range ({})",
+                p.name(),
+                range.why
+            ));
+        }
+    }
+    let reach = robot.reach_mm();
+    for f in features {
+        if f.position.norm() > 2.0 * reach {
+            out.push(format!(
+                "{} is {:.0} mm from the base, beyond twice the robot's reach ({reach:.0} mm)",
+                f.label(),
+                f.position.norm()
+            ));
+        }
+        if let Some(r) = f
+            .radius_mm
+            .filter(|r| r.is_nan() || *r <= 0.0 || *r >= reach)
+        {
+            out.push(format!(
+                "{}'s radius {r:.3} mm is not between 0 and the robot's reach",
+                f.label()
+            ));
+        }
+    }
+    out
 }
 
 /// The features' start values from the nominal tool points of their rows.

@@ -317,3 +317,115 @@ fn kr480_fixed_points_with_distances_reach_three_hundredths() {
     // Random configurations vary: no seed far off.
     assert!(means.iter().all(|m| *m <= 0.06), "{means:?}");
 }
+
+/// The tracker's figure at `n` random poses, 0.01 mm noise per axis: the pipeline's calibration
+/// of the geometric model, error against the truth after the same rigid alignment.
+fn tracker_error(t: &Robot, n: usize, seed: u64) -> f64 {
+    use crate::frame::{pose, TrackerFrame};
+    use crate::identification::{calibrate, CalibrationData, CalibrationSettings};
+    let tr = crate::simulation::Tracker::new(
+        TrackerFrame::new(pose(&[3900.0, -2200.0, -350.0, 2.6, 0.007, -0.012])),
+        0.01,
+        0.0,
+    )
+    .unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(9000 + seed);
+    let qs = random_poses(t, n, &sampler(), &mut rng).unwrap();
+    let mut obs = crate::observations::Observations::new(6);
+    for (i, q) in qs.iter().enumerate() {
+        obs.push(q, tr.measure(&t.tool_position(q), &mut rng), i + 2)
+            .unwrap();
+    }
+    let cal = calibrate(
+        &nominal(),
+        CalibrationData {
+            calibration: &obs,
+            plane: None,
+            validation: None,
+        },
+        &CalibrationSettings::default(),
+        &(),
+    )
+    .unwrap();
+    aligned_model_error(&cal.calibrated, t, &check_poses(seed))
+        .unwrap()
+        .0
+}
+
+/// Sphere (known radius) and plane data beside the tracker's at the same number of poses
+/// (80: 4 features x 20), 0.01 mm noise, three seeds. The figures are printed (`--nocapture`)
+/// for the issue's note; the bounds only guard against a regression. A sphere's radius is a
+/// short ruler: with 25 mm the scale is known to about 0.01 / 25 / sqrt(80), some 0.1 mm at
+/// the KR 480's reach, so a larger sphere or known distances between centres do better.
+#[test]
+fn spheres_and_planes_beside_the_tracker_at_80_poses() {
+    let up_to_scale = ConstraintOptions {
+        accept_unknown_scale: true,
+        ..ConstraintOptions::default()
+    };
+    let mut rows = Vec::new();
+    for seed in 1..=3 {
+        let t = truth(seed);
+        let poses = check_poses(seed);
+        let error = |s: ConstraintSimulation, o: &ConstraintOptions| {
+            let cal = calibrate_constraints(&nominal(), &simulate(&t, &s).data, o).unwrap();
+            aligned_model_error(&cal.robot, &t, &poses).unwrap().0
+        };
+        let sphere = |radius_mm: f64, distances: bool| ConstraintSimulation {
+            radius_mm,
+            distances,
+            ..spec(ConstraintKind::Sphere, 0.01, seed)
+        };
+        let r25 = error(sphere(25.0, false), &Default::default());
+        let r150 = error(sphere(150.0, false), &Default::default());
+        let r25d = error(sphere(25.0, true), &Default::default());
+        let plane = error(
+            ConstraintSimulation {
+                span_mm: 400.0,
+                ..spec(ConstraintKind::Plane, 0.01, seed)
+            },
+            &up_to_scale,
+        );
+        let tracker = tracker_error(&t, 80, seed);
+        let nom = aligned_model_error(&nominal(), &t, &poses).unwrap().0;
+        eprintln!(
+            "seed {seed}: nominal {nom:.3} mm; tracker {tracker:.4}; spheres r=25 {r25:.4}, \
+             r=150 {r150:.4}, r=25 + 6 distances {r25d:.4}; planes (scale held) {plane:.4} mm"
+        );
+        rows.push([tracker, r25, r150, r25d, plane, nom]);
+    }
+    for [tracker, r25, r150, r25d, plane, nom] in rows {
+        assert!(tracker < 0.02, "tracker {tracker}");
+        assert!(
+            r150 < r25 && r25 < 0.25 * nom,
+            "spheres r=25 {r25}, r=150 {r150}"
+        );
+        assert!(r25d < 0.06, "spheres with distances {r25d}");
+        // Planes hold the scale at a nominal length (0.5 mm errors): better than nominal,
+        // worse than the rest.
+        assert!(plane < 0.6 * nom, "planes {plane} against nominal {nom}");
+    }
+}
+
+#[test]
+fn the_gate_flags_a_parameter_moved_beyond_its_plausible_range() {
+    // The truth's a2 5% of the reach longer than the nominal's: a wrong robot, not an error.
+    let nom = nominal();
+    let mut t = truth(2);
+    let a2 = Param::a(1);
+    t.set(a2, t.get(a2) + 0.06 * nom.reach_mm());
+    let sim = simulate(&t, &spec(ConstraintKind::Point, 0.01, 2));
+    let cal = calibrate_constraints(&nom, &sim.data, &ConstraintOptions::default()).unwrap();
+    assert!(
+        cal.implausible.iter().any(|m| m.starts_with("a2 moved")),
+        "{:?}",
+        cal.implausible
+    );
+    let good = calibrate_constraints(
+        &nom,
+        &simulate(&truth(2), &spec(ConstraintKind::Point, 0.01, 2)).data,
+        &ConstraintOptions::default(),
+    )
+    .unwrap();
+    assert!(good.implausible.is_empty(), "{:?}", good.implausible);
+}
