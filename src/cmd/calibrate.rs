@@ -18,6 +18,7 @@ use robocal_core::observations::{TrackerSigma, Weighting};
 use robocal_core::{Param, Robot};
 use std::path::{Path, PathBuf};
 
+mod constraints;
 mod print;
 mod real_cell;
 pub(crate) use print::print_selection;
@@ -143,6 +144,14 @@ pub struct CalibrateArgs {
     /// accuracy, not the tracker's move. Without it, such a set is an error (exit 3).
     #[arg(long)]
     validate_refit_frame: bool,
+    /// Known distances between fixed points or sphere centres of constraint data (CSV
+    /// `from,to,distance_mm`): they give the calibration its scale.
+    #[arg(long, value_name = "FILE")]
+    distances: Option<PathBuf>,
+    /// Constraint data without a known distance or radius: write a result up to scale (the
+    /// longest link length held at its nominal value) instead of refusing.
+    #[arg(long)]
+    accept_unknown_scale: bool,
     /// Where to write the result JSON.
     #[arg(long)]
     out: PathBuf,
@@ -522,6 +531,16 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let s = Settings::try_from(&a)?;
     let Settings { robot, betas, .. } = &s;
     let rank_tolerance = s.calibration.identifiability.rank_tolerance;
+    if constraints::is_constraint_file(&s.data, robot)? {
+        return constraints::run(&s, a.distances.as_deref(), a.accept_unknown_scale);
+    }
+    if a.distances.is_some() || a.accept_unknown_scale {
+        return Err(exit::usage(format!(
+            "--distances and --accept-unknown-scale are for constraint data (a `constraint` \
+             column); {} has none",
+            s.data.display()
+        )));
+    }
     let mut outside = Vec::new();
     let mut data = read(&s.data, robot, s.nominal_limits, &mut outside)?;
     let robot = &real_cell::fit_to_data(robot, &mut data, &s.data)?;

@@ -15,6 +15,8 @@ use robocal_core::simulation::{
 use robocal_core::Robot;
 use std::path::{Path, PathBuf};
 
+mod constraints;
+
 /// Rows from which a progress bar is shown.
 const BAR_FROM: usize = 10_000;
 
@@ -30,7 +32,7 @@ pub struct SimulateArgs {
     truth: String,
     /// Number of random calibration poses (set `calibration`); with --validation at most
     /// 10000000 in all.
-    #[arg(long, required_unless_present = "joints")]
+    #[arg(long, required_unless_present_any = ["joints", "constraint"])]
     poses: Option<usize>,
     /// Measure the joint values of this CSV (q1..qn in degrees, mm for a prismatic joint, or
     /// axis1..axisN) instead of random poses, e.g.
@@ -147,6 +149,33 @@ pub struct SimulateArgs {
     /// again; evaluate such data with --refit-frame [default: 0, the --tracker pose].
     #[arg(long, default_value_t = 0)]
     station: u32,
+    /// Constraint data instead of tracker readings: the tool point brought to fixed points,
+    /// onto spheres or onto planes from varied orientations (a `constraint` column, no x,y,z);
+    /// --noise-mm is then the contact's noise (probe and repeatability).
+    #[arg(long, value_name = "point|sphere|plane", conflicts_with_all = ["poses", "joints", "validation"])]
+    constraint: Option<String>,
+    /// With --constraint: how many points, spheres or planes.
+    #[arg(long, default_value_t = 4, requires = "constraint")]
+    features: usize,
+    /// With --constraint: configurations per point, sphere or plane.
+    #[arg(long, default_value_t = 20, requires = "constraint")]
+    per_feature: usize,
+    /// With --constraint sphere: the spheres' radius (mm).
+    #[arg(long, default_value_t = 25.0, requires = "constraint")]
+    radius_mm: f64,
+    /// With --constraint sphere: leave radius_mm empty (the radius is estimated).
+    #[arg(long, requires = "constraint")]
+    unknown_radius: bool,
+    /// With --constraint: largest tilt of the tool from a feature's reference orientation (deg).
+    #[arg(long, default_value_t = 60.0, requires = "constraint")]
+    tilt_deg: f64,
+    /// With --constraint: a plane's touched square's half-size, a sphere's contact region (mm).
+    #[arg(long, default_value_t = 300.0, requires = "constraint")]
+    span_mm: f64,
+    /// With --constraint point|sphere: write the true distances between every pair of points
+    /// or centres to this CSV (from,to,distance_mm), for calibrate --distances.
+    #[arg(long, requires = "constraint")]
+    distances_out: Option<PathBuf>,
 }
 
 /// A list of numbers `V` or `V1,..,Vn` (the library spreads one value to every joint and
@@ -308,6 +337,9 @@ impl TryFrom<&SimulateArgs> for Settings {
 }
 
 pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
+    if let Some(kind) = &a.constraint {
+        return constraints::run(&a, kind);
+    }
     let Settings {
         nominal,
         truth,

@@ -26,6 +26,7 @@ mod cli_calibrate;
 mod cli_compensate;
 mod cli_compensate_pose;
 mod cli_compliance;
+mod cli_constraints;
 mod cli_demo;
 mod cli_evaluate;
 mod cli_import;

@@ -25,6 +25,7 @@
 //! - [`report`]: the result JSON.
 
 pub mod bounds;
+pub mod constraint;
 pub mod covariance;
 pub mod cross_validation;
 pub(crate) mod householder;

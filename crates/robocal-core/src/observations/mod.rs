@@ -3,6 +3,7 @@
 //! adds (DESIGN.md, "Measurement CSV additions"): which target (reflector) a row measures, the
 //! measured frame's orientation of 6-DoF data, and each point's uncertainty.
 
+pub mod constraint;
 pub mod kinds;
 mod weighting;
 

@@ -17,7 +17,7 @@
 mod affine;
 mod plane;
 pub(crate) mod procrustes;
-mod rigid;
+pub(crate) mod rigid;
 mod tool_fit;
 
 use crate::error::{Error, Result};

@@ -41,6 +41,7 @@ mod backlash;
 mod cell;
 mod conditions;
 mod config;
+pub mod constraint;
 mod gravity;
 mod gravity_equivalent;
 mod monte_carlo;

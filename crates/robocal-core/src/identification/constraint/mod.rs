@@ -1,0 +1,479 @@
+//! Calibration without a laser tracker (issue 31): from rows that put the tool point at fixed,
+//! unknown points, on fixed spheres or on fixed planes ([`crate::observations::constraint`]),
+//! with known distances between points or sphere centres, the robot's geometric parameters and
+//! the features' own are estimated jointly ([`fit`]), in the robot's base frame: there is no
+//! tracker frame to register.
+//!
+//! What such data cannot see is said, not hidden:
+//! - **the base pose**, always: the features sit at unknown places, which take up any move of
+//!   the base, so the base frame parameters are held at their nominal values and every
+//!   parameter that only duplicates them is fixed too (the structural analysis of
+//!   [`crate::identification::identifiability`] on the nominal tool points names them). The
+//!   result is "up to the base pose".
+//! - **the robot's scale**, without a known distance or a sphere of known radius: scaling every
+//!   length of the robot and of the features leaves every residual unchanged. The calibration
+//!   then refuses, naming what to add, unless a result up to scale is accepted explicitly
+//!   ([`ConstraintOptions::accept_unknown_scale`]), which holds the longest link length at its
+//!   nominal value.
+//! - **directions the features do not see** (a plane sees the tool point only along its
+//!   normal): after the fit, the column-scaled Jacobian's smallest singular directions below
+//!   [`ConstraintOptions::weak_tolerance`] are named, their largest robot parameter fixed, and
+//!   the fit repeated.
+
+pub mod features;
+pub mod fit;
+
+pub use features::FeatureEstimate;
+pub use fit::FitReport;
+
+use crate::error::{Error, Result};
+use crate::identification::identifiability::{analyze, IdentifiabilityOptions};
+use crate::model::{Param, Robot, Unit};
+use crate::observations::constraint::{ConstraintData, CONSTRAINT_COLUMN};
+use crate::observations::Observations;
+use fit::Layout;
+use nalgebra::DMatrix;
+
+/// Settings of a constraint calibration.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstraintOptions {
+    /// Accept a result up to scale when the data have no known length (else an error).
+    pub accept_unknown_scale: bool,
+    /// The structural analysis's rank tolerance ([`IdentifiabilityOptions::rank_tolerance`]).
+    pub rank_tolerance: f64,
+    /// A singular value of the column-scaled Jacobian below this times the largest is a
+    /// direction the data do not see.
+    pub weak_tolerance: f64,
+    /// Most Levenberg-Marquardt iterations per fit.
+    pub max_iterations: usize,
+}
+
+impl Default for ConstraintOptions {
+    fn default() -> Self {
+        ConstraintOptions {
+            accept_unknown_scale: false,
+            rank_tolerance: crate::identification::identifiability::DEFAULT_RANK_TOLERANCE,
+            weak_tolerance: 1e-5,
+            max_iterations: 200,
+        }
+    }
+}
+
+impl ConstraintOptions {
+    /// Rejects tolerances outside (0, 1) and zero iterations.
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("rank_tolerance", self.rank_tolerance),
+            ("weak_tolerance", self.weak_tolerance),
+        ] {
+            if !(v > 0.0 && v < 1.0) {
+                return Err(Error::invalid(name, format!("{v} is not within (0, 1)")));
+            }
+        }
+        if self.max_iterations == 0 {
+            return Err(Error::invalid("max_iterations", "must be at least 1"));
+        }
+        Ok(())
+    }
+}
+
+/// Where the calibration's length scale comes from.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Scale {
+    /// From the data: known distances and/or spheres of known radius.
+    Known {
+        /// What gives it (`3 known distances, sphere S's radius`).
+        from: String,
+    },
+    /// Not determined: held by a link length kept at its nominal value (accepted explicitly).
+    Assumed {
+        /// The parameter held.
+        held: Param,
+    },
+}
+
+/// A robot parameter the calibration did not identify, with why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fixed {
+    /// The parameter.
+    pub param: Param,
+    /// Why it is held at its nominal value.
+    pub reason: String,
+}
+
+/// The result of a constraint calibration.
+#[derive(Debug, Clone)]
+pub struct ConstraintCalibration {
+    /// The calibrated robot (geometric model; base frame as the nominal's).
+    pub robot: Robot,
+    /// The robot parameters identified.
+    pub identified: Vec<Param>,
+    /// The robot parameters held at their nominal values, with why.
+    pub fixed: Vec<Fixed>,
+    /// The features as estimated (base frame of the calibrated model).
+    pub features: Vec<FeatureEstimate>,
+    /// Where the scale comes from.
+    pub scale: Scale,
+    /// Directions the data cannot see, in words (always the base pose first).
+    pub unseen: Vec<String>,
+    /// RMS of the rows' residuals (mm; a point row's residual is the 3-vector's norm).
+    pub residual_rms_mm: f64,
+    /// Largest row residual (mm).
+    pub residual_max_mm: f64,
+    /// Each feature's RMS residual (mm), in feature order.
+    pub feature_rms_mm: Vec<f64>,
+    /// Each known distance's residual, fitted minus given (mm), in file order.
+    pub distance_residuals_mm: Vec<f64>,
+    /// Condition number of the column-scaled Jacobian of the final fit.
+    pub condition_number: f64,
+    /// How the final fit ended.
+    pub fit: FitReport,
+    /// The plausibility gate's failed checks, adapted to constraint data (empty: passed): a
+    /// parameter moved beyond its plausible range
+    /// ([`crate::model::family::plausible`]), a sphere's radius or a feature's distance from
+    /// the base beyond what the robot could touch.
+    pub implausible: Vec<String>,
+}
+
+/// What every result says about its frame.
+pub const UP_TO_BASE: &str = "the base pose (6 degrees of freedom): constraint data have no \
+     reference frame (the fixed features sit at unknown places, which take up any move of the \
+     base), so the base frame is held at its nominal value and the calibration is up to the \
+     base pose: positions are right relative to each other and to the constrained features, not \
+     absolutely";
+
+/// Calibrates `nominal`'s geometric model from constraint data (see the module docs).
+pub fn calibrate_constraints(
+    nominal: &Robot,
+    data: &ConstraintData,
+    opts: &ConstraintOptions,
+) -> Result<ConstraintCalibration> {
+    opts.validate()?;
+    if data.rows.is_empty() {
+        return Err(Error::invalid("constraint data", "no rows"));
+    }
+    if data.dof != nominal.dof() {
+        return Err(Error::JointCount {
+            context: data.describe(0),
+            expected: nominal.dof(),
+            got: data.dof,
+        });
+    }
+    data.check_counts()?;
+    let mut robot = nominal.geometric();
+    let mut features = start_values(&robot, data)?;
+    let scale =
+        match scale_source(data) {
+            Some(from) => Scale::Known { from },
+            None if opts.accept_unknown_scale => Scale::Assumed {
+                held: longest_length(&robot)?,
+            },
+            None => return Err(Error::Numerical(
+                "the robot's scale is not determined by these data: scaling every length of the \
+                 robot and of the features leaves every residual unchanged, so the model could be \
+                 off by millimetres while the residuals look perfect. Add a known distance \
+                 between two fixed points or sphere centres (a distances file: from,to,\
+                 distance_mm), or a sphere of known radius (its radius_mm), or accept a result \
+                 up to scale explicitly"
+                    .into(),
+            )),
+        };
+    let (mut identified, mut fixed) = structural(&robot, data, opts)?;
+    if let Scale::Assumed { held } = &scale {
+        identified.retain(|p| p != held);
+        fixed.push(Fixed {
+            param: *held,
+            reason: "holds the robot's scale (no known distance or radius: the result is up to \
+                     scale, accepted explicitly)"
+                .into(),
+        });
+    }
+    let mut unseen = vec![UP_TO_BASE.to_string()];
+    if let Scale::Assumed { held } = &scale {
+        unseen.push(format!(
+            "the robot's scale: no known length in the data; {} is held at its nominal value",
+            held.name()
+        ));
+    }
+    // Fit; fix what the data turn out not to see; fit again.
+    let start_robot = robot.clone();
+    let start_features = features.clone();
+    loop {
+        robot = start_robot.clone();
+        features = start_features.clone();
+        let layout = Layout::new(&robot, &identified, &features);
+        let report = fit::solve(
+            &mut robot,
+            &layout,
+            data,
+            &mut features,
+            opts.max_iterations,
+        )?;
+        let (e, j) = fit::evaluate(&robot, &layout, data, &features, true);
+        let j = j.expect("asked for");
+        let (cond, weak) = weakest(&j, opts.weak_tolerance);
+        if let Some(v) = weak {
+            // The robot parameter with the largest share of the unseen direction.
+            let Some((c, _)) = (0..identified.len())
+                .map(|c| (c, v[c].abs()))
+                .max_by(|a, b| a.1.total_cmp(&b.1))
+                .filter(|(_, w)| *w > 1e-3)
+            else {
+                return Err(Error::Numerical(format!(
+                    "the features' own parameters are not determined by these data (condition \
+                     number {cond:.3e}); {}",
+                    feature_advice(&features)
+                )));
+            };
+            let p = identified.remove(c);
+            let mut others: Vec<(String, f64)> = (0..layout.n)
+                .filter(|&k| k != c && v[k].abs() > 0.1 * v[c].abs())
+                .map(|k| (column_name(&layout, &features, k), v[k].abs()))
+                .collect();
+            others.sort_by(|a, b| b.1.total_cmp(&a.1));
+            let with: Vec<String> = others.into_iter().take(4).map(|o| o.0).collect();
+            let reason = format!(
+                "not seen by these constraints{}{}",
+                if with.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (its effect is nearly that of {})", with.join(", "))
+                },
+                if features
+                    .iter()
+                    .all(|f| f.kind == crate::observations::constraint::ConstraintKind::Plane)
+                {
+                    "; a plane sees the tool point only along its normal"
+                } else {
+                    ""
+                }
+            );
+            unseen.push(format!("{}: {reason}", p.name()));
+            fixed.push(Fixed { param: p, reason });
+            if identified.is_empty() {
+                return Err(Error::Numerical(
+                    "the constraints determine none of the robot's parameters".into(),
+                ));
+            }
+            continue;
+        }
+        let mut norms = Vec::with_capacity(data.rows.len());
+        let mut per_feature = vec![(0.0, 0usize); features.len()];
+        let mut row = 0;
+        for r in &data.rows {
+            let k = features[r.feature].rows();
+            let n = e.rows(row, k).norm();
+            row += k;
+            norms.push(n);
+            per_feature[r.feature].0 += n * n;
+            per_feature[r.feature].1 += 1;
+        }
+        let distance_residuals_mm = e.as_slice()[row..].to_vec();
+        let implausible = gate(&start_robot, &robot, &features);
+        let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+        return Ok(ConstraintCalibration {
+            robot,
+            identified,
+            fixed,
+            residual_rms_mm: rms(&norms),
+            residual_max_mm: norms.iter().cloned().fold(0.0, f64::max),
+            feature_rms_mm: per_feature
+                .iter()
+                .map(|(s, n)| (s / (*n).max(1) as f64).sqrt())
+                .collect(),
+            features,
+            scale,
+            unseen,
+            distance_residuals_mm,
+            condition_number: cond,
+            fit: report,
+            implausible,
+        });
+    }
+}
+
+/// The plausibility gate on constraint data: each identified parameter's move within its
+/// family's plausible range, each feature within twice the robot's reach of the base, each
+/// sphere's radius below the reach.
+fn gate(start: &Robot, robot: &Robot, features: &[FeatureEstimate]) -> Vec<String> {
+    let mut out = Vec::new();
+    for &p in start.param_list() {
+        let (was, now) = (start.get_display(p), robot.get_display(p));
+        let range = crate::model::family::plausible::of(start, p);
+        let u = p.unit().as_str();
+        if (now - was).abs() > range.max_move || !range.contains(now) {
+            out.push(format!(
+                "{} moved from {was:.4} to {now:.4} {u}, beyond its plausible range ({})",
+                p.name(),
+                range.why
+            ));
+        }
+    }
+    let reach = robot.reach_mm();
+    for f in features {
+        if f.position.norm() > 2.0 * reach {
+            out.push(format!(
+                "{} is {:.0} mm from the base, beyond twice the robot's reach ({reach:.0} mm)",
+                f.label(),
+                f.position.norm()
+            ));
+        }
+        if let Some(r) = f
+            .radius_mm
+            .filter(|r| r.is_nan() || *r <= 0.0 || *r >= reach)
+        {
+            out.push(format!(
+                "{}'s radius {r:.3} mm is not between 0 and the robot's reach",
+                f.label()
+            ));
+        }
+    }
+    out
+}
+
+/// The features' start values from the nominal tool points of their rows.
+fn start_values(robot: &Robot, data: &ConstraintData) -> Result<Vec<FeatureEstimate>> {
+    data.features
+        .iter()
+        .enumerate()
+        .map(|(k, f)| {
+            let pts: Vec<_> = data.rows_of(k).map(|r| robot.tool_position(&r.q)).collect();
+            FeatureEstimate::start(f.kind, &f.name, f.radius_mm, &pts)
+                .map_err(|m| data.parse_error(f.first_line, CONSTRAINT_COLUMN, m))
+        })
+        .collect()
+}
+
+/// What gives the data a length scale, if anything.
+fn scale_source(data: &ConstraintData) -> Option<String> {
+    let mut from = Vec::new();
+    if !data.distances.is_empty() {
+        from.push(format!(
+            "{} known distance{}",
+            data.distances.len(),
+            if data.distances.len() == 1 { "" } else { "s" }
+        ));
+    }
+    for f in &data.features {
+        if let Some(r) = f.radius_mm {
+            from.push(format!("sphere {}'s radius {r} mm", f.name));
+        }
+    }
+    (!from.is_empty()).then(|| from.join(", "))
+}
+
+/// The robot's longest link length (`a` or `d`): the one held when the scale is accepted as
+/// unknown.
+fn longest_length(robot: &Robot) -> Result<Param> {
+    robot
+        .param_list()
+        .iter()
+        .filter(|p| p.family_id() == Param::d(0).family_id() && p.unit() == Unit::Mm)
+        .max_by(|a, b| robot.get(**a).abs().total_cmp(&robot.get(**b).abs()))
+        .copied()
+        .ok_or_else(|| Error::invalid("robot", "has no link length to hold the scale"))
+}
+
+/// The structural analysis: the parameters tool points could identify (linearized at zero
+/// residual), less the base frame and what duplicates it.
+fn structural(
+    robot: &Robot,
+    data: &ConstraintData,
+    opts: &ConstraintOptions,
+) -> Result<(Vec<Param>, Vec<Fixed>)> {
+    let mut obs = Observations::new(robot.dof());
+    for r in &data.rows {
+        obs.push(&r.q, robot.tool_position(&r.q), r.line)?;
+    }
+    let id = analyze(
+        robot,
+        &obs,
+        &IdentifiabilityOptions {
+            rank_tolerance: opts.rank_tolerance,
+            ..IdentifiabilityOptions::default()
+        },
+    )?;
+    let base = Param::base(0).family_id();
+    let mut fixed: Vec<Fixed> = Vec::new();
+    let mut identified = Vec::new();
+    for p in &id.identified {
+        if p.family_id() == base {
+            fixed.push(Fixed {
+                param: *p,
+                reason: "base frame: no reference in constraint data (the result is up to the \
+                         base pose)"
+                    .into(),
+            });
+        } else {
+            identified.push(*p);
+        }
+    }
+    for f in &id.fixed {
+        let mut reason = f.describe();
+        if let crate::identification::identifiability::FixReason::Duplicate { of, .. } = &f.reason {
+            if of.iter().any(|(q, _)| q.family_id() == base) {
+                reason.push_str(" (moves like the base frame, which constraint data cannot see)");
+            }
+        }
+        fixed.push(Fixed {
+            param: f.param,
+            reason,
+        });
+    }
+    Ok((identified, fixed))
+}
+
+/// The condition number of `j` with unit columns and, when its smallest singular value is below
+/// `tol` times the largest, that direction (in the unscaled unknowns' columns order, unit norm
+/// in scaled units).
+fn weakest(j: &DMatrix<f64>, tol: f64) -> (f64, Option<Vec<f64>>) {
+    let n = j.ncols();
+    let norms: Vec<f64> = (0..n).map(|c| j.column(c).norm()).collect();
+    let js = DMatrix::from_fn(j.nrows(), n, |r, c| {
+        if norms[c] > 0.0 {
+            j[(r, c)] / norms[c]
+        } else {
+            0.0
+        }
+    });
+    let svd = js.svd(false, true);
+    let s = &svd.singular_values;
+    let (imin, smin) = s.argmin();
+    let smax = s.max();
+    let cond = if smin > 0.0 {
+        smax / smin
+    } else {
+        f64::INFINITY
+    };
+    if smin > tol * smax {
+        return (cond, None);
+    }
+    let vt = svd.v_t.expect("asked for");
+    (cond, Some(vt.row(imin).iter().copied().collect()))
+}
+
+/// The name of unknown `k` of a fit.
+fn column_name(layout: &Layout, features: &[FeatureEstimate], k: usize) -> String {
+    if k < layout.params.len() {
+        return layout.params[k].name();
+    }
+    for (f, &c0) in features.iter().zip(&layout.feature_col) {
+        if (c0..c0 + f.param_count()).contains(&k) {
+            return f.param_names()[k - c0].clone();
+        }
+    }
+    format!("unknown {k}")
+}
+
+/// What to change when the features themselves are undetermined.
+fn feature_advice(features: &[FeatureEstimate]) -> String {
+    let kinds: Vec<&str> = features.iter().map(|f| f.kind.key()).collect();
+    format!(
+        "the data's features ({}) need configurations that differ in orientation as well as in \
+         position",
+        kinds.join(", ")
+    )
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,342 @@
+//! Simulated constraint data (issue 31): the true robot brings its tool point to fixed points,
+//! onto spheres or onto planes from varied orientations, each configuration found by inverse
+//! kinematics on the true robot ([`Compensator::reach_pose`]); the contact carries probe noise
+//! and the robot's repeatability (`noise_mm`, Gaussian per axis at the contact). Each feature is
+//! placed where a random reference configuration of the true robot puts its tool point, so it
+//! is reachable; the orientations spread up to `tilt_deg` about the reference's.
+
+use crate::compensation::{Compensator, DampedLeastSquares};
+use crate::error::{Error, Result};
+use crate::frame::Frame;
+use crate::io::{Measurement, MeasurementSet};
+use crate::model::Robot;
+use crate::observations::constraint::{ConstraintData, ConstraintKind, KnownDistance};
+use crate::registration::rigid::fit_rigid;
+use crate::simulation::{random_poses, PoseSampler};
+use nalgebra::{Rotation3, Translation3, Vector3};
+use rand::{Rng, SeedableRng};
+use rand_distr::{Distribution, StandardNormal};
+
+/// What to simulate.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConstraintSimulation {
+    /// The kind of feature.
+    pub kind: ConstraintKind,
+    /// How many features (points, spheres or planes).
+    pub features: usize,
+    /// Configurations per feature.
+    pub per_feature: usize,
+    /// 1-sigma noise of the contact per axis (mm): probe and repeatability.
+    pub noise_mm: f64,
+    /// A sphere's radius (mm).
+    pub radius_mm: f64,
+    /// Whether the sphere's radius is written to the data (known) or left empty.
+    pub radius_known: bool,
+    /// Largest tilt of the tool's orientation from the reference configuration's (degrees).
+    pub tilt_deg: f64,
+    /// A plane's touched region: a square of this half-size (mm) about the reference point; a
+    /// sphere's: contacts within this angle (degrees) of the reference direction, as
+    /// `span_mm / radius_mm` radians capped at 80 degrees.
+    pub span_mm: f64,
+    /// Give the distances between every pair of points or sphere centres.
+    pub distances: bool,
+    /// Seed of every random draw.
+    pub seed: u64,
+}
+
+impl Default for ConstraintSimulation {
+    fn default() -> Self {
+        ConstraintSimulation {
+            kind: ConstraintKind::Point,
+            features: 4,
+            per_feature: 20,
+            noise_mm: 0.01,
+            radius_mm: 25.0,
+            radius_known: true,
+            tilt_deg: 60.0,
+            span_mm: 300.0,
+            distances: true,
+            seed: 1,
+        }
+    }
+}
+
+impl ConstraintSimulation {
+    /// Rejects counts of zero, too few rows per feature, and lengths, noise or angles outside
+    /// their ranges.
+    pub fn validate(&self) -> Result<()> {
+        if self.features == 0 {
+            return Err(Error::invalid("features", "must be at least 1"));
+        }
+        if self.per_feature < self.kind.min_rows() {
+            return Err(Error::invalid(
+                "per_feature",
+                format!(
+                    "{} is fewer than a {} needs ({})",
+                    self.per_feature,
+                    self.kind.key(),
+                    self.kind.min_rows()
+                ),
+            ));
+        }
+        if !(self.noise_mm >= 0.0 && self.noise_mm <= 10.0) {
+            return Err(Error::invalid(
+                "noise_mm",
+                format!("{} is not within 0..10 mm", self.noise_mm),
+            ));
+        }
+        if !(self.radius_mm > 0.0 && self.radius_mm <= 1000.0) {
+            return Err(Error::invalid(
+                "radius_mm",
+                format!("{} is not within (0, 1000] mm", self.radius_mm),
+            ));
+        }
+        if !(self.tilt_deg >= 0.0 && self.tilt_deg <= 90.0) {
+            return Err(Error::invalid(
+                "tilt_deg",
+                format!("{} is not within 0..90 degrees", self.tilt_deg),
+            ));
+        }
+        if !(self.span_mm > 0.0 && self.span_mm <= 5000.0) {
+            return Err(Error::invalid(
+                "span_mm",
+                format!("{} is not within (0, 5000] mm", self.span_mm),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Simulated constraint data with the truth behind it.
+#[derive(Debug, Clone)]
+pub struct SimulatedConstraints {
+    /// The rows (and known distances, when asked).
+    pub data: ConstraintData,
+    /// Each feature's true position (point, sphere centre, or plane's reference point), in the
+    /// true robot's base frame (mm).
+    pub true_positions: Vec<Vector3<f64>>,
+    /// Each plane's true unit normal (None for points and spheres).
+    pub true_normals: Vec<Option<Vector3<f64>>>,
+}
+
+/// Reference configurations tried per feature before giving up.
+const REFERENCE_TRIES: usize = 50;
+
+/// Simulates `spec` on the true robot `truth`, reference configurations drawn by `sampler`.
+pub fn simulate_constraints(
+    truth: &Robot,
+    sampler: &PoseSampler,
+    spec: &ConstraintSimulation,
+) -> Result<SimulatedConstraints> {
+    spec.validate()?;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(spec.seed);
+    let mut ik = Compensator::new(truth, truth, DampedLeastSquares::default())?;
+    // Contacts to rounding: noise-free data must be exact.
+    ik.pose_solver.tolerance_mm = 1e-10;
+    ik.pose_solver.tolerance_deg = 1e-9;
+    let mut data = ConstraintData::new(truth.dof());
+    let mut true_positions = Vec::new();
+    let mut true_normals = Vec::new();
+    for k in 0..spec.features {
+        let mut done = None;
+        for _ in 0..REFERENCE_TRIES {
+            let q0 = random_poses(truth, 1, sampler, &mut rng)?.remove(0);
+            if let Some(found) = feature_rows(truth, &ik, &q0, spec, &mut rng) {
+                done = Some(found);
+                break;
+            }
+        }
+        let Some((rows, position, normal)) = done else {
+            return Err(Error::Numerical(format!(
+                "simulation: no reference configuration in {REFERENCE_TRIES} draws from which the \
+                 robot reaches a {} in {} orientations (lower the tilt or the span)",
+                spec.kind.key(),
+                spec.per_feature
+            )));
+        };
+        let name = format!(
+            "{}{}",
+            spec.kind
+                .key()
+                .to_ascii_uppercase()
+                .chars()
+                .next()
+                .unwrap_or('F'),
+            k + 1
+        );
+        let radius =
+            (spec.kind == ConstraintKind::Sphere && spec.radius_known).then_some(spec.radius_mm);
+        let f = data
+            .feature_index(spec.kind, &name, radius, 0)
+            .map_err(|(_, m)| Error::invalid("simulation", m))?;
+        for q in rows {
+            data.push(q, f, 0)?;
+        }
+        true_positions.push(position);
+        true_normals.push(normal);
+    }
+    if spec.distances && spec.kind != ConstraintKind::Plane {
+        for a in 0..spec.features {
+            for b in a + 1..spec.features {
+                data.distances.push(KnownDistance {
+                    from: a,
+                    to: b,
+                    distance_mm: (true_positions[a] - true_positions[b]).norm(),
+                    line: 0,
+                });
+            }
+        }
+    }
+    Ok(SimulatedConstraints {
+        data,
+        true_positions,
+        true_normals,
+    })
+}
+
+/// A random rotation of at most `max_deg` about a uniformly random axis.
+fn random_tilt<R: Rng>(rng: &mut R, max_deg: f64) -> Rotation3<f64> {
+    let axis = random_unit(rng);
+    let angle = max_deg.to_radians() * rng.gen::<f64>();
+    Rotation3::from_scaled_axis(axis * angle)
+}
+
+fn random_unit<R: Rng>(rng: &mut R) -> Vector3<f64> {
+    loop {
+        let v = Vector3::from_fn(|_, _| StandardNormal.sample(rng));
+        let n: f64 = v.norm();
+        if n > 1e-9 {
+            return v / n;
+        }
+    }
+}
+
+/// The rows of one feature from reference configuration `q0`: `None` when the robot cannot
+/// reach every contact from there.
+#[allow(clippy::type_complexity)]
+fn feature_rows<R: Rng>(
+    truth: &Robot,
+    ik: &Compensator<'_>,
+    q0: &[f64],
+    spec: &ConstraintSimulation,
+    rng: &mut R,
+) -> Option<(Vec<Vec<f64>>, Vector3<f64>, Option<Vector3<f64>>)> {
+    let t0 = truth.tool_pose(q0);
+    let r0 = t0.rotation;
+    let p0 = t0.translation.vector;
+    let z0 = r0.matrix().column(2).into_owned();
+    let (position, normal) = match spec.kind {
+        ConstraintKind::Point => (p0, None),
+        ConstraintKind::Sphere => (p0 - spec.radius_mm * z0, None),
+        ConstraintKind::Plane => (p0, Some(z0)),
+    };
+    let (t1, t2) = crate::identification::constraint::features::tangents(&z0);
+    let cone = (spec.span_mm / spec.radius_mm).min(80f64.to_radians());
+    let mut rows = Vec::with_capacity(spec.per_feature);
+    let mut q = vec![0.0; truth.dof()];
+    let mut misses = 0;
+    while rows.len() < spec.per_feature {
+        let contact = match spec.kind {
+            ConstraintKind::Point => p0,
+            ConstraintKind::Sphere => {
+                let phi = rng.gen::<f64>() * std::f64::consts::TAU;
+                // Uniform over the spherical cap of half-angle `cone`.
+                let cos_t = 1.0 - rng.gen::<f64>() * (1.0 - cone.cos());
+                let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+                let u = cos_t * z0 + sin_t * (phi.cos() * t1 + phi.sin() * t2);
+                position + spec.radius_mm * u
+            }
+            ConstraintKind::Plane => {
+                let a = (2.0 * rng.gen::<f64>() - 1.0) * spec.span_mm;
+                let b = (2.0 * rng.gen::<f64>() - 1.0) * spec.span_mm;
+                p0 + a * t1 + b * t2
+            }
+        };
+        let noise = Vector3::from_fn(|_, _| {
+            let z: f64 = StandardNormal.sample(rng);
+            spec.noise_mm * z
+        });
+        let rot = random_tilt(rng, spec.tilt_deg) * r0;
+        let target = Frame::from_parts(Translation3::from(contact + noise), rot);
+        let rep = ik.reach_pose(&target, Some(q0), &mut q);
+        let at = truth.tool_position(&q);
+        if rep.status.reaches_target()
+            && truth.joints_outside_limits(&q).is_empty()
+            && (at - (contact + noise)).norm() < 1e-6
+        {
+            rows.push(q.clone());
+        } else {
+            misses += 1;
+            if misses > 4 * spec.per_feature {
+                return None;
+            }
+        }
+    }
+    Some((rows, position, normal))
+}
+
+/// The measurement file of simulated constraint data: joints, `constraint` and (for spheres)
+/// `radius_mm` columns, no `x,y,z`.
+pub fn constraint_measurements(robot: &Robot, data: &ConstraintData) -> MeasurementSet {
+    let spheres = data
+        .features
+        .iter()
+        .any(|f| f.kind == ConstraintKind::Sphere);
+    let mut extra_columns = vec![crate::observations::constraint::CONSTRAINT_COLUMN.to_string()];
+    if spheres {
+        extra_columns.push(crate::observations::constraint::RADIUS_COLUMN.to_string());
+    }
+    let rows = data
+        .rows
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let f = &data.features[r.feature];
+            let mut extra = vec![f.label()];
+            if spheres {
+                extra.push(f.radius_mm.map_or(String::new(), |v| format!("{v}")));
+            }
+            Measurement {
+                line: i + 2,
+                q: r.q.clone(),
+                p: None,
+                extra,
+            }
+        })
+        .collect();
+    MeasurementSet {
+        path: std::path::PathBuf::new(),
+        joints: robot.joint_space().clone(),
+        extra_columns,
+        rows,
+        warnings: Vec::new(),
+    }
+}
+
+/// The distances file of `data` (`from,to,distance_mm`, 6 decimals).
+pub fn distances_csv(data: &ConstraintData) -> String {
+    let mut s = String::from("from,to,distance_mm\n");
+    for d in &data.distances {
+        s.push_str(&format!(
+            "{},{},{:.6}\n",
+            data.features[d.from].name, data.features[d.to].name, d.distance_mm
+        ));
+    }
+    s
+}
+
+/// The error of a model against the true robot at `poses` after the best rigid alignment of
+/// the model's tool points onto the truth's (a constraint calibration is up to the base pose):
+/// mean and largest distance (mm).
+pub fn aligned_model_error(model: &Robot, truth: &Robot, poses: &[Vec<f64>]) -> Result<(f64, f64)> {
+    let m: Vec<Vector3<f64>> = poses.iter().map(|q| model.tool_position(q)).collect();
+    let t: Vec<Vector3<f64>> = poses.iter().map(|q| truth.tool_position(q)).collect();
+    let f = fit_rigid(&m, &t, None)?;
+    let d: Vec<f64> = m
+        .iter()
+        .zip(&t)
+        .map(|(a, b)| (f.to_base(a) - b).norm())
+        .collect();
+    let mean = d.iter().sum::<f64>() / d.len().max(1) as f64;
+    Ok((mean, d.iter().cloned().fold(0.0, f64::max)))
+}

@@ -1,0 +1,239 @@
+//! `calibrate` on constraint data (issue 31): a measurement file with a `constraint` column
+//! (fixed points, spheres, planes; no `x,y,z`) and, with `--distances`, known distances between
+//! points or sphere centres. The robot's geometric model and the features are fitted together
+//! in the robot's base frame ([`robocal_core::identification::constraint`]); the result is up
+//! to the base pose, and says so.
+
+use super::Settings;
+use crate::cmd::common;
+use crate::exit;
+use robocal_core::identification::constraint::{
+    calibrate_constraints, ConstraintCalibration, ConstraintOptions, Scale,
+};
+use robocal_core::io::joint_limits::OutsideLimits;
+use robocal_core::io::measurements::MeasurementReader;
+use robocal_core::io::{read_measurements, Positions};
+use robocal_core::model::Robot;
+use robocal_core::observations::constraint::{
+    read_distances, ConstraintData, ConstraintKind, CONSTRAINT_COLUMN,
+};
+use serde_json::json;
+use std::path::Path;
+
+/// Whether the measurement file at `path` holds constraint rows (its header has a
+/// `constraint` column).
+pub(super) fn is_constraint_file(path: &Path, robot: &Robot) -> anyhow::Result<bool> {
+    let r = MeasurementReader::open(path, robot.joint_space(), Positions::Ignored)?;
+    Ok(r.extra_columns()
+        .iter()
+        .any(|c| c.eq_ignore_ascii_case(CONSTRAINT_COLUMN)))
+}
+
+/// Reads, calibrates, prints and writes a constraint calibration.
+pub(super) fn run(
+    s: &Settings,
+    distances: Option<&Path>,
+    accept_unknown_scale: bool,
+) -> anyhow::Result<()> {
+    if s.validate.is_some() {
+        return Err(exit::usage(
+            "--validate: constraint data have no tracker points to validate against (not \
+             supported with a constraint file)",
+        ));
+    }
+    let robot = &s.robot;
+    let set = read_measurements(&s.data, robot.joint_space(), Positions::Ignored)?;
+    for w in &set.warnings {
+        errln!("warning: {w}")?;
+    }
+    let mut o = OutsideLimits::new(robot, &s.data);
+    for r in &set.rows {
+        o.check(r.line, &r.q);
+    }
+    common::check_limits(o, s.nominal_limits, &mut Vec::new())?;
+    let mut data = ConstraintData::from_measurements(&set)?;
+    if let Some(d) = distances {
+        data.distances = read_distances(d, &data)?;
+    }
+    let count = |k: ConstraintKind| data.features.iter().filter(|f| f.kind == k).count();
+    outln!(
+        "robot {} ({} joints); {} constraint row(s): {} fixed point(s), {} sphere(s), {} \
+         plane(s); {} known distance(s)",
+        robot.name(),
+        robot.dof(),
+        data.rows.len(),
+        count(ConstraintKind::Point),
+        count(ConstraintKind::Sphere),
+        count(ConstraintKind::Plane),
+        data.distances.len()
+    )?;
+    let opts = ConstraintOptions {
+        accept_unknown_scale,
+        rank_tolerance: s.calibration.identifiability.rank_tolerance,
+        ..ConstraintOptions::default()
+    };
+    let cal = calibrate_constraints(robot, &data, &opts).map_err(|e| {
+        let hint = if data.has_known_length() {
+            ""
+        } else {
+            " (--distances FILE with from,to,distance_mm; or radius_mm on a sphere's rows; or \
+             --accept-unknown-scale)"
+        };
+        anyhow::Error::new(e).context(format!("calibrating from {}{hint}", s.data.display()))
+    })?;
+    print(robot, &cal)?;
+    if !cal.fit.converged {
+        return Err(exit::numerical(format!(
+            "the constraint fit did not converge in {} iterations; nothing written to {}",
+            cal.fit.iterations,
+            s.out.display()
+        )));
+    }
+    let mut json = result_json(s, &cal, &data);
+    if !cal.implausible.is_empty() {
+        let summary = common::indent(&cal.implausible.join("\n"));
+        if !s.accept_implausible {
+            return Err(exit::implausible(format!(
+                "implausible fit: the constraint fit converged, but the result cannot be a \
+                 calibration; nothing written to {}. Failed checks:\n{summary}\n(fix the data \
+                 or the robot; --accept-implausible writes it anyway, marked \"status\": \
+                 \"implausible\")",
+                s.out.display()
+            )));
+        }
+        json["status"] = "implausible".into();
+        json["implausible"] = cal.implausible.clone().into();
+        errln!(
+            "WARNING: IMPLAUSIBLE FIT WRITTEN (--accept-implausible): failed checks:\n{summary}"
+        )?;
+    }
+    let bytes = serde_json::to_vec_pretty(&json)?;
+    robocal_core::io::atomic::write_atomic(&s.out, &bytes)?;
+    outln!("result written to {}", s.out.display())?;
+    Ok(())
+}
+
+/// The table of parameters, the features and what the data cannot see.
+fn print(nominal: &Robot, cal: &ConstraintCalibration) -> anyhow::Result<()> {
+    outln!(
+        "fit: {} iteration(s), residual RMS {:.4} mm, max {:.4} mm, condition number {:.0}",
+        cal.fit.iterations,
+        cal.residual_rms_mm,
+        cal.residual_max_mm,
+        cal.condition_number
+    )?;
+    outln!(
+        "{:<10} {:>14} {:>14} {:>12}",
+        "parameter",
+        "nominal",
+        "calibrated",
+        "change"
+    )?;
+    for p in &cal.identified {
+        let u = p.unit().as_str();
+        let (was, now) = (nominal.get_display(*p), cal.robot.get_display(*p));
+        outln!(
+            "{:<10} {:>14.6} {:>14.6} {:>9.6} {u}",
+            p.name(),
+            was,
+            now,
+            now - was
+        )?;
+    }
+    outln!("features (base frame of the calibrated model):")?;
+    for (f, rms) in cal.features.iter().zip(&cal.feature_rms_mm) {
+        let p = f.position;
+        let extra = match (f.kind, f.radius_mm, f.normal) {
+            (ConstraintKind::Sphere, Some(r), _) => format!(
+                ", radius {r:.4} mm{}",
+                if f.radius_known { " (given)" } else { "" }
+            ),
+            (ConstraintKind::Plane, _, Some(n)) => format!(
+                ", normal ({:.6}, {:.6}, {:.6}), offset {:.4} mm",
+                n.x,
+                n.y,
+                n.z,
+                f.offset_mm.unwrap_or(0.0)
+            ),
+            _ => String::new(),
+        };
+        outln!(
+            "  {:<16} ({:.4}, {:.4}, {:.4}) mm{extra}; residual RMS {rms:.4} mm",
+            f.label(),
+            p.x,
+            p.y,
+            p.z
+        )?;
+    }
+    for d in &cal.distance_residuals_mm {
+        outln!("  known distance residual {d:+.4} mm")?;
+    }
+    match &cal.scale {
+        Scale::Known { from } => outln!("scale: from {from}")?,
+        Scale::Assumed { held } => errln!(
+            "WARNING: the robot's scale is not determined by these data; {} is held at its \
+                 nominal value (--accept-unknown-scale): lengths may be off in proportion",
+            held.name()
+        )?,
+    }
+    outln!("not identifiable from these data:")?;
+    for u in &cal.unseen {
+        outln!("  - {u}")?;
+    }
+    for f in &cal.fixed {
+        outln!("  {:<10} held: {}", f.param.name(), f.reason)?;
+    }
+    Ok(())
+}
+
+/// The result file: what was identified, the features, what the data cannot see.
+fn result_json(
+    s: &Settings,
+    cal: &ConstraintCalibration,
+    data: &ConstraintData,
+) -> serde_json::Value {
+    let params: serde_json::Map<String, serde_json::Value> = cal
+        .robot
+        .param_list()
+        .iter()
+        .map(|p| (p.name(), json!(cal.robot.get_display(*p))))
+        .collect();
+    let features: Vec<serde_json::Value> = cal
+        .features
+        .iter()
+        .zip(&cal.feature_rms_mm)
+        .map(|(f, rms)| {
+            json!({
+                "label": f.label(),
+                "position_mm": [f.position.x, f.position.y, f.position.z],
+                "radius_mm": f.radius_mm,
+                "radius_given": f.radius_known,
+                "normal": f.normal.map(|n| [n.x, n.y, n.z]),
+                "offset_mm": f.offset_mm,
+                "residual_rms_mm": rms,
+            })
+        })
+        .collect();
+    json!({
+        "kind": "constraint-calibration",
+        "robot": s.robot_arg,
+        "data": s.data.display().to_string(),
+        "frame": "base frame of the nominal robot: the calibration is up to the base pose",
+        "rows": data.rows.len(),
+        "known_distances": data.distances.len(),
+        "scale": match &cal.scale {
+            Scale::Known { from } => json!({ "from": from }),
+            Scale::Assumed { held } => json!({ "assumed": true, "held": held.name() }),
+        },
+        "identified": cal.identified.iter().map(|p| p.name()).collect::<Vec<_>>(),
+        "fixed": cal.fixed.iter().map(|f| json!({ "param": f.param.name(), "reason": f.reason })).collect::<Vec<_>>(),
+        "unseen": cal.unseen,
+        "parameters": params,
+        "features": features,
+        "residual_rms_mm": cal.residual_rms_mm,
+        "residual_max_mm": cal.residual_max_mm,
+        "distance_residuals_mm": cal.distance_residuals_mm,
+        "condition_number": cal.condition_number,
+        "iterations": cal.fit.iterations,
+    })
+}
