@@ -4,15 +4,18 @@
 //! noise (probe and repeatability). Writes the measurement CSV (`constraint`, `radius_mm`, no
 //! `x,y,z`) and, with `--distances-out`, the true distances between the points or centres.
 
-use super::{truth_arg, SimulateArgs};
+use super::SimulateArgs;
 use crate::exit;
+use anyhow::Context;
 use robocal_core::io::measurements::measurements_csv;
 use robocal_core::io::write_all_atomic;
 use robocal_core::observations::constraint::ConstraintKind;
 use robocal_core::simulation::constraint::{
     constraint_measurements, distances_csv, simulate_constraints, ConstraintSimulation,
 };
-use robocal_core::simulation::{check_truth_matches, stream_rng, PoseSampler, Stream, TruthSpec};
+use robocal_core::simulation::{
+    check_truth_matches, stream_rng, GeometricErrors, PoseSampler, Stream, TruthSource,
+};
 
 /// Runs the constraint simulation of `a` (`a.constraint` is set).
 pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
@@ -28,10 +31,28 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
         ));
     }
     let nominal = super::common::robot(&a.robot)?;
-    let (truth, _) = truth_arg(a, &nominal)?;
+    let truth = TruthSource::from_arg(&a.truth, &nominal)
+        .with_context(|| format!("--truth {}", a.truth))?;
+    let random = matches!(truth, TruthSource::Random);
+    if !random
+        && (a.length_error_mm.is_some() || a.angle_error_deg.is_some() || a.tilt_parallel_axes)
+    {
+        return Err(exit::usage(
+            "--length-error-mm, --angle-error-deg and --tilt-parallel-axes apply only to --truth \
+             random",
+        ));
+    }
     let truth = match truth {
-        TruthSpec::Random(e) => e.apply(&nominal, &mut stream_rng(a.seed, Stream::Truth))?,
-        TruthSpec::Robot(t) => {
+        TruthSource::Random => {
+            let d = GeometricErrors::default();
+            let e = GeometricErrors {
+                length_sigma_mm: a.length_error_mm.unwrap_or(d.length_sigma_mm),
+                angle_sigma_deg: a.angle_error_deg.unwrap_or(d.angle_sigma_deg),
+                tilt_parallel_axes: a.tilt_parallel_axes,
+            };
+            e.apply(&nominal, &mut stream_rng(a.seed, Stream::Truth))?
+        }
+        TruthSource::Robot(t) | TruthSource::File { robot: t, .. } => {
             check_truth_matches(&nominal, &t)?;
             t
         }
