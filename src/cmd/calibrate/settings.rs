@@ -1,0 +1,359 @@
+//! `calibrate`'s flags turned into checked settings before any work (ripgrep's high-level
+//! arguments): the robot with its Hayati tilts and joint families, parameter names, weighting,
+//! the library's calibration settings, the files plan; and the reading of a measurement file.
+
+use super::super::io_plan::IoPlan;
+use super::super::{common, limits};
+use super::{CalibrateArgs, ModelArg, ObjectiveArg, RobustArg};
+use crate::exit;
+use robocal_core::identification::{
+    split_measurements, AutoFamilies, CalibrationSettings, IdentifiabilityOptions, ModelChoice,
+    Objective, RobustLoss, SolverOptions, DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
+};
+use robocal_core::io::joint_limits::OutsideLimits;
+use robocal_core::io::{read_measurements, Positions};
+use robocal_core::observations::{TrackerSigma, Weighting};
+use robocal_core::{Param, Robot};
+use std::path::{Path, PathBuf};
+
+/// The weighting of `--tracker-sigma` and `--orientation-weight`.
+pub(crate) fn weighting(
+    tracker_sigma: Option<&str>,
+    orientation_weight: Option<f64>,
+) -> anyhow::Result<Weighting> {
+    let mut w = Weighting::default();
+    let tracker_sigma: Vec<f64> = match tracker_sigma.map(str::trim) {
+        None => Vec::new(),
+        Some("off") => {
+            w.automatic = false;
+            Vec::new()
+        }
+        Some(text) => {
+            let v: Vec<f64> = text
+                .split(',')
+                .map(|t| t.trim().parse::<f64>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| {
+                    exit::usage(format!(
+                        "--tracker-sigma {text}: expected two numbers FIXED_MM,PER_M_MM (e.g. \
+                         0.0075,0.003) or `off`"
+                    ))
+                })?;
+            if v.len() != 2 {
+                return Err(exit::usage(format!(
+                    "--tracker-sigma: expected two numbers FIXED_MM,PER_M_MM (e.g. 0.0075,0.003), \
+                     got {}",
+                    v.len()
+                )));
+            }
+            v
+        }
+    };
+    if let [fixed, per_m] = tracker_sigma[..] {
+        let (fixed, per_m) = (&fixed, &per_m);
+        w.tracker = Some(TrackerSigma::new(*fixed, *per_m).map_err(|_| {
+            exit::usage(format!(
+                "--tracker-sigma {fixed},{per_m}: expected FIXED_MM,PER_M_MM, both non-negative \
+                 and at most 1000, not both zero (e.g. 0.0075,0.003)"
+            ))
+        })?);
+    }
+    if let Some(m) = orientation_weight {
+        if !(m > 0.0 && m.is_finite() && m <= 1e6) {
+            return Err(exit::usage(format!(
+                "--orientation-weight {m}: expected a positive number of mm per degree"
+            )));
+        }
+        w.mm_per_deg = m;
+    }
+    Ok(w)
+}
+
+/// Parses a list of parameter names, naming every unknown one at once.
+fn param_list(robot: &Robot, names: &[String], flag: &str) -> anyhow::Result<Vec<Param>> {
+    let mut out = Vec::new();
+    let mut unknown = Vec::new();
+    for n in names.iter().map(|n| n.trim()).filter(|n| !n.is_empty()) {
+        match robot.param_by_name(n) {
+            Ok(p) if !out.contains(&p) => out.push(p),
+            Ok(_) => {}
+            Err(_) => unknown.push(format!("`{n}`")),
+        }
+    }
+    if !unknown.is_empty() {
+        let known: Vec<String> = robot.params().iter().map(|p| p.name()).collect();
+        return Err(exit::usage(format!(
+            "{flag}: unknown parameter{} {} (robot `{}` has: {})",
+            if unknown.len() > 1 { "s" } else { "" },
+            unknown.join(", "),
+            robot.name(),
+            known.join(", ")
+        )));
+    }
+    Ok(out)
+}
+
+/// Applies `--beta`.
+fn apply_beta(robot: &mut Robot, arg: &str) -> anyhow::Result<Vec<usize>> {
+    match arg.trim() {
+        "none" | "" => Ok(Vec::new()),
+        "parallel" => Ok(robot.enable_beta_for_parallel_axes()),
+        list => {
+            let mut out = Vec::new();
+            for part in list.split(',') {
+                let j: usize = part.trim().parse().map_err(|_| {
+                    exit::usage(format!(
+                        "--beta: `{part}` is not `parallel`, `none` or a joint number"
+                    ))
+                })?;
+                if j == 0 || j > robot.dof() {
+                    return Err(exit::usage(format!(
+                        "--beta: joint {j} does not exist (robot `{}` has joints 1..{})",
+                        robot.name(),
+                        robot.dof()
+                    )));
+                }
+                robot.enable_beta(j - 1)?;
+                out.push(j - 1);
+            }
+            Ok(out)
+        }
+    }
+}
+
+/// A joint-family flag's joints (0-based, sorted, once each): `none` (or absent) none, `auto`
+/// those `auto` gives, else a comma list of joint numbers 1..dof.
+pub(super) fn joint_list(
+    flag: &str,
+    arg: Option<&str>,
+    robot: &Robot,
+    auto: impl FnOnce(&Robot) -> Vec<usize>,
+) -> anyhow::Result<Vec<usize>> {
+    let list = match arg.unwrap_or("none").trim() {
+        "none" | "" => return Ok(Vec::new()),
+        "auto" => return Ok(auto(robot)),
+        list => list,
+    };
+    let mut out = Vec::new();
+    for part in list.split(',') {
+        let j: usize = part.trim().parse().map_err(|_| {
+            exit::usage(format!(
+                "{flag}: `{part}` is not `auto`, `none` or a joint number"
+            ))
+        })?;
+        if j == 0 || j > robot.dof() {
+            return Err(exit::usage(format!(
+                "{flag}: joint {j} does not exist (robot `{}` has joints 1..{})",
+                robot.name(),
+                robot.dof()
+            )));
+        }
+        if !out.contains(&(j - 1)) {
+            out.push(j - 1);
+        }
+    }
+    out.sort_unstable();
+    Ok(out)
+}
+
+/// Applies `--compliance`, `--payload-kg` and `--harmonics`; returns the compliant joints
+/// (0-based).
+fn apply_joint_families(robot: &mut Robot, a: &CalibrateArgs) -> anyhow::Result<Vec<usize>> {
+    use robocal_core::model::family::{compliance, transmission};
+    let joints = joint_list(
+        "--compliance",
+        a.compliance.as_deref(),
+        robot,
+        compliance::auto_joints,
+    )?;
+    if a.payload_kg.is_some() && joints.is_empty() {
+        return Err(exit::usage(
+            "--payload-kg: the payload makes the joint compliances physical; give --compliance              auto or a list of joints too",
+        ));
+    }
+    if !joints.is_empty() {
+        compliance::enable(robot, &joints, a.payload_kg)
+            .map_err(|e| exit::usage(super::super::flags::cli_text(&e)))?;
+    }
+    let harmonics = a.harmonics.unwrap_or(0);
+    if harmonics > transmission::MAX_HARMONICS {
+        return Err(exit::usage(format!(
+            "--harmonics {harmonics}: at most {} harmonics per joint",
+            transmission::MAX_HARMONICS
+        )));
+    }
+    let all: Vec<usize> = (0..robot.dof()).collect();
+    transmission::enable(robot, &all, harmonics)
+        .map_err(|e| exit::usage(super::super::flags::cli_text(&e)))?;
+    Ok(joints)
+}
+
+/// Reads a measurement file and sorts its rows (see `split_measurements`). Rows outside the
+/// robot's joint limits are an error, or with --nominal-limits a warning, and are added to
+/// `outside`.
+pub(super) fn read(
+    path: &Path,
+    robot: &Robot,
+    nominal_limits: bool,
+    outside: &mut Vec<OutsideLimits>,
+) -> anyhow::Result<robocal_core::identification::SplitData> {
+    let set = read_measurements(path, robot.joint_space(), Positions::Required)?;
+    for w in &set.warnings {
+        errln!("warning: {w}")?;
+    }
+    let split = split_measurements(&set)?;
+    let mut o = OutsideLimits::new(robot, path);
+    for r in &set.rows {
+        o.check(r.line, &r.q);
+    }
+    common::check_limits(o, nominal_limits, outside)?;
+    Ok(split)
+}
+
+/// Everything `calibrate` needs, checked completely before any work (ripgrep's high-level
+/// arguments): ranges, parameter names, the robot, the files plan. The command body only reads
+/// it.
+pub(super) struct Settings {
+    /// The `--robot` argument as given (recorded in the result).
+    pub(super) robot_arg: String,
+    /// The nominal robot, with the Hayati tilts of `--beta`.
+    pub(super) robot: Robot,
+    /// The joints given a tilt parameter (0-based).
+    pub(super) betas: Vec<usize>,
+    pub(super) data: PathBuf,
+    pub(super) validate: Option<PathBuf>,
+    pub(super) nominal_limits: bool,
+    /// The library's settings: objective, identifiability, solver.
+    pub(super) calibration: CalibrationSettings,
+    pub(super) keep_partial: bool,
+    pub(super) accept_implausible: bool,
+    pub(super) out: PathBuf,
+}
+
+impl TryFrom<&CalibrateArgs> for Settings {
+    type Error = anyhow::Error;
+
+    fn try_from(a: &CalibrateArgs) -> anyhow::Result<Settings> {
+        limits::count(
+            "--max-iterations",
+            a.max_iterations,
+            1,
+            limits::MAX_CALIBRATION_ITERATIONS,
+            "a solver that has not converged by then will not",
+        )?;
+        if let Some(s) = a.robust_scale {
+            limits::magnitude("--robust-scale", s, limits::MAX_LENGTH_MM, "mm")?;
+        }
+        let mut robot = common::robot(&a.robot)?;
+        let betas = apply_beta(&mut robot, &a.beta)?;
+        let compliant = apply_joint_families(&mut robot, a)?;
+        super::real_cell::apply(&mut robot, a.backlash.as_deref(), a.thermal.as_deref())?;
+        if compliant.is_empty() && a.compliance.as_deref().map(str::trim) == Some("auto") {
+            errln!(
+                "note: --compliance auto: no joint of robot `{}` turns under gravity (every axis                  is parallel to its `gravity`); no compliance added",
+                robot.name()
+            )?;
+        }
+        if betas.is_empty() && a.beta.trim() == "parallel" {
+            errln!(
+                "note: --beta parallel: robot `{}` has no pair of consecutive parallel axes; no \
+                 tilt parameter added",
+                robot.name()
+            )?;
+        }
+        let fix = param_list(&robot, &a.fix, "--fix")?;
+        let free = param_list(&robot, &a.free, "--free")?;
+        if fix.len() == robot.param_count() {
+            return Err(exit::usage(format!(
+                "--fix names every parameter of robot `{}` ({}): nothing is left to identify",
+                robot.name(),
+                robot.param_count()
+            )));
+        }
+        if let Some(p) = fix.iter().find(|p| free.contains(p)) {
+            // Exit code 3, as when the library finds it.
+            return Err(exit::input(format!(
+                "--fix: `{}` is given both to --fix and to --free",
+                p.name()
+            )));
+        }
+        let rank_tolerance = a.rank_tol.unwrap_or(DEFAULT_RANK_TOLERANCE);
+        if !(MIN_RANK_TOLERANCE..1.0).contains(&rank_tolerance) {
+            return Err(exit::usage(format!(
+                "--rank-tol {rank_tolerance:?}: not in [{MIN_RANK_TOLERANCE:e}, 1); it is the \
+                 smallest independence (sine of the angle between a parameter's effect and the \
+                 others') accepted, and below {MIN_RANK_TOLERANCE:e} double precision cannot \
+                 tell a parameter from an exact duplicate (whose independence computes as 1e-17 \
+                 to 1e-14 from rounding)"
+            )));
+        }
+        IoPlan::new()
+            .robot("--robot", &a.robot)
+            .input("--data", &a.data)
+            .input_opt("--validate", a.validate.as_deref())
+            .output(
+                "--out",
+                &a.out,
+                "the result is a file that later commands read, and the tables go to standard \
+                 output",
+            )
+            .check()?;
+        if let Some(v) = &a.validate {
+            if super::super::io_plan::same_file(v, &a.data) {
+                return Err(exit::usage(format!(
+                    "--validate {}: this is the --data file {} (the same file); validation \
+                     points must be points the calibration did not fit: give another file, or \
+                     mark validation rows of --data with set = validation",
+                    v.display(),
+                    a.data.display()
+                )));
+            }
+        }
+        let calibration = CalibrationSettings {
+            objective: match a.objective {
+                ObjectiveArg::Adaptive => Objective::Adaptive,
+                ObjectiveArg::SumOfNorms => Objective::SumOfNorms,
+                ObjectiveArg::LeastSquares => Objective::LeastSquares,
+                ObjectiveArg::Robust => Objective::Robust(match a.robust_loss {
+                    RobustArg::Cauchy => RobustLoss::Cauchy,
+                    RobustArg::Huber => RobustLoss::Huber,
+                }),
+            },
+            robust_scale_mm: a.robust_scale,
+            affine_registration: a.affine,
+            identifiability: IdentifiabilityOptions {
+                rank_tolerance,
+                fix,
+                free,
+                allow_ill_conditioned: a.rank_tol.is_some(),
+            },
+            solver: SolverOptions {
+                max_iterations: a.max_iterations,
+                ..Default::default()
+            },
+            weighting: weighting(a.tracker_sigma.as_deref(), a.orientation_weight)?,
+            validation_refit_frame: a.validate_refit_frame,
+            model: match a.model {
+                ModelArg::Geometric => ModelChoice::Given,
+                ModelArg::Auto => ModelChoice::Auto(AutoFamilies {
+                    harmonics: a.harmonics.is_none(),
+                    compliance: a.compliance.is_none(),
+                    backlash: a.backlash.is_none(),
+                    thermal: a.thermal.is_none(),
+                }),
+            },
+        };
+        Ok(Settings {
+            robot_arg: a.robot.clone(),
+            robot,
+            betas,
+            data: a.data.clone(),
+            validate: a.validate.clone(),
+            nominal_limits: a.nominal_limits,
+            calibration,
+            keep_partial: a.keep_partial,
+            accept_implausible: a.accept_implausible,
+            out: a.out.clone(),
+        })
+    }
+}
