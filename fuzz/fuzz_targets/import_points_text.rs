@@ -1,22 +1,8 @@
 //! Fuzzes robocal import's `text` points parser: any bytes give points or an error, never a panic.
 #![no_main]
 use libfuzzer_sys::fuzz_target;
-use robocal_core::io::import::{parse_points, ImportConfig, LengthUnit, MatchBy, PointsFormat};
-use std::path::Path;
+#[path = "points_common.rs"]
+mod common;
+use robocal_core::io::import::PointsFormat;
 
-fuzz_target!(|data: &[u8]| {
-    let Some((&first, rest)) = data.split_first() else {
-        return;
-    };
-    let mut config = ImportConfig::new(MatchBy::Order);
-    config.points_format = if first % 2 == 0 { PointsFormat::Text } else { PointsFormat::Auto };
-    config.length_unit = [None, Some(LengthUnit::Mm), Some(LengthUnit::M), Some(LengthUnit::In)]
-        [(first / 2 % 4) as usize];
-    if let Ok(t) = parse_points(rest, Path::new("fuzz.txt"), &config) {
-        assert!(!t.rows.is_empty());
-        for r in &t.rows {
-            assert!(r.p.iter().all(|v| v.is_finite()));
-            assert!(r.abc_deg.map_or(true, |a| a.iter().all(|v| v.is_finite())));
-        }
-    }
-});
+fuzz_target!(|data: &[u8]| common::check_points(PointsFormat::Text, data));

@@ -14,7 +14,7 @@ pub(super) fn apply(
     backlash_arg: Option<&str>,
     thermal_arg: Option<&str>,
 ) -> anyhow::Result<()> {
-    let joints = super::settings::joint_list("--backlash", backlash_arg, robot, |r| {
+    let joints = super::joint_list::joint_list("--backlash", backlash_arg, robot, |r| {
         (0..r.dof()).collect()
     })?;
     backlash::enable(robot, &joints).map_err(|e| exit::usage(e.to_string()))?;

@@ -13,7 +13,7 @@
 
 use crate::error::Result;
 use crate::identification::pipeline::Calibration;
-use crate::identification::solver::{solve, SolverOptions};
+use crate::identification::solver::{solve, undamped_step, SolverOptions};
 use crate::identification::system::{Accumulated, Level, Problem};
 use crate::model::Robot;
 use crate::observations::{Observations, Weighting};
@@ -172,7 +172,7 @@ pub fn cross_validate(
             let (f, test, acc) = &parts[p];
             let h_train = &h - acc.h.as_ref().expect("Newton level");
             let b_train = &b - &acc.b;
-            match newton_step(&h_train, &b_train) {
+            match undamped_step(&h_train, &b_train) {
                 Some(step) => {
                     let problem = Problem::new(robot, params, test, &cal.frame);
                     let mut stepped: Robot = robot.clone();
@@ -192,23 +192,6 @@ pub fn cross_validate(
 
 /// A fold: its index, its points and their share of the normal equations.
 type Part = (usize, Observations, Accumulated);
-
-/// The Newton step `h^-1 b`, solved with the matrix scaled to a unit diagonal (the parameters
-/// mix millimetres and radians); `None` when it is not positive definite or the step not
-/// finite.
-fn newton_step(h: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
-    let k = b.len();
-    let d: Vec<f64> = (0..k).map(|j| h[(j, j)]).collect();
-    if d.iter().any(|&v| v.is_nan() || v <= 0.0 || !v.is_finite()) {
-        return None;
-    }
-    let s: Vec<f64> = d.iter().map(|v| 1.0 / v.sqrt()).collect();
-    let scaled = DMatrix::from_fn(k, k, |i, j| h[(i, j)] * s[i] * s[j]);
-    let rhs = DVector::from_fn(k, |i, _| b[i] * s[i]);
-    let y = nalgebra::Cholesky::new(scaled)?.solve(&rhs);
-    let x = DVector::from_fn(k, |i, _| y[i] * s[i]);
-    x.iter().all(|v| v.is_finite()).then_some(x)
-}
 
 /// The cross-validated mean and its standard error from each fold's left-out errors.
 fn summarize(runs: Vec<Result<(Vec<f64>, bool)>>) -> Result<CrossValidation> {

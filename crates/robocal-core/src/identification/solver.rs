@@ -335,6 +335,14 @@ pub fn gradient_cosine(a: &DMatrix<f64>, b: &DVector<f64>, weighted_sq: f64) -> 
         .fold(0.0, f64::max)
 }
 
+/// The undamped step `model^-1 b` (a Newton or Gauss-Newton step), as the solver takes it; `None`
+/// when `model` is not positive definite or the step not finite.
+pub(crate) fn undamped_step(model: &DMatrix<f64>, b: &DVector<f64>) -> Option<DVector<f64>> {
+    let k = b.len();
+    let (mut m, mut delta) = (DMatrix::zeros(k, k), DVector::zeros(k));
+    damped_solve(model, &DVector::zeros(k), 0.0, b, &mut m, &mut delta).then_some(delta)
+}
+
 /// Solves `(model + lambda diag(d)) delta = b` by Cholesky into `delta`, reusing `m`'s storage.
 /// Returns false when the matrix is not positive definite or the solution not finite.
 fn damped_solve(
