@@ -8,11 +8,11 @@ use super::joint_list::joint_list;
 use super::{CalibrateArgs, ModelArg, ObjectiveArg, RobustArg};
 use crate::exit;
 use robocal_core::identification::{
-    split_measurements, AutoFamilies, CalibrationSettings, IdentifiabilityOptions, ModelChoice,
-    Objective, RobustLoss, SolverOptions, DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
+    read_split, AutoFamilies, CalibrationSettings, IdentifiabilityOptions, ModelChoice, Objective,
+    RobustLoss, SolverOptions, DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
 };
 use robocal_core::io::joint_limits::OutsideLimits;
-use robocal_core::io::{read_measurements, Positions};
+use robocal_core::io::{MeasurementReader, Positions};
 use robocal_core::observations::{TrackerSigma, Weighting};
 use robocal_core::{Param, Robot};
 use std::path::{Path, PathBuf};
@@ -163,14 +163,12 @@ pub(super) fn read(
     nominal_limits: bool,
     outside: &mut Vec<OutsideLimits>,
 ) -> anyhow::Result<robocal_core::identification::SplitData> {
-    let set = read_measurements(path, robot.joint_space(), Positions::Required)?;
-    for w in &set.warnings {
-        errln!("warning: {w}")?;
-    }
-    let split = split_measurements(&set)?;
+    // Row by row: a million rows are never held as text rows beside their observations.
+    let reader = MeasurementReader::open(path, robot.joint_space(), Positions::Required)?;
     let mut o = OutsideLimits::new(robot, path);
-    for r in &set.rows {
-        o.check(r.line, &r.q);
+    let (split, warnings) = read_split(reader, |r| o.check(r.line, &r.q))?;
+    for w in &warnings {
+        errln!("warning: {w}")?;
     }
     common::check_limits(o, nominal_limits, outside)?;
     Ok(split)

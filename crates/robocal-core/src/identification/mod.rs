@@ -73,5 +73,5 @@ pub use plausibility::{Check, CheckKind, Plausibility};
 pub use prediction::{MapPoint, Prediction};
 pub use selection::calibrate;
 pub use solver::{solve, SolverOptions, SolverReport, Termination};
-pub use split::{split_measurements, SplitData};
+pub use split::{read_split, split_measurements, SplitData};
 pub use system::Problem;

@@ -10,7 +10,7 @@
 //! weighted model majorizes every loss used here, an accepted step always lowers the objective.
 
 use crate::identification::objective::Loss;
-use crate::identification::system::{Level, Problem};
+use crate::identification::system::{Accumulated, Level, Problem};
 use crate::model::Robot;
 use crate::progress::{Observer, Stage};
 use nalgebra::{DMatrix, DVector};
@@ -128,6 +128,32 @@ pub fn solve(
     opts: &SolverOptions,
     observer: &dyn Observer,
 ) -> SolverReport {
+    solve_keeping(problem, robot, loss, opts, observer).0
+}
+
+/// [`solve`], also returning the full pass ([`Level::Full`]) at the final `robot` when the solve
+/// ended on one (a solve that stops at its start, as the last stage of a reweighted fit usually
+/// does): the covariance needs exactly that pass, which is then not repeated.
+pub(crate) fn solve_keeping(
+    problem: &Problem,
+    robot: &mut Robot,
+    loss: &Loss,
+    opts: &SolverOptions,
+    observer: &dyn Observer,
+) -> (SolverReport, Option<Accumulated>) {
+    let (report, acc, current) = solve_inner(problem, robot, loss, opts, observer);
+    let full = current && acc.h.is_some() && acc.s.is_some();
+    (report, full.then_some(acc))
+}
+
+/// The solve; also its last pass and whether that pass is at the final `robot`.
+fn solve_inner(
+    problem: &Problem,
+    robot: &mut Robot,
+    loss: &Loss,
+    opts: &SolverOptions,
+    observer: &dyn Observer,
+) -> (SolverReport, Accumulated, bool) {
     let k = problem.params().len();
     let n = problem.len().max(1) as f64;
     let mut x = problem.values(robot);
@@ -156,7 +182,7 @@ pub fn solve(
     if k == 0 {
         report.termination = Termination::ConvergedGradient;
         report.final_gradient = 0.0;
-        return report;
+        return (report, acc, true);
     }
     let mut d = DVector::from_fn(k, |j, _| acc.a[(j, j)]);
     let mut lambda = opts.initial_lambda;
@@ -165,6 +191,8 @@ pub fn solve(
     let mut m = DMatrix::zeros(k, k);
     let mut delta = DVector::zeros(k);
     let mut x_new = DVector::zeros(k);
+    // Whether `acc` is the pass at `robot`'s current values.
+    let mut current = true;
     'outer: for it in 1..=opts.max_iterations {
         report.iterations = it;
         observer.progress(Stage::Identification(loss.name()), it, opts.max_iterations);
@@ -213,6 +241,7 @@ pub fn solve(
                 f_cur = f_new;
                 x.copy_from(&x_new);
                 problem.apply(robot, &x);
+                current = false;
                 lambda = (lambda / 3.0).max(MIN_LAMBDA);
                 nu = 2.0;
                 if step <= opts.step_tolerance_mm {
@@ -224,6 +253,7 @@ pub fn solve(
                     break 'outer;
                 }
                 acc = problem.accumulate(robot, loss, level);
+                current = true;
                 report.evaluations += 1;
                 report.final_objective = acc.objective;
                 continue 'outer;
@@ -281,6 +311,7 @@ pub fn solve(
                 f_cur = f_new_accepted;
                 x.copy_from(&x_new);
                 problem.apply(robot, &x);
+                current = false;
                 nu = 2.0;
                 if report.last_step_mm <= opts.step_tolerance_mm {
                     report.termination = Termination::ConvergedStep;
@@ -291,6 +322,7 @@ pub fn solve(
                     break 'outer;
                 }
                 acc = problem.accumulate(robot, loss, level);
+                current = true;
                 report.evaluations += 1;
                 report.final_objective = acc.objective;
                 continue 'outer;
@@ -314,7 +346,7 @@ pub fn solve(
         }
     }
     report.final_objective = f_cur;
-    report
+    (report, acc, current)
 }
 
 /// The largest cosine between a weighted Jacobian column and the weighted residual vector:

@@ -2,9 +2,12 @@
 //! and the paper's plane points.
 
 use crate::error::{Error, Result};
+use crate::io::measurements::MeasurementReader;
 use crate::io::row_extras::ExtrasLayout;
-use crate::io::{MeasurementSet, SetLabel};
+use crate::io::set_label::Labeler;
+use crate::io::{Measurement, MeasurementSet, SetLabel};
 use crate::observations::Observations;
+use std::io::Read;
 
 /// The points of a measurement file sorted by their role, from an optional `set` column
 /// ([`SetLabel`]): `plane` marks the paper's three points for the initial measurement frame,
@@ -23,29 +26,71 @@ pub struct SplitData {
 /// Sorts a measurement file's rows by their `set` column (see [`SplitData`]). Every row must have
 /// a measured position, and every `set` label must be known ([`MeasurementSet::set_labels`]).
 pub fn split_measurements(set: &MeasurementSet) -> Result<SplitData> {
-    let mk = || Observations::with_source(set.dof(), &set.path);
-    let mut out = SplitData {
-        calibration: mk(),
-        validation: mk(),
-        plane: mk(),
-    };
     let labels = set.set_labels()?;
-    let extras = ExtrasLayout::of(set)?;
+    let mut split = Splitter::new(set)?;
     for (r, label) in set.rows.iter().zip(labels) {
+        split.push(set, r, label)?;
+    }
+    Ok(split.out)
+}
+
+/// Reads a measurement file row by row into its [`SplitData`], as [`split_measurements`] of
+/// [`MeasurementReader::read_all`] would, without holding the file's rows: a million rows take
+/// the memory of their observations only (about 80 bytes each), not of the text rows as well.
+/// `each_row` sees every row as it is read (a check of its joints, say). Returns the split and
+/// the reader's warnings ([`MeasurementReader::finish`]).
+pub fn read_split<R: Read>(
+    mut reader: MeasurementReader<R>,
+    mut each_row: impl FnMut(&Measurement),
+) -> Result<(SplitData, Vec<String>)> {
+    let header = reader.header();
+    let mut split = Splitter::new(&header)?;
+    let mut labeler = Labeler::new(&header.extra_columns);
+    while let Some(r) = reader.next_row()? {
+        each_row(&r);
+        if let Some(label) = labeler.label(r.line, &r.extra) {
+            split.push(&header, &r, label)?;
+        }
+    }
+    labeler.finish(&header.path)?;
+    let warnings = reader.finish()?;
+    Ok((split.out, warnings))
+}
+
+/// The split being built: the extra columns' layout and the three sets.
+struct Splitter {
+    extras: ExtrasLayout,
+    out: SplitData,
+}
+
+impl Splitter {
+    fn new(header: &MeasurementSet) -> Result<Splitter> {
+        let mk = || Observations::with_source(header.dof(), &header.path);
+        Ok(Splitter {
+            extras: ExtrasLayout::of(header)?,
+            out: SplitData {
+                calibration: mk(),
+                validation: mk(),
+                plane: mk(),
+            },
+        })
+    }
+
+    /// Adds row `r` of the file `header` describes to the set `label` names.
+    fn push(&mut self, header: &MeasurementSet, r: &Measurement, label: SetLabel) -> Result<()> {
         let Some(p) = r.p else {
             return Err(Error::parse(
-                &set.path,
+                &header.path,
                 Some(r.line),
                 Some("x"),
                 "no measured position (x,y,z) in this row",
             ));
         };
         let target = match label {
-            SetLabel::Plane => &mut out.plane,
-            SetLabel::Validation => &mut out.validation,
-            SetLabel::Calibration => &mut out.calibration,
+            SetLabel::Plane => &mut self.out.plane,
+            SetLabel::Validation => &mut self.out.validation,
+            SetLabel::Calibration => &mut self.out.calibration,
         };
-        target.push_with(&r.q, p, extras.read(set, r)?, r.line)?;
+        target.push_with(&r.q, p, self.extras.read(header, r)?, r.line)
     }
-    Ok(out)
 }

@@ -169,3 +169,45 @@ fn passes_give_the_same_bits_with_and_without_avx() {
         assert_eq!(fw.to_bits(), fb.to_bits());
     }
 }
+
+/// The solver keeps its last full pass only when it is the pass at the final parameters, and
+/// then it is exactly the pass the covariance would make there: a solve that moves keeps nothing
+/// stale, one that starts at its minimum keeps its first pass.
+#[test]
+fn the_kept_pass_is_the_full_pass_at_the_solution() {
+    use crate::identification::solver::{solve_keeping, SolverOptions};
+    let (nominal, obs) = kr480_problem_data(120, 0.02);
+    let names = ["a2", "a3", "d4", "phi2", "phi3", "alpha2", "alpha3"];
+    let params: Vec<Param> = nominal
+        .params()
+        .into_iter()
+        .filter(|p| names.contains(&p.name().as_str()))
+        .collect();
+    assert_eq!(params.len(), names.len());
+    let p = Problem::new(&nominal, &params, &obs, &TrackerFrame::identity());
+    let loss = Loss::Huber { k: 0.05 };
+    let opts = SolverOptions::default();
+    let same = |kept: &Accumulated, robot: &Robot| {
+        let fresh = p.accumulate(robot, &loss, Level::Full);
+        assert_eq!(kept.objective.to_bits(), fresh.objective.to_bits());
+        assert_eq!(kept.a, fresh.a);
+        assert_eq!(kept.b, fresh.b);
+        assert_eq!(kept.h, fresh.h);
+        assert_eq!(kept.s, fresh.s);
+    };
+    let mut robot = nominal.clone();
+    let (moved, kept) = solve_keeping(&p, &mut robot, &loss, &opts, &());
+    assert!(
+        moved.termination.converged() && moved.iterations > 1,
+        "{moved:?}"
+    );
+    if let Some(k) = &kept {
+        same(k, &robot);
+    }
+    let at_minimum = robot.clone();
+    let (again, kept) = solve_keeping(&p, &mut robot, &loss, &opts, &());
+    assert!(again.termination.converged(), "{again:?}");
+    let kept = kept.expect("a solve that stops at its start keeps its full pass");
+    same(&kept, &robot);
+    assert_eq!(p.values(&robot), p.values(&at_minimum));
+}

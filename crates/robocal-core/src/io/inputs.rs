@@ -26,7 +26,10 @@ pub type Inputs = IndexMap<String, InputFile>;
 
 /// The SHA-256 of `bytes`, lower-case hexadecimal.
 pub fn sha256_hex(bytes: &[u8]) -> String {
-    let digest = Sha256::digest(bytes);
+    hex(&Sha256::digest(bytes))
+}
+
+fn hex(digest: &[u8]) -> String {
     let mut s = String::with_capacity(64);
     for b in digest {
         s.push_str(&format!("{b:02x}"));
@@ -34,18 +37,26 @@ pub fn sha256_hex(bytes: &[u8]) -> String {
     s
 }
 
-/// Reads a file's bytes (its path in the error).
-fn read(path: &Path) -> Result<Vec<u8>> {
-    std::fs::read(path).map_err(|source| Error::Io {
+/// The SHA-256 of the file at `path`, read in blocks (a million-row measurement file is not
+/// held in memory to be hashed); its path in the error.
+fn sha256_of_file(path: &Path) -> Result<String> {
+    let io = |source| Error::Io {
         path: path.to_path_buf(),
         source,
-    })
+    };
+    let mut file = std::fs::File::open(path).map_err(io)?;
+    let mut hasher = Sha256::new();
+    std::io::copy(&mut file, &mut hasher).map_err(io)?;
+    Ok(hex(&hasher.finalize()))
 }
 
 impl InputFile {
     /// The record of the file at `path` as it is now.
     pub fn of(path: &Path) -> Result<InputFile> {
-        Ok(InputFile::from_bytes(path, &read(path)?))
+        Ok(InputFile {
+            path: path.display().to_string(),
+            sha256: sha256_of_file(path)?,
+        })
     }
 
     /// The record of a file at `path` whose bytes are `bytes` (a file about to be written).
@@ -74,7 +85,7 @@ pub fn check_unchanged(inputs: &Inputs, path: &Path, result_path: &Path) -> Resu
     let Some((role, f)) = recorded(inputs, path) else {
         return Ok(());
     };
-    let now = sha256_hex(&read(path)?);
+    let now = sha256_of_file(path)?;
     if now != f.sha256 {
         return Err(Error::invalid(
             path.display().to_string(),

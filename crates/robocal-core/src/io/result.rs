@@ -276,18 +276,23 @@ impl CalibrationResult {
         Ok((r, nominal))
     }
 
-    /// Writes the result atomically as pretty JSON, after reading the text back as every command
+    /// Writes the result atomically as pretty JSON (each per-point entry on one line), after reading the text back as every command
     /// that takes a result does ([`CalibrationResult::parse`], then the calibrated model): what
     /// robocal writes, robocal reads. A result its readers would refuse (a value outside its
     /// range) is not written: [`Error::Implausible`] names the field.
     pub fn write(&self, path: &Path) -> Result<()> {
-        // Sized for the per-point entries (about 130 bytes each, pretty), so that a million
-        // points' text is not copied as it grows.
+        // Sized for the per-point entries (one line of at most about 90 bytes each: two errors
+        // written to the last digit and a line number), so that a million points' text is
+        // neither copied as it grows nor given twice the room it needs.
         let points = self.points.as_ref().map_or(0, |p| {
             p.calibration.len() + p.validation.as_ref().map_or(0, Vec::len)
         });
-        let mut buf = Vec::with_capacity((1 << 17) + 140 * points);
-        serde_json::to_writer_pretty(&mut buf, self)
+        let mut buf = Vec::with_capacity((1 << 17) + 92 * points);
+        let mut ser = serde_json::Serializer::with_formatter(
+            &mut buf,
+            crate::io::result_format::ResultFormatter::new(),
+        );
+        serde::Serialize::serialize(self, &mut ser)
             .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
         buf.push(b'\n');
         let s = String::from_utf8(buf)

@@ -74,35 +74,72 @@ impl MeasurementSet {
     /// whose label is not one of [`SetLabel::ACCEPTED`], naming the file, its line, the column
     /// and the labels that exist, and counting the rows with unknown labels.
     pub fn set_labels(&self) -> Result<Vec<SetLabel>> {
-        let Some(k) = set_column(&self.extra_columns) else {
-            return Ok(vec![SetLabel::Calibration; self.rows.len()]);
-        };
-        let mut labels = Vec::with_capacity(self.rows.len());
-        let mut first_bad = None;
-        let mut bad = 0;
-        for r in &self.rows {
-            match SetLabel::of_cell(&r.extra[k]) {
-                Some(l) => labels.push(l),
-                None => {
-                    bad += 1;
-                    first_bad.get_or_insert(r);
-                }
-            }
+        let mut labeler = Labeler::new(&self.extra_columns);
+        let labels = self
+            .rows
+            .iter()
+            .filter_map(|r| labeler.label(r.line, &r.extra))
+            .collect();
+        labeler.finish(&self.path)?;
+        Ok(labels)
+    }
+}
+
+/// Labels a file's rows one at a time, as they are read ([`MeasurementSet::set_labels`] for
+/// rows already in memory): remembers the first unknown label and counts them, so that
+/// [`Labeler::finish`] fails as `set_labels` does.
+#[derive(Debug, Clone)]
+pub struct Labeler {
+    /// The `set` column among the extra columns, and its name.
+    column: Option<(usize, String)>,
+    /// The line and the cell of the first unknown label.
+    first_bad: Option<(usize, String)>,
+    /// How many rows have an unknown label.
+    bad: usize,
+}
+
+impl Labeler {
+    /// A labeler for a file whose extra columns are `extra_columns`.
+    pub fn new(extra_columns: &[String]) -> Labeler {
+        Labeler {
+            column: set_column(extra_columns).map(|k| (k, extra_columns[k].clone())),
+            first_bad: None,
+            bad: 0,
         }
-        let Some(r) = first_bad else {
-            return Ok(labels);
+    }
+
+    /// The label of the row at `line` with the extra values `extra`; `None` (remembered for
+    /// [`Labeler::finish`]) when it is not one of [`SetLabel::ACCEPTED`].
+    pub fn label(&mut self, line: usize, extra: &[String]) -> Option<SetLabel> {
+        let Some((k, _)) = &self.column else {
+            return Some(SetLabel::Calibration);
         };
-        let others = match bad {
+        let cell = &extra[*k];
+        let l = SetLabel::of_cell(cell);
+        if l.is_none() {
+            self.bad += 1;
+            self.first_bad
+                .get_or_insert_with(|| (line, cell.trim().to_owned()));
+        }
+        l
+    }
+
+    /// Fails when some row had an unknown label, naming the first (file `path`, its line, the
+    /// column) and counting the others.
+    pub fn finish(self, path: &std::path::Path) -> Result<()> {
+        let (Some((line, cell)), Some((_, column))) = (self.first_bad, self.column) else {
+            return Ok(());
+        };
+        let others = match self.bad {
             1 => String::new(),
             n => format!(" ({n} rows of this file have an unknown set)"),
         };
         Err(Error::parse(
-            &self.path,
-            Some(r.line),
-            Some(&self.extra_columns[k]),
+            path,
+            Some(line),
+            Some(&column),
             format!(
-                "unknown set `{}`{others}: the sets are {}",
-                r.extra[k].trim(),
+                "unknown set `{cell}`{others}: the sets are {}",
                 SetLabel::ACCEPTED
             ),
         ))

@@ -307,6 +307,7 @@ pub(crate) fn complete(
         loss: cal.stages.last().expect("at least one stage").loss,
         stages: cal.stages,
         robust_scale: cal.robust_scale_mm,
+        final_pass: None,
     };
     let job = Job {
         nominal: &nominal,

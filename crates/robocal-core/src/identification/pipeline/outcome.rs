@@ -54,7 +54,11 @@ pub(super) fn assemble(
     );
     let robot = &solved.robot;
     observer.progress(progress::Stage::Uncertainty, 0, 1);
-    let acc = problem.accumulate(robot, &solved.loss, Level::Full);
+    // The solver's last pass when it is at the solution, else a pass of its own.
+    let acc = match &solved.final_pass {
+        Some(pass) => std::borrow::Cow::Borrowed(pass),
+        None => std::borrow::Cow::Owned(problem.accumulate(robot, &solved.loss, Level::Full)),
+    };
     let mut covariance = Covariance::from_accumulated(&identified.identifiability.identified, &acc);
     if let Some(why) = &identified.ill_conditioned {
         covariance.mark_unavailable(why.clone());

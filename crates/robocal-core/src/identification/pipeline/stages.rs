@@ -8,7 +8,8 @@ use crate::identification::objective::{
     robust_sigma, Loss, Objective, RobustLoss, ADAPTIVE_THRESHOLD_SIGMAS, ROBUST_SCALE_SIGMAS,
     SUM_OF_NORMS_SMOOTHING_MM,
 };
-use crate::identification::solver::{solve, SolverOptions};
+use crate::identification::solver::{solve_keeping, SolverOptions};
+use crate::identification::system::Accumulated;
 use crate::identification::system::Problem;
 use crate::model::Robot;
 use crate::progress::Observer;
@@ -23,6 +24,9 @@ pub(super) struct Solved {
     pub loss: Loss,
     /// The robust loss's scale (mm), for robust objectives.
     pub robust_scale: Option<f64>,
+    /// The last run's full pass at `robot` with `loss`, when it ended on one (the covariance's
+    /// pass, not repeated then).
+    pub final_pass: Option<Accumulated>,
 }
 
 /// The solver runs of one identification, with the iteration limit shared by all.
@@ -32,6 +36,8 @@ struct Runs<'p, 'a> {
     observer: &'p dyn Observer,
     robot: Robot,
     stages: Vec<Stage>,
+    /// The last run's full pass at `robot`, when it ended on one.
+    final_pass: Option<Accumulated>,
 }
 
 impl Runs<'_, '_> {
@@ -43,7 +49,9 @@ impl Runs<'_, '_> {
             max_iterations: self.settings.solver.max_iterations.saturating_sub(used),
             ..self.settings.solver
         };
-        let report = solve(self.problem, &mut self.robot, &loss, &opts, self.observer);
+        let (report, pass) =
+            solve_keeping(self.problem, &mut self.robot, &loss, &opts, self.observer);
+        self.final_pass = pass;
         if let crate::identification::solver::Termination::Failed(m) = &report.termination {
             return Err(Error::Numerical(format!(
                 "identification ({}) failed after {} iterations: {m}",
@@ -80,6 +88,7 @@ pub(super) fn solve_stages(
         observer,
         robot: start.clone(),
         stages: Vec::new(),
+        final_pass: None,
     };
     let son = Loss::SumOfNorms {
         delta: SUM_OF_NORMS_SMOOTHING_MM,
@@ -114,6 +123,7 @@ pub(super) fn solve_stages(
         stages: runs.stages,
         loss,
         robust_scale,
+        final_pass: runs.final_pass,
     })
 }
 
