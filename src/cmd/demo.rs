@@ -1,6 +1,7 @@
 //! `robocal demo`: the paper's whole experiment in simulation, with its tables beside the
 //! paper's, a report, and the files of every step.
 
+use super::demo_text::{command_line, para, sh};
 use super::io_plan::IoPlan;
 use super::paper_tables::{error_table, parameter_table, percent, Column};
 use anyhow::Context;
@@ -45,19 +46,6 @@ const OUTPUT_FILES: [&str; 9] = [
     HTML_FILE,
     HISTOGRAM_FILE,
 ];
-
-/// A path as the user would type it in a POSIX shell (quoted when needed).
-pub(super) fn sh(p: &Path) -> String {
-    let s = p.display().to_string();
-    if !s.is_empty()
-        && s.chars()
-            .all(|c| c.is_ascii_alphanumeric() || "_./-+:@%,".contains(c))
-    {
-        s
-    } else {
-        format!("'{}'", s.replace('\'', r"'\''"))
-    }
-}
 
 /// Everything `demo` needs, checked before any work: the output directory plan and the
 /// experiment's configuration.
@@ -146,25 +134,6 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     outln!()?;
     super::iso9283::demo_table(&exp)?;
     outln!("report: {}", path(HTML_FILE).display())?;
-    Ok(())
-}
-
-/// Prints `text` wrapped at 100 columns.
-pub(super) fn para(text: &str) -> anyhow::Result<()> {
-    let mut line = String::new();
-    for w in text.split_whitespace() {
-        if !line.is_empty() && line.len() + 1 + w.len() > 100 {
-            outln!("{line}")?;
-            line.clear();
-        }
-        if !line.is_empty() {
-            line.push(' ');
-        }
-        line.push_str(w);
-    }
-    if !line.is_empty() {
-        outln!("{line}")?;
-    }
     Ok(())
 }
 
@@ -578,24 +547,5 @@ fn print_files(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
         "--paper".to_owned(),
         format!("--out {}", p("by-hand")),
     ])?;
-    Ok(())
-}
-
-/// Prints a shell command made of `parts`, continued with `\` on new lines before 100 columns.
-pub(super) fn command_line(parts: &[String]) -> anyhow::Result<()> {
-    let mut line = String::from("  ");
-    let mut out = String::new();
-    for (i, part) in parts.iter().enumerate() {
-        if i > 0 && line.len() + 1 + part.len() + 2 > 100 {
-            out.push_str(&line);
-            out.push_str(" \\\n");
-            line = String::from("      ");
-        } else if i > 0 {
-            line.push(' ');
-        }
-        line.push_str(part);
-    }
-    out.push_str(&line);
-    outln!("{out}")?;
     Ok(())
 }

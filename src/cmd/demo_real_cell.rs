@@ -1,7 +1,7 @@
 //! The demo's honest cell: what it adds to the paper's cell, the by-hand flags that simulate it,
 //! and the calibration with the real cell's families beside the geometric one.
 
-use super::demo::{command_line, para};
+use super::demo_text::{command_line, para};
 use robocal_core::experiment::{files, Experiment, PAPER_NOMINAL};
 use robocal_report::number_list;
 use std::path::Path;
@@ -170,10 +170,10 @@ pub(super) fn print_families(
     command_line(&[
         "robocal calibrate".to_owned(),
         format!("--robot {PAPER_NOMINAL}"),
-        format!("--data {}", super::demo::sh(&dir.join(files::CELL))),
+        format!("--data {}", super::demo_text::sh(&dir.join(files::CELL))),
         format!(
             "--validate {}",
-            super::demo::sh(&dir.join(files::VALIDATION))
+            super::demo_text::sh(&dir.join(files::VALIDATION))
         ),
         "--compliance auto".to_owned(),
         format!("--payload-kg {payload}"),
@@ -181,7 +181,7 @@ pub(super) fn print_families(
         "--model geometric".to_owned(),
         format!(
             "--out {}",
-            super::demo::sh(&dir.join("result-real-cell.json"))
+            super::demo_text::sh(&dir.join("result-real-cell.json"))
         ),
     ])?;
     outln!()?;

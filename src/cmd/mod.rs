@@ -5,6 +5,7 @@ mod common;
 mod compensate;
 mod demo;
 mod demo_real_cell;
+mod demo_text;
 mod evaluate;
 mod export;
 mod fk;
