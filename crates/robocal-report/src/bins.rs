@@ -16,7 +16,7 @@
 //!   first bin.
 //! - A few gross outliers (a failed point) are gathered in an overflow bin ([`outlier_cap`]).
 
-use crate::data::finite;
+use crate::values::finite;
 
 /// Fewest regular bins a histogram gets (unless all values are equal).
 pub const MIN_BINS: usize = 10;

@@ -49,7 +49,7 @@ pub struct ReportData {
     /// row per point set and model; empty for point data.
     pub orientation: Vec<AngleRow>,
     /// ISO 9283 acceptance tests (e.g. before and after calibration); empty: no section.
-    pub iso9283: Vec<crate::iso9283::IsoTest>,
+    pub iso9283: Vec<crate::iso_results::IsoTest>,
 }
 
 /// One row of the orientation-error table.
@@ -415,20 +415,6 @@ impl Note {
     }
 }
 
-/// Finite values of `v`, and how many were not finite.
-pub(crate) fn finite(v: impl IntoIterator<Item = f64>) -> (Vec<f64>, usize) {
-    let mut out = Vec::new();
-    let mut skipped = 0;
-    for x in v {
-        if x.is_finite() {
-            out.push(x);
-        } else {
-            skipped += 1;
-        }
-    }
-    (out, skipped)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -483,12 +469,5 @@ mod tests {
     fn reach() {
         assert_eq!(ReachKind::Radial.of([3.0, 4.0, 100.0]), 5.0);
         assert_eq!(ReachKind::Spherical.of([2.0, 3.0, 6.0]), 7.0);
-    }
-
-    #[test]
-    fn finite_counts_skipped() {
-        let (v, k) = finite([1.0, f64::NAN, 3.0, f64::NEG_INFINITY]);
-        assert_eq!(v, vec![1.0, 3.0]);
-        assert_eq!(k, 2);
     }
 }

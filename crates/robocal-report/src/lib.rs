@@ -43,6 +43,7 @@ mod histogram_section;
 mod html;
 mod identification;
 pub mod iso9283;
+mod iso_results;
 mod joints;
 mod map;
 mod markup;
@@ -60,6 +61,7 @@ mod serde_nan;
 mod summary;
 mod svgplot;
 mod tables;
+mod values;
 
 pub use build::{before_after_histogram, paper, paper_tables};
 pub use data::{
@@ -68,7 +70,7 @@ pub use data::{
     Setting, SolverSummary,
 };
 pub use histogram::{histogram_svg, HistogramFigure};
-pub use iso9283::{IsoPoseRow, IsoTest};
+pub use iso_results::{IsoPoseRow, IsoTest};
 pub use numfmt::number_list;
 pub use run::RunData;
 pub use scatter::{scatter_svg, ScatterFigure};

@@ -1,10 +1,11 @@
 //! The "Summary" section: the mean error of each point set before and after calibration, and
 //! the report's warnings and notes.
 
-use crate::data::{finite, Note, NoteLevel, PointSet};
+use crate::data::{Note, NoteLevel, PointSet};
 use crate::escape::xml as esc;
 use crate::numfmt::{fixed, mm};
 use crate::page::Page;
+use crate::values::finite;
 use robocal_core::Result;
 use std::fmt::Write;
 
