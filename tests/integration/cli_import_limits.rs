@@ -90,16 +90,16 @@ fn joint_values_outside_the_limits_are_refused_or_listed() {
     // Nominal limits: kept, one warning per value outside.
     let (o, out) = import(&dir, &bad, &["--nominal-limits"]);
     o.assert_code(0);
-    let warned: Vec<&str> = o
-        .stdout()
+    let stdout = o.stdout();
+    let warned: Vec<&str> = stdout
         .lines()
         .filter(|l| l.starts_with("warning: "))
         .collect();
-    assert_eq!(warned.len(), 3, "{}", o.stdout());
+    assert_eq!(warned.len(), 3, "{stdout}");
     assert!(warned[0].contains("bad.csv: line 3: q2 = 25 deg (limits -130..20)"));
     assert!(warned[2].contains("line 7: q5 = -121 deg") && warned[2].contains("nominal"));
     let written = std::fs::read_to_string(&out).unwrap();
-    assert!(written.lines().any(|l| l.contains(",25,")), "{written}");
+    assert!(written.lines().any(|l| l.contains(",25.000000000,")), "{written}");
 }
 
 #[test]

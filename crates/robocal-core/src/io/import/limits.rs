@@ -40,7 +40,11 @@ impl ImportLimits {
                 .limits()
                 .iter()
                 .enumerate()
-                .map(|(j, l)| (js.to_display(j, l.min), js.to_display(j, l.max)))
+                // To the 9 decimals files hold (120, not 119.99999999999999).
+                .map(|(j, l)| {
+                    let shown = |v: f64| (js.to_display(j, v) * 1e9).round() / 1e9;
+                    (shown(l.min), shown(l.max))
+                })
                 .collect(),
             revolute: (0..robot.dof())
                 .map(|j| robot.joint_type(j) == JointType::Revolute)
@@ -131,8 +135,9 @@ pub(super) fn check(
         Some(&layout.joint_names[j0]),
         format!(
             "{} {u} is outside the joint limits of robot `{}` (q{}: {}..{} {u}); {points} of the \
-             {} paired points are outside: {}. Is the angle unit right ({} from {})? If the \
-             robot's limits are only nominal, see the `nominal_limits` setting",
+             {} paired points are outside: {}. Is the angle unit right ({} from {}; see the \
+             `angle_unit` setting)? If the robot's limits are only nominal, see the \
+             `nominal_limits` setting",
             fmt_value(v0),
             lim.robot,
             j0 + 1,
