@@ -99,7 +99,10 @@ fn joint_values_outside_the_limits_are_refused_or_listed() {
     assert!(warned[0].contains("bad.csv: line 3: q2 = 25 deg (limits -130..20)"));
     assert!(warned[2].contains("line 7: q5 = -121 deg") && warned[2].contains("nominal"));
     let written = std::fs::read_to_string(&out).unwrap();
-    assert!(written.lines().any(|l| l.contains(",25.000000000,")), "{written}");
+    assert!(
+        written.lines().any(|l| l.contains(",25.000000000,")),
+        "{written}"
+    );
 }
 
 #[test]
