@@ -101,6 +101,7 @@ const PHRASES: &[(&str, &str)] = &[
     ("`time_tolerance_s` setting", "--time-tolerance"),
     ("the `dwell.min_s` setting", "--dwell-min-s"),
     ("the `dwell.still_deg` setting", "--still-deg"),
+    ("the `nominal_limits` setting", "--nominal-limits"),
 ];
 
 /// `text` with every setting named in backticks (`` `noise_mm` ``) replaced by its flag.

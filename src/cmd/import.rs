@@ -5,8 +5,8 @@ use super::common;
 use super::io_plan::IoPlan;
 use clap::Args;
 use robocal_core::io::import::{
-    import_files, write_import, AngleUnit, DwellSettings, ImportConfig, JointsFormat, LengthUnit,
-    MatchBy, PointsFormat,
+    import_files, write_import, AngleUnit, DwellSettings, ImportConfig, ImportLimits, JointsFormat,
+    LengthUnit, MatchBy, PointsFormat,
 };
 use std::path::PathBuf;
 
@@ -32,9 +32,15 @@ pub struct ImportArgs {
     /// pattern of dwells when not given.
     #[arg(long, allow_hyphen_values = true)]
     time_offset: Option<f64>,
-    /// The robot, to check the joint log's joint count against.
+    /// The robot, to check the joint log against: its joint count, and each paired point's
+    /// joint values against the robot's limits (a value outside them is an error naming the
+    /// line and column; so is a log in radians read as degrees).
     #[arg(long)]
     robot: Option<String>,
+    /// With --robot: the robot's limits are only nominal: paired joint values outside them are
+    /// kept, each listed as a warning.
+    #[arg(long, requires = "robot")]
+    nominal_limits: bool,
     /// The export's length unit (mm, m, in), for files that do not say it.
     #[arg(long)]
     length_unit: Option<LengthUnit>,
@@ -69,8 +75,8 @@ pub fn run(a: ImportArgs) -> anyhow::Result<()> {
         .robot_opt("--robot", a.robot.as_deref())
         .output("--out", &a.out, "the report goes to standard output")
         .check()?;
-    let dof = match &a.robot {
-        Some(r) => Some(common::robot(r)?.dof()),
+    let robot_limits = match &a.robot {
+        Some(r) => Some(ImportLimits::new(&common::robot(r)?, a.nominal_limits)),
         None => None,
     };
     let config = ImportConfig {
@@ -82,7 +88,7 @@ pub fn run(a: ImportArgs) -> anyhow::Result<()> {
         angle_unit: a.angle_unit,
         joint_columns: a.joint_columns,
         name_column: a.name_column,
-        dof,
+        robot_limits,
         dwell: DwellSettings {
             still_deg: a.still_deg,
             min_s: a.dwell_min_s,

@@ -156,3 +156,44 @@ fn the_tracker_range_limits_the_poses() {
         assert!((2000.0 - 1e-3..=4000.0 + 1e-3).contains(&dist), "{dist}");
     }
 }
+
+/// On a terminal `plan` shows its progress: the stages (candidates, choosing poses, exchanging
+/// poses) with their counts, drawn on stderr. Run under a pseudo-terminal by util-linux's
+/// `script`; a tenth of `--poses 2000 --candidates 200000` (whose time the README gives), so
+/// that each stage lasts long enough to be drawn. Skipped, saying so, without `script`.
+#[test]
+fn plan_shows_its_progress_on_a_terminal() {
+    let has_script = std::process::Command::new("script")
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !has_script {
+        eprintln!("skipped: util-linux `script` (a pseudo-terminal) is not installed");
+        return;
+    }
+    let d = Dir::new();
+    let out = d.join("poses.csv");
+    let cmd = format!(
+        "{} plan --robot {KUKA} --poses 200 --candidates 20000 --seed 3 --out {}",
+        env!("CARGO_BIN_EXE_robocal"),
+        p(&out)
+    );
+    let start = std::time::Instant::now();
+    let o = std::process::Command::new("script")
+        .args(["-qefc", &cmd, "/dev/null"])
+        .env("TERM", "xterm")
+        .env_remove("NO_COLOR")
+        .output()
+        .unwrap();
+    let took = start.elapsed();
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}");
+    eprintln!("plan --poses 200 --candidates 20000 on a terminal: {took:.1?}");
+    for stage in ["choosing poses", "exchanging poses"] {
+        assert!(text.contains(stage), "no `{stage}` drawn:\n{text}");
+    }
+    // Counts of the 200 poses chosen, below and at the total.
+    assert!(text.contains("/200"), "{text}");
+    assert!(text.contains("200 poses written"), "{text}");
+    assert!(out.is_file());
+}

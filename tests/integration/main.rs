@@ -30,6 +30,7 @@ mod cli_constraints;
 mod cli_demo;
 mod cli_evaluate;
 mod cli_import;
+mod cli_import_limits;
 mod cli_interrupted;
 mod cli_iso9283;
 mod cli_iso9283_plan;

@@ -4,7 +4,9 @@
 use crate::errors::{usage, IntoPy};
 use crate::robot::PyRobot;
 use pyo3::prelude::*;
-use robocal_core::io::import::{import_files, write_import, DwellSettings, ImportConfig};
+use robocal_core::io::import::{
+    import_files, write_import, DwellSettings, ImportConfig, ImportLimits,
+};
 use std::path::PathBuf;
 
 fn choice<T: std::str::FromStr<Err = String>>(name: &str, v: &str) -> PyResult<T> {
@@ -18,7 +20,7 @@ fn choice<T: std::str::FromStr<Err = String>>(name: &str, v: &str) -> PyResult<T
 #[pyo3(signature = (points, joints, match_by, out = None, points_format = "auto",
     joints_format = "auto", time_offset = None, length_unit = None, angle_unit = None,
     joint_columns = None, name_column = None, robot = None, still_deg = None, dwell_min_s = None,
-    time_tolerance = 0.2))]
+    time_tolerance = 0.2, nominal_limits = false))]
 #[allow(clippy::too_many_arguments)]
 pub fn import_measurements(
     points: PathBuf,
@@ -36,6 +38,7 @@ pub fn import_measurements(
     still_deg: Option<f64>,
     dwell_min_s: Option<f64>,
     time_tolerance: f64,
+    nominal_limits: bool,
 ) -> PyResult<(String, Vec<String>)> {
     let d = DwellSettings::default();
     let config = ImportConfig {
@@ -47,7 +50,7 @@ pub fn import_measurements(
         angle_unit: angle_unit.map(|u| choice("angle_unit", u)).transpose()?,
         joint_columns,
         name_column,
-        dof: robot.map(|r| r.inner.dof()),
+        robot_limits: robot.map(|r| ImportLimits::new(&r.inner, nominal_limits)),
         dwell: DwellSettings {
             still_deg: still_deg.unwrap_or(d.still_deg),
             min_s: dwell_min_s.unwrap_or(d.min_s),

@@ -41,3 +41,19 @@ def test_bad_input_names_the_file_line_and_setting(tmp_path):
     with pytest.raises(robocal.UsageError, match="match_by"):
         robocal.import_measurements(f, example("import/kr480-joints.txt"), "sideways")
     assert not (tmp_path / "never.csv").exists()
+
+
+def test_the_robot_checks_each_points_joint_values_against_its_limits(tmp_path):
+    kr = robocal.Robot.preset("kuka-kr480-r3330")
+    rows = open(example("import/kr480-joints.csv")).read().splitlines()
+    cells = rows[2].split(",")
+    cells[2] = "25"  # q2 of the point on line 3, beyond its 20 deg limit
+    rows[2] = ",".join(cells)
+    joints = tmp_path / "j.csv"
+    joints.write_text("\n".join(rows) + "\n")
+    pts = example("import/kr480-points.csv")
+    with pytest.raises(robocal.InputError, match=r"j.csv:3: field `q2`: 25 deg is outside"):
+        robocal.import_measurements(pts, joints, "name", robot=kr)
+    got = robocal.import_measurements(pts, joints, "name", robot=kr, nominal_limits=True)
+    warned = [l for l in got.report if l.startswith("warning: ")]
+    assert len(warned) == 1 and "line 3: q2 = 25 deg (limits -130..20)" in warned[0], warned

@@ -388,6 +388,7 @@ def import_measurements(
     still_deg: Optional[float] = None,
     dwell_min_s: Optional[float] = None,
     time_tolerance: float = 0.2,
+    nominal_limits: bool = False,
 ) -> Imported: ...
 
 class Iso9283Plan:

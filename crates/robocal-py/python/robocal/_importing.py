@@ -37,6 +37,7 @@ def import_measurements(
     still_deg: Optional[float] = None,
     dwell_min_s: Optional[float] = None,
     time_tolerance: float = 0.2,
+    nominal_limits: bool = False,
 ) -> Imported:
     """A tracker export and a joint log into a measurement CSV, as ``robocal import`` does.
 
@@ -46,7 +47,10 @@ def import_measurements(
     with the clock offset ``time_offset``, tracker minus log in seconds, found when not given).
     ``length_unit`` (mm, m, in) for exports that do not say it; ``angle_unit`` (deg, rad) of a
     CSV log; ``joint_columns`` names a log's joint columns (controller values, written as
-    ``axis1..axisN``); ``robot`` checks the joint count. Writes the CSV to ``out`` when given.
+    ``axis1..axisN``); ``robot`` checks the joint count and each paired point's joint values
+    against the robot's limits (outside them, or a log in radians read as degrees, is an
+    :class:`InputError`; with ``nominal_limits`` each point outside is a warning line of the
+    report and kept). Writes the CSV to ``out`` when given.
     Returns an :class:`Imported`: the CSV's text and the report's lines (the CLI prints them).
     Bad input raises :class:`InputError` naming the file, line and field.
     """
@@ -66,5 +70,6 @@ def import_measurements(
         still_deg=still_deg,
         dwell_min_s=dwell_min_s,
         time_tolerance=time_tolerance,
+        nominal_limits=nominal_limits,
     )
     return Imported(csv, report)

@@ -15,6 +15,7 @@ pub mod headed;
 pub mod joints;
 pub mod joints_csv;
 pub mod leica;
+mod limits;
 pub mod lines;
 pub mod match_rows;
 pub mod points;
@@ -29,6 +30,7 @@ mod write;
 pub mod xyz;
 
 pub use dwells::{Dwell, DwellSettings};
+pub use limits::ImportLimits;
 pub use points::{PointRow, PointTable};
 pub use report::ImportReport;
 pub use units::{AngleUnit, LengthUnit};
@@ -121,8 +123,9 @@ pub struct ImportConfig {
     pub joint_columns: Option<Vec<String>>,
     /// The point-name column (points and joints).
     pub name_column: Option<String>,
-    /// The robot's joint count, to check the log against.
-    pub dof: Option<usize>,
+    /// The robot's joint limits, to check the log's joint count and the paired joint values
+    /// against (see [`ImportLimits`]).
+    pub robot_limits: Option<ImportLimits>,
     /// How dwells are found (matching by time).
     pub dwell: DwellSettings,
     /// How far outside a dwell a measurement time may be (s).
@@ -142,7 +145,7 @@ impl ImportConfig {
             angle_unit: None,
             joint_columns: None,
             name_column: None,
-            dof: None,
+            robot_limits: None,
             dwell: DwellSettings::default(),
             time_tolerance_s: 0.2,
         }
@@ -264,7 +267,7 @@ pub fn parse_joints<R: BufRead>(
         }
     };
     let hline = layout.dialect.header_line.unwrap_or(1);
-    if let Some(dof) = config.dof {
+    if let Some(dof) = config.robot_limits.as_ref().map(ImportLimits::dof) {
         if layout.joint_fields.len() != dof {
             return Err(joints::dof_mismatch(
                 path,
@@ -414,6 +417,33 @@ pub fn import_tables(
             ),
         ));
     }
+    let warnings = match &config.robot_limits {
+        Some(lim) => {
+            let rows: Vec<limits::PairedRow> = pairs
+                .iter()
+                .filter_map(|j| *j)
+                .map(|j| {
+                    if config.match_by == MatchBy::Time {
+                        let d = &log.dwells[j];
+                        limits::PairedRow {
+                            line: d.first_line,
+                            label: format!("dwell of lines {}-{}", d.first_line, d.last_line),
+                            q: &d.q_deg,
+                        }
+                    } else {
+                        let r = &log.kept[j];
+                        limits::PairedRow {
+                            line: r.line,
+                            label: format!("line {}", r.line),
+                            q: &r.q_deg,
+                        }
+                    }
+                })
+                .collect();
+            limits::check(lim, &log.layout, &rows)?
+        }
+        None => Vec::new(),
+    };
     let (csv, columns, left_out) = write::csv(
         &table,
         &matched,
@@ -434,6 +464,7 @@ pub fn import_tables(
         columns,
         left_out,
         joints_path: &joints_path,
+        warnings,
     });
     Ok(Imported { csv, report })
 }

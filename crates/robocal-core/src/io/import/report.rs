@@ -63,6 +63,8 @@ pub struct ImportReport {
     pub columns: Vec<String>,
     /// Optional columns not written, and why.
     pub left_out: Vec<String>,
+    /// Warnings (joint values outside nominal limits, listed per point).
+    pub warnings: Vec<String>,
 }
 
 pub(super) struct Parts<'a> {
@@ -75,6 +77,7 @@ pub(super) struct Parts<'a> {
     pub columns: Vec<String>,
     pub left_out: Vec<String>,
     pub joints_path: &'a Path,
+    pub warnings: Vec<String>,
 }
 
 pub(super) fn build(p: Parts<'_>) -> ImportReport {
@@ -144,6 +147,7 @@ pub(super) fn build(p: Parts<'_>) -> ImportReport {
         unmatched_joints,
         columns: p.columns,
         left_out: p.left_out,
+        warnings: p.warnings,
     }
 }
 
@@ -241,6 +245,7 @@ impl ImportReport {
         for l in &self.left_out {
             v.push(format!("  not written: {l}"));
         }
+        v.extend(self.warnings.iter().map(|w| format!("warning: {w}")));
         v
     }
 }

@@ -1,7 +1,8 @@
 //! URDF robots: the serial chain of a URDF file (ROS's robot description) imported as a
 //! modified-DH [`Robot`] that calibrates like any other.
 //!
-//! The file is parsed by the `urdf-rs` crate (openrr's, maintained); [`chain`] picks the chain
+//! The file's kinematic part is read in one streaming pass (`read`, linear in the file's size,
+//! into `urdf-rs`'s types); [`chain`] picks the chain
 //! from the base link to the tip link and keeps the URDF's own kinematics (joint origins and
 //! motions); [`mdh`] turns it into an MDH table, a base frame and a tool (the tip link's frame).
 //! The import is checked: the robot's forward kinematics must equal the URDF chain's at a set of
@@ -13,6 +14,7 @@
 
 pub mod chain;
 pub mod mdh;
+mod read;
 
 pub use chain::{Step, UrdfChain};
 
@@ -46,21 +48,9 @@ pub fn looks_like_urdf(text: &str) -> bool {
 /// Parses a URDF file's text and selects its chain; `path` names the file in errors.
 pub fn parse_urdf_chain(text: &str, path: &Path, sel: &ChainSelection) -> Result<UrdfChain> {
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-    let robot = urdf_rs::read_from_string(text).map_err(|e| {
-        let msg = e.to_string();
-        let line = line_in_message(&msg);
-        Error::parse(path, line, None, format!("not a valid URDF: {msg}"))
-    })?;
+    let robot = read::read(text)
+        .map_err(|e| Error::parse(path, e.line, None, format!("not a valid URDF: {}", e.msg)))?;
     chain::select(&robot, sel, text, path)
-}
-
-/// A line number the XML parser's message gives (`... line 12 ...` or `12:5`), if any.
-fn line_in_message(msg: &str) -> Option<usize> {
-    let words: Vec<&str> = msg.split(|c: char| c.is_whitespace() || c == ',').collect();
-    words
-        .windows(2)
-        .find(|w| w[0].eq_ignore_ascii_case("line"))
-        .and_then(|w| w[1].trim_end_matches([':', '.']).parse().ok())
 }
 
 /// Imports a URDF's chain as an MDH robot (see the module documentation), checked against the
@@ -132,5 +122,7 @@ pub fn frame_difference_mm(a: &crate::frame::Frame, b: &crate::frame::Frame) -> 
     }
 }
 
+#[cfg(test)]
+mod read_tests;
 #[cfg(test)]
 mod tests;

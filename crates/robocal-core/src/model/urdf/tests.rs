@@ -87,7 +87,7 @@ fn ur5_imports_with_the_urdf_kinematics_and_equals_the_dh_file() {
 /// A chain with every awkward feature: joint rpy, axes off z (oblique, negative), a prismatic
 /// joint, parallel, intersecting, collinear and skew axes, fixed joints between, a continuous
 /// joint and a tool rotated off the last axis.
-const AWKWARD: &str = r#"<?xml version="1.0"?>
+pub(super) const AWKWARD: &str = r#"<?xml version="1.0"?>
 <robot name="awkward">
   <link name="world"/> <link name="l1"/> <link name="l2"/> <link name="l3"/> <link name="l4"/>
   <link name="l5"/> <link name="l5b"/> <link name="l6"/> <link name="l7"/> <link name="tip"/>
@@ -182,7 +182,7 @@ fn one_joint_and_each_axis_pair_alone() {
     }
 }
 
-const TREE: &str = r#"<robot name="two_arms">
+pub(super) const TREE: &str = r#"<robot name="two_arms">
   <link name="torso"/> <link name="l1"/> <link name="l2"/> <link name="left_hand"/>
   <link name="right_hand"/> <link name="camera"/>
   <joint name="cam" type="fixed"><parent link="torso"/><child link="camera"/>
@@ -327,8 +327,8 @@ fn urdf_sniffing() {
 }
 
 /// Reading is linear in the file's size: a chain of 100,000 fixed joints after one revolute joint
-/// reads in little more than urdf-rs's XML reading of it (it took minutes while each joint's line
-/// was searched in the text).
+/// is read and imported in under 2 s (release build; it took minutes while each joint's line was
+/// searched in the text).
 #[test]
 fn a_long_fixed_chain_reads_in_linear_time() {
     let n = 100_000;
@@ -348,11 +348,6 @@ fn a_long_fixed_chain_reads_in_linear_time() {
         ));
     }
     text.push_str("</robot>");
-    // The XML reading of urdf-rs alone (about 2 s on a loaded 2-core machine): the bound.
-    let start = std::time::Instant::now();
-    let xml = urdf_rs::read_from_string(&text).unwrap();
-    let xml_took = start.elapsed();
-    drop(xml);
     let start = std::time::Instant::now();
     let r = parse(&text, &ChainSelection::default()).unwrap();
     let took = start.elapsed();
@@ -360,10 +355,9 @@ fn a_long_fixed_chain_reads_in_linear_time() {
     // The tool is 100 mm + 100,000 x 0.001 mm above the base.
     let p = r.tool_position(&[0.3]);
     assert!((p.z - 200.0).abs() < 1e-6, "{p:?}");
-    // robocal's own work on the chain is small beside the XML reading (it was quadratic: 11
-    // minutes for this file).
-    assert!(
-        took.as_secs_f64() < 2.0 * xml_took.as_secs_f64() + 1.0,
-        "took {took:?}, the XML reading alone {xml_took:?}"
-    );
+    // It was quadratic (11 minutes for this file), then took 5.7-7.3 s through urdf-rs's two DOM
+    // passes (`robot show`, whole process, under a load of about 7); read in one streaming pass,
+    // 1.1-1.3 s for the whole process on the same machine.
+    let bound = if cfg!(debug_assertions) { 20.0 } else { 2.0 };
+    assert!(took.as_secs_f64() < bound, "took {took:?}");
 }
