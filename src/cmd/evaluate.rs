@@ -4,7 +4,6 @@
 
 mod conditions;
 mod constraints;
-pub(crate) use constraints::is_constraint_file;
 
 use super::common;
 use super::io_plan::{self, IoPlan};
@@ -159,7 +158,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         robocal_core::io::inputs::check_unchanged(inputs, &data, &params)?;
     }
     let section = robocal_core::io::result_constraint::ConstraintSection::of(&res, &params)?;
-    if constraints::is_constraint_file(&data, &nominal)? {
+    if super::calibrate::is_constraint_file(&data, &nominal)? {
         if per_point_path.is_some() || !matches!(against, Against::Auto | Against::Model) {
             return Err(crate::exit::usage(
                 "--per-point and --against desired apply to tracker points, not to constraint \

@@ -21,7 +21,7 @@ use std::path::Path;
 
 /// Whether the measurement file at `path` holds constraint rows (its header has a
 /// `constraint` column).
-pub(super) fn is_constraint_file(path: &Path, robot: &Robot) -> anyhow::Result<bool> {
+pub(crate) fn is_constraint_file(path: &Path, robot: &Robot) -> anyhow::Result<bool> {
     let r = MeasurementReader::open(path, robot.joint_space(), Positions::Ignored)?;
     Ok(r.extra_columns()
         .iter()

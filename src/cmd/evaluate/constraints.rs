@@ -8,20 +8,11 @@
 //!   so).
 
 use robocal_core::identification::constraint::result::held_out;
-use robocal_core::io::measurements::MeasurementReader;
 use robocal_core::io::result_constraint::ConstraintSection;
 use robocal_core::io::{read_measurements, Positions};
-use robocal_core::observations::constraint::{ConstraintData, CONSTRAINT_COLUMN};
+use robocal_core::observations::constraint::ConstraintData;
 use robocal_core::{ErrorStats, Robot};
 use std::path::Path;
-
-/// Whether the measurement file at `path` holds constraint rows (a `constraint` column).
-pub(crate) fn is_constraint_file(path: &Path, robot: &Robot) -> anyhow::Result<bool> {
-    let r = MeasurementReader::open(path, robot.joint_space(), Positions::Ignored)?;
-    Ok(r.extra_columns()
-        .iter()
-        .any(|c| c.eq_ignore_ascii_case(CONSTRAINT_COLUMN)))
-}
 
 /// What evaluating constraint rows needs.
 pub(super) struct HeldOut<'a> {
