@@ -77,8 +77,13 @@ fn bad_rows_are_errors_naming_file_line_and_column() {
         "{e}"
     );
     let e = err(&format!("q1,q2,constraint,x,y,z\n{pts}5,6,,1,a,3\n"));
-    assert!(e.contains("c.csv:4") && e.contains("`a` is not a number"), "{e}");
-    let e = err(&format!("q1,q2,constraint,x,y,z\n{pts}5,6,,1,2,3\n7,8,,4,5,6\n"));
+    assert!(
+        e.contains("c.csv:4") && e.contains("`a` is not a number"),
+        "{e}"
+    );
+    let e = err(&format!(
+        "q1,q2,constraint,x,y,z\n{pts}5,6,,1,2,3\n7,8,,4,5,6\n"
+    ));
     assert!(
         e.contains("c.csv:4") && e.contains("2 tracker row(s)") && e.contains("at least 3"),
         "{e}"
