@@ -143,3 +143,102 @@ pub fn calibrate_constraint_file(
     text.push('\n');
     Ok((text, status, warnings, seconds))
 }
+
+/// `robocal simulate --constraint KIND`: constraint data of the truth (`"random"`, a preset, a
+/// robot file, a truth file or a Robot) written to `out` (and the true distances to
+/// `distances_out`), the truth file beside `out` (`FILE.truth.json`), through the CLI's library
+/// calls, so the files are the CLI's for the same settings. Returns the truth file's path.
+#[pyfunction]
+#[pyo3(signature = (robot, out, truth, kind, features = 4, per_feature = 20, noise_mm = 0.01,
+                    radius_mm = 25.0, unknown_radius = false, tilt_deg = 60.0, span_mm = 300.0,
+                    seed = 1, distances_out = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_constraints(
+    robot: &PyRobot,
+    out: PathBuf,
+    truth: &Bound<'_, PyAny>,
+    kind: &str,
+    features: usize,
+    per_feature: usize,
+    noise_mm: f64,
+    radius_mm: f64,
+    unknown_radius: bool,
+    tilt_deg: f64,
+    span_mm: f64,
+    seed: u64,
+    distances_out: Option<PathBuf>,
+) -> PyResult<PathBuf> {
+    use robocal_core::io::measurements::measurements_csv;
+    use robocal_core::observations::constraint::ConstraintKind;
+    use robocal_core::simulation::constraint::{
+        constraint_measurements, distances_csv, simulate_constraints as simulate, truth_json,
+        ConstraintSimulation,
+    };
+    use robocal_core::simulation::{
+        check_truth_matches, stream_rng, GeometricErrors, PoseSampler, Stream, TruthSource,
+    };
+    let nominal = &robot.inner;
+    let Some(kind) = ConstraintKind::parse(kind) else {
+        return Err(crate::errors::usage(format!(
+            "constraint: `{kind}` is not point, sphere or plane"
+        )));
+    };
+    if distances_out.is_some() && kind == ConstraintKind::Plane {
+        return Err(crate::errors::usage(
+            "distances_out: planes have no distances (they are between points or sphere centres)",
+        ));
+    }
+    let label = match truth.extract::<String>() {
+        Ok(s) => s,
+        Err(_) => "robot".to_owned(),
+    };
+    let (true_robot, errors) = match crate::simulate::truth_arg(truth, nominal)? {
+        TruthSource::Random => {
+            let e = GeometricErrors::default();
+            let t = e
+                .apply(nominal, &mut stream_rng(seed, Stream::Truth))
+                .py_err()?;
+            (t, Some(e))
+        }
+        TruthSource::Robot(t) | TruthSource::File { robot: t, .. } => {
+            check_truth_matches(nominal, &t).py_err()?;
+            (t, None)
+        }
+    };
+    let spec = ConstraintSimulation {
+        kind,
+        features,
+        per_feature,
+        noise_mm,
+        radius_mm,
+        radius_known: !unknown_radius,
+        tilt_deg,
+        span_mm,
+        distances: distances_out.is_some(),
+        seed,
+    };
+    spec.validate()
+        .map_err(|e| crate::errors::usage(format!("constraint {}: {e}", kind.key())))?;
+    let sampler = PoseSampler {
+        footprint_radius_mm: 0.15 * nominal.reach_mm(),
+        ..PoseSampler::default()
+    };
+    let sim = simulate(&true_robot, &sampler, &spec).py_err()?;
+    let csv = measurements_csv(&constraint_measurements(nominal, &sim.data))
+        .map_err(|e| raise(1, format!("cannot write the measurement CSV: {e}")))?;
+    let dist = distances_csv(&sim.data).into_bytes();
+    let truth_out = out.with_extension("truth.json");
+    let name = out
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tj = truth_json((nominal, &true_robot), (&label, errors), &spec, &sim, &name)
+        .py_err()?
+        .into_bytes();
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&out, &csv), (&truth_out, &tj)];
+    if let Some(d) = &distances_out {
+        files.push((d, &dist));
+    }
+    robocal_core::io::write_all_atomic(&files).py_err()?;
+    Ok(truth_out)
+}

@@ -34,6 +34,7 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate::calibrate_files, m)?)?;
     m.add_function(wrap_pyfunction!(constraints::is_constraint_file, m)?)?;
     m.add_function(wrap_pyfunction!(constraints::calibrate_constraint_file, m)?)?;
+    m.add_function(wrap_pyfunction!(constraints::simulate_constraints, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(compensate::compensate_arrays, m)?)?;
     m.add_class::<simulation::PySimulation>()?;

@@ -103,3 +103,31 @@ def test_tracker_points_are_registered_to_a_constraint_result(points, cli):
     r.write(res)
     j = json.loads(cli("evaluate", "--params", str(res), "--data", str(trk), "--json"))
     assert j["calibrated"]["mean_mm"] == pytest.approx(cal, rel=1e-9)
+
+
+@pytest.mark.parametrize("kind", ["point", "sphere"])
+def test_simulate_constraints_writes_the_clis_files(kind, cli, tmp_path):
+    kr = robocal.Robot.preset(KR)
+    py_out, py_dist = tmp_path / "py.csv", tmp_path / "py.d.csv"
+    truth = robocal.simulate_constraints(
+        kr, py_out, kind, per_feature=8, seed=5, distances_out=py_dist
+    )
+    assert truth == str(tmp_path / "py.truth.json")
+    cli_out, cli_dist = tmp_path / "cli.csv", tmp_path / "cli.d.csv"
+    cli(
+        "simulate", "--robot", KR, "--truth", "random", "--constraint", kind,
+        "--per-feature", "8", "--seed", "5", "--noise-mm", "0.01",
+        "--out", str(cli_out), "--distances-out", str(cli_dist),
+    )
+    assert py_out.read_bytes() == cli_out.read_bytes()
+    assert py_dist.read_bytes() == cli_dist.read_bytes()
+    py_truth = json.loads((tmp_path / "py.truth.json").read_text())
+    cli_truth = json.loads((tmp_path / "cli.truth.json").read_text())
+    assert py_truth["sets"]["constraint"]["file"] == "py.csv"
+    py_truth["sets"]["constraint"]["file"] = "cli.csv"
+    assert py_truth == cli_truth
+    # Planes have no distances; a kind that is not one is a usage error.
+    with pytest.raises(robocal.UsageError, match="planes have no distances"):
+        robocal.simulate_constraints(kr, tmp_path / "x.csv", "plane", distances_out=py_dist)
+    with pytest.raises(robocal.UsageError, match="not point, sphere or plane"):
+        robocal.simulate_constraints(kr, tmp_path / "x.csv", "circle")

@@ -11,7 +11,7 @@ use robocal_core::io::measurements::measurements_csv;
 use robocal_core::io::write_all_atomic;
 use robocal_core::observations::constraint::ConstraintKind;
 use robocal_core::simulation::constraint::{
-    constraint_measurements, distances_csv, simulate_constraints, ConstraintSimulation,
+    constraint_measurements, distances_csv, simulate_constraints, truth_json, ConstraintSimulation,
 };
 use robocal_core::simulation::{
     check_truth_matches, stream_rng, GeometricErrors, PoseSampler, Stream, TruthSource,
@@ -82,7 +82,19 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
     let csv = measurements_csv(&set)?;
     let dist = distances_csv(&sim.data).into_bytes();
     let truth_out = super::truth_path(&a.out);
-    let truth_json = truth_file(a, (&nominal, &truth, errors), &spec, &sim)?.into_bytes();
+    let file_name = a
+        .out
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let truth_json = truth_json(
+        (&nominal, &truth),
+        (&a.truth, errors),
+        &spec,
+        &sim,
+        &file_name,
+    )?
+    .into_bytes();
     let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&a.out, &csv), (&truth_out, &truth_json)];
     if let Some(d) = &a.distances_out {
         files.push((d, &dist));
@@ -108,97 +120,4 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
         truth_out.display()
     )?;
     Ok(())
-}
-
-/// The truth file: the one the other simulate modes write (the true robot's parameters; the
-/// tracker frame the identity, as there is no tracker), with a `constraint` section holding the
-/// true features (base frame of the true robot) and the simulation's settings.
-fn truth_file(
-    a: &SimulateArgs,
-    (nominal, truth, errors): (
-        &robocal_core::Robot,
-        &robocal_core::Robot,
-        Option<GeometricErrors>,
-    ),
-    spec: &ConstraintSimulation,
-    sim: &robocal_core::simulation::constraint::SimulatedConstraints,
-) -> anyhow::Result<String> {
-    use robocal_core::io::result::{FrameVec, RobotInfo};
-    use robocal_core::simulation::{SetInfo, SimulationConfig, TruthFile};
-    let identity = FrameVec {
-        x: 0.0,
-        y: 0.0,
-        z: 0.0,
-        a: 0.0,
-        b: 0.0,
-        c: 0.0,
-    };
-    let file_name = a
-        .out
-        .file_name()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tf = TruthFile {
-        generator: format!("robocal-core {}", env!("CARGO_PKG_VERSION")),
-        robot: RobotInfo::shape_of(truth),
-        nominal: nominal.name().to_owned(),
-        truth: a.truth.clone(),
-        parameters: TruthFile::parameter_entries(nominal, truth),
-        tracker_frame: identity,
-        settings: SimulationConfig {
-            seed: a.seed,
-            poses: sim.data.rows.len(),
-            validation_poses: 0,
-            plane_points: false,
-            plane_z_mm: None,
-            tracker_frame: identity,
-            noise_mm: spec.noise_mm,
-            noise_per_m: 0.0,
-            ..SimulationConfig::default()
-        },
-        geometric_errors: errors,
-        joints_file: None,
-        sets: [(
-            "constraint".to_owned(),
-            SetInfo {
-                rows: sim.data.rows.len(),
-                file: file_name,
-            },
-        )]
-        .into_iter()
-        .collect(),
-        plane_z_mm: None,
-        outliers: Vec::new(),
-        gravity_effect: None,
-        warnings: Vec::new(),
-    };
-    let mut v = serde_json::to_value(&tf)?;
-    let features: Vec<serde_json::Value> = sim
-        .data
-        .features
-        .iter()
-        .zip(sim.true_positions.iter().zip(&sim.true_normals))
-        .map(|(f, (p, n))| {
-            serde_json::json!({
-                "kind": f.kind.key(),
-                "name": f.name,
-                "position_mm": [p.x, p.y, p.z],
-                "radius_mm": (f.kind == ConstraintKind::Sphere).then_some(spec.radius_mm),
-                "radius_given": f.radius_mm.is_some(),
-                "normal": n.map(|n| [n.x, n.y, n.z]),
-            })
-        })
-        .collect();
-    v["constraint"] = serde_json::json!({
-        "frame": "base frame of the true robot",
-        "kind": spec.kind.key(),
-        "features": features,
-        "per_feature": spec.per_feature,
-        "tilt_deg": spec.tilt_deg,
-        "span_mm": spec.span_mm,
-        "distances": sim.data.distances.len(),
-    });
-    let mut s = serde_json::to_string_pretty(&v)?;
-    s.push('\n');
-    Ok(s)
 }

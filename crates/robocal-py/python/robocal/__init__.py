@@ -60,6 +60,7 @@ __all__ = [
     "evaluate",
     "compensate",
     "simulate",
+    "simulate_constraints",
     "Simulation",
     "plan",
     "Plan",
@@ -445,6 +446,48 @@ def calibrate_files(
             os.fspath(data),
             None if validate is None else os.fspath(validate),
             opts,
+        )
+    )
+
+
+def simulate_constraints(
+    robot: Robot,
+    out: Union[str, os.PathLike],
+    constraint: str = "point",
+    *,
+    truth: Union[str, "os.PathLike[str]", Robot] = "random",
+    features: int = 4,
+    per_feature: int = 20,
+    noise_mm: float = 0.010,
+    radius_mm: float = 25.0,
+    unknown_radius: bool = False,
+    tilt_deg: float = 60.0,
+    span_mm: float = 300.0,
+    seed: int = 1,
+    distances_out: Optional[Union[str, os.PathLike]] = None,
+) -> str:
+    """Constraint data without a tracker: the CLI's ``robocal simulate --constraint
+    point|sphere|plane`` (the same files for the same settings). The true robot brings its tool
+    point to ``features`` fixed points, onto spheres (``radius_mm``; ``unknown_radius`` leaves
+    ``radius_mm`` empty in the file) or onto planes, in ``per_feature`` configurations each;
+    writes the measurement CSV to ``out``, the truth file beside it (returned: its path) and,
+    with ``distances_out``, the true distances between the points or sphere centres.
+    """
+    return os.fspath(
+        _robocal.simulate_constraints(
+            robot,
+            os.fspath(out),
+            truth,
+            constraint,
+            features,
+            per_feature,
+            noise_mm,
+            radius_mm,
+            unknown_radius,
+            tilt_deg,
+            span_mm,
+            seed,
+            None if distances_out is None else os.fspath(distances_out),
         )
     )
 
