@@ -158,7 +158,8 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         robocal_core::io::inputs::check_unchanged(inputs, &data, &params)?;
     }
     let section = robocal_core::io::result_constraint::ConstraintSection::of(&res, &params)?;
-    if super::calibrate::is_constraint_file(&data, &nominal)? {
+    // A file that cannot be read is the reader's to report, with its context.
+    if super::calibrate::is_constraint_file(&data, &nominal).unwrap_or(false) {
         if per_point_path.is_some() || !matches!(against, Against::Auto | Against::Model) {
             return Err(crate::exit::usage(
                 "--per-point and --against desired apply to tracker points, not to constraint \

@@ -227,7 +227,7 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         robocal_core::io::result_constraint::ConstraintSection::of(&result, &result_path)?;
     let mut data_path = data_path;
     if let Some(p) = data_path.as_ref() {
-        if super::calibrate::is_constraint_file(p, &nominal)? {
+        if super::calibrate::is_constraint_file(p, &nominal).unwrap_or(false) {
             errln!(
                 "note: {} holds constraint rows, which have no tracker points to plot; the \
                  report shows their residuals from the result (robocal evaluate gives those of \
