@@ -10,6 +10,7 @@ use robocal_core::io::result_sections::RowsOutside;
 use std::path::PathBuf;
 
 mod constraints;
+pub(crate) use constraints::is_constraint_file;
 mod joint_list;
 mod print;
 mod real_cell;

@@ -234,6 +234,16 @@ impl TryFrom<&CompensateArgs> for Settings {
                 super::common::indent(&why)
             )?;
         }
+        if robocal_core::io::result_constraint::ConstraintSection::of(&res, &a.params)?
+            .is_some_and(|s| !s.base_pose_known)
+        {
+            errln!(
+                "note: {} is a constraint calibration, up to the base pose: targets are taken in \
+                 the calibrated base frame, whose pose is the nominal one; positions are right \
+                 relative to each other and to the constrained features, not absolutely",
+                a.params.display()
+            )?;
+        }
         Ok(Settings {
             nominal,
             calibrated,

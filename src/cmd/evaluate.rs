@@ -3,6 +3,7 @@
 //! desired positions (verification, section V.B, Table V).
 
 mod conditions;
+mod constraints;
 
 use super::common;
 use super::io_plan::{self, IoPlan};
@@ -155,6 +156,37 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     } = Settings::try_from(&a)?;
     if let Some(inputs) = &res.inputs {
         robocal_core::io::inputs::check_unchanged(inputs, &data, &params)?;
+    }
+    let section = robocal_core::io::result_constraint::ConstraintSection::of(&res, &params)?;
+    // A file that cannot be read is the reader's to report, with its context.
+    if super::calibrate::is_constraint_file(&data, &nominal).unwrap_or(false) {
+        if per_point_path.is_some() || !matches!(against, Against::Auto | Against::Model) {
+            return Err(crate::exit::usage(
+                "--per-point and --against desired apply to tracker points, not to constraint \
+                 rows",
+            ));
+        }
+        return constraints::run(constraints::HeldOut {
+            nominal: &nominal,
+            calibrated: &cal,
+            section: section.as_ref(),
+            params: &params,
+            data: &data,
+            json,
+        });
+    }
+    // A calibration up to the base pose has no tracker frame: tracker points are registered to
+    // it, as with --refit-frame.
+    let refit_frame = refit_frame || section.as_ref().is_some_and(|s| !s.base_pose_known);
+    if let Some(s) = section.as_ref().filter(|s| !s.base_pose_known) {
+        errln!(
+            "note: {} is a constraint calibration: {}; the tracker frame of {} is registered to \
+             its points under each model (as --refit-frame), so the errors are those after the \
+             best rigid alignment",
+            params.display(),
+            s.frame,
+            data.display()
+        )?;
     }
     // Row by row: only the error norms are kept (16 bytes per row), so files of any length fit.
     let context = || format!("--data {}", data.display());

@@ -110,6 +110,12 @@ impl TryFrom<&ExportArgs> for Settings {
                 tf.x, tf.y, tf.z, tf.a, tf.b, tf.c
             ),
         ];
+        if let Some(c) =
+            robocal_core::io::result_constraint::ConstraintSection::of(&res, &a.result)?
+        {
+            notes.pop();
+            notes.extend(constraint_notes(&c));
+        }
         if format == ExportFormat::Urdf {
             notes.push(
                 "Joint values are robocal's model joint values (rad; m for a prismatic joint). \
@@ -138,6 +144,41 @@ impl TryFrom<&ExportArgs> for Settings {
             out: a.out.clone(),
         })
     }
+}
+
+/// The notes of a constraint calibration: its frame, its features and what its data cannot see.
+fn constraint_notes(c: &robocal_core::io::result_constraint::ConstraintSection) -> Vec<String> {
+    let mut notes = vec![format!(
+        "Calibrated from constraint data (no tracker): {}.",
+        c.frame
+    )];
+    for f in &c.features {
+        let [x, y, z] = f.position_mm;
+        notes.push(format!(
+            "Feature {} at ({x:.4}, {y:.4}, {z:.4}) mm in the base frame{}{} ({} rows, residual \
+             RMS {:.4} mm).",
+            f.label(),
+            f.radius_mm
+                .map_or(String::new(), |r| format!(", radius {r:.4} mm")),
+            f.normal.map_or(String::new(), |[a, b, c]| format!(
+                ", normal ({a:.6}, {b:.6}, {c:.6})"
+            )),
+            f.rows,
+            f.residual_rms_mm
+        ));
+    }
+    notes.push(match (&c.scale.from, &c.scale.held) {
+        (Some(from), _) => format!("Scale from {from}."),
+        (None, Some(held)) => format!(
+            "Scale NOT determined by the data: {held} held at its nominal value (accepted \
+             explicitly)."
+        ),
+        (None, None) => "Scale: not recorded.".into(),
+    });
+    for u in &c.unseen {
+        notes.push(format!("Not identifiable from these data: {u}."));
+    }
+    notes
 }
 
 pub fn run(a: ExportArgs) -> anyhow::Result<()> {

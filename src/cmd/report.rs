@@ -223,6 +223,20 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
             robocal_core::io::inputs::check_unchanged(inputs, p, &result_path)?;
         }
     }
+    let section =
+        robocal_core::io::result_constraint::ConstraintSection::of(&result, &result_path)?;
+    let mut data_path = data_path;
+    if let Some(p) = data_path.as_ref() {
+        if super::calibrate::is_constraint_file(p, &nominal).unwrap_or(false) {
+            errln!(
+                "note: {} holds constraint rows, which have no tracker points to plot; the \
+                 report shows their residuals from the result (robocal evaluate gives those of \
+                 held-out rows)",
+                p.display()
+            )?;
+            data_path = None;
+        }
+    }
     let data = read(&data_path, joints, "--data")?;
     let validation = read(&val_path, joints, "--validate")?;
     let verification = read(&verify, joints, "--verify")?;
@@ -267,6 +281,9 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
             .settings
             .push(robocal_report::Setting::new("Verification data", name(v)));
     }
+    if let Some(c) = &section {
+        constraint_report(&mut report, c);
+    }
     let files = write_report(&out, &report)?;
     print_summary(&report)?;
     outln!(
@@ -275,6 +292,90 @@ pub fn run(a: ReportArgs) -> anyhow::Result<()> {
         files.histogram_svg.display()
     )?;
     Ok(())
+}
+
+/// A constraint calibration's report: its error tables are the constraint residuals, and its
+/// settings show the frame, the features, the scale and what the data cannot see.
+fn constraint_report(
+    report: &mut ReportData,
+    c: &robocal_core::io::result_constraint::ConstraintSection,
+) {
+    use robocal_report::Setting;
+    for t in &mut report.error_tables {
+        if t.title.starts_with("Before") {
+            t.title = "Before calibration: constraint residuals, nominal model with the features \
+                       fitted to it"
+                .into();
+        } else if t.title.starts_with("After") {
+            t.title =
+                "After calibration: constraint residuals, calibrated model and features".into();
+        }
+        t.caption = Some(
+            "Distance of each row's tool point from its fixed point, or from its sphere's or \
+             plane's surface (mm)."
+                .into(),
+        );
+        for r in &mut t.rows {
+            r.label = r.label.replace("points", "rows");
+        }
+    }
+    let s = &mut report.settings;
+    s.push(Setting::new(
+        "Data",
+        format!(
+            "constraint rows (no tracker): {} row(s) on {} feature(s), {} known distance(s){}",
+            c.rows,
+            c.features.len(),
+            c.known_distances.len(),
+            if c.tracker_rows > 0 {
+                format!(", with {} tracker row(s)", c.tracker_rows)
+            } else {
+                String::new()
+            }
+        ),
+    ));
+    s.push(Setting::new("Frame", &c.frame));
+    s.push(Setting::new(
+        "Scale",
+        match (&c.scale.from, &c.scale.held) {
+            (Some(from), _) => format!("from {from}"),
+            (None, Some(held)) => format!(
+                "NOT determined by the data: {held} held at its nominal value (accepted \
+                 explicitly)"
+            ),
+            (None, None) => "not recorded".into(),
+        },
+    ));
+    for f in &c.features {
+        let [x, y, z] = f.position_mm;
+        s.push(Setting::new(
+            format!("Feature {}", f.label()),
+            format!(
+                "({x:.3}, {y:.3}, {z:.3}) mm{}{}; {} row(s), residual RMS {:.4} mm",
+                f.radius_mm.map_or(String::new(), |r| format!(
+                    ", radius {r:.3} mm{}",
+                    if f.radius_given { " (given)" } else { "" }
+                )),
+                f.normal.map_or(String::new(), |[a, b, c]| format!(
+                    ", normal ({a:.5}, {b:.5}, {c:.5})"
+                )),
+                f.rows,
+                f.residual_rms_mm
+            ),
+        ));
+    }
+    for d in &c.known_distances {
+        s.push(Setting::new(
+            format!("Distance {}-{}", d.from, d.to),
+            format!(
+                "{:.4} mm given, fitted {:+.4} mm",
+                d.distance_mm, d.residual_mm
+            ),
+        ));
+    }
+    for u in &c.unseen {
+        s.push(Setting::new("Not identifiable", u));
+    }
 }
 
 fn print_summary(report: &ReportData) -> anyhow::Result<()> {

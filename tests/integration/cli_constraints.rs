@@ -62,11 +62,30 @@ fn fixed_points_with_distances_calibrate_up_to_the_base_pose() {
     assert!(text.contains("the base pose"), "{text}");
     assert!(text.contains("base_x") && text.contains("held"), "{text}");
     let r = read_json(&out);
-    assert_eq!(r["kind"], "constraint-calibration");
-    assert!(r["residual_rms_mm"].as_f64().unwrap() < 0.03, "{r}");
-    assert_eq!(r["features"].as_array().unwrap().len(), 4);
-    assert!(r["frame"].as_str().unwrap().contains("up to the base pose"));
-    assert!(r["identified"].as_array().unwrap().len() >= 15, "{r}");
+    // A normal result file (status, robot, parameters, inputs) with a `constraint` section.
+    assert_eq!(r["status"], "calibrated");
+    assert_eq!(r["robot"]["name"], KR);
+    assert!(
+        r["inputs"]["data"]["sha256"].as_str().unwrap().len() == 64,
+        "{r}"
+    );
+    assert!(r["inputs"]["distances"]["sha256"].is_string(), "{r}");
+    let c = &r["constraint"];
+    assert!(c["residual_rms_mm"].as_f64().unwrap() < 0.03, "{c}");
+    assert_eq!(c["features"].as_array().unwrap().len(), 4);
+    assert_eq!(c["base_pose_known"], false);
+    assert!(c["frame"].as_str().unwrap().contains("up to the base pose"));
+    let params = r["parameters"].as_object().unwrap();
+    let identified = params.values().filter(|e| e["fixed"] == false).count();
+    assert!(identified >= 15, "{r}");
+    assert_eq!(params["base_x"]["fixed"], true);
+    let after = r["errors"]["calibration"]["after"]["mean_mm"]
+        .as_f64()
+        .unwrap();
+    let before = r["errors"]["calibration"]["before"]["mean_mm"]
+        .as_f64()
+        .unwrap();
+    assert!(after < 0.03 && before > 10.0 * after, "{before} {after}");
 }
 
 #[test]
@@ -99,7 +118,9 @@ fn without_distances_the_scale_is_refused_unless_accepted() {
         "{}",
         o.stderr()
     );
-    assert_eq!(read_json(&out)["scale"]["assumed"], true);
+    let c = &read_json(&out)["constraint"];
+    assert_eq!(c["scale"]["known"], false, "{c}");
+    assert!(c["scale"]["held"].is_string(), "{c}");
 }
 
 #[test]

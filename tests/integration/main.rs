@@ -26,6 +26,8 @@ mod cli_calibrate;
 mod cli_compensate;
 mod cli_compensate_pose;
 mod cli_compliance;
+mod cli_constraint_mixed;
+mod cli_constraint_readers;
 mod cli_constraints;
 mod cli_demo;
 mod cli_evaluate;

@@ -69,7 +69,26 @@ pub fn evaluate_arrays<'py>(
         rows,
         warnings: Vec::new(),
     };
-    let frames = [res.nominal_frame(), res.tracker_frame()];
+    // A constraint calibration up to the base pose has no tracker frame: the points are
+    // registered to it under each model, as the CLI's evaluate does.
+    let section = robocal_core::io::result_constraint::ConstraintSection::of(
+        &res,
+        Path::new("<result json>"),
+    )
+    .py_err()?;
+    let frames = if section.is_some_and(|s| !s.base_pose_known) {
+        warnings.push(
+            "the result is a constraint calibration, up to the base pose: the tracker frame is \
+             registered to these points under each model (as the CLI's evaluate does), so the \
+             errors are those after the best rigid alignment"
+                .into(),
+        );
+        let (n, c) =
+            robocal_core::evaluation::station_frames(&nom.inner, &cal.inner, &data).py_err()?;
+        [n, c]
+    } else {
+        [res.nominal_frame(), res.tracker_frame()]
+    };
     let ev = py
         .detach(|| {
             evaluate_framed(

@@ -10,6 +10,7 @@ mod args;
 mod arrays;
 mod calibrate;
 mod compensate;
+mod constraints;
 mod errors;
 mod evaluate;
 mod import;
@@ -31,6 +32,9 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<robot::PyRobot>()?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(calibrate::calibrate_files, m)?)?;
+    m.add_function(wrap_pyfunction!(constraints::is_constraint_file, m)?)?;
+    m.add_function(wrap_pyfunction!(constraints::calibrate_constraint_file, m)?)?;
+    m.add_function(wrap_pyfunction!(constraints::simulate_constraints, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(compensate::compensate_arrays, m)?)?;
     m.add_class::<simulation::PySimulation>()?;

@@ -20,7 +20,7 @@ use std::path::PathBuf;
 
 /// The truth robot (`robocal simulate --truth`): a `Robot`, or a name the library reads
 /// (`random`, a preset, a robot file, a truth file).
-fn truth_arg(truth: &Bound<'_, PyAny>, nominal: &Robot) -> PyResult<TruthSource> {
+pub(crate) fn truth_arg(truth: &Bound<'_, PyAny>, nominal: &Robot) -> PyResult<TruthSource> {
     if let Ok(r) = truth.extract::<PyRef<'_, PyRobot>>() {
         return Ok(TruthSource::Robot(r.inner.clone()));
     }

@@ -17,12 +17,11 @@ use robocal_core::model::Robot;
 use robocal_core::observations::constraint::{
     read_distances, ConstraintData, ConstraintKind, CONSTRAINT_COLUMN,
 };
-use serde_json::json;
 use std::path::Path;
 
 /// Whether the measurement file at `path` holds constraint rows (its header has a
 /// `constraint` column).
-pub(super) fn is_constraint_file(path: &Path, robot: &Robot) -> anyhow::Result<bool> {
+pub(crate) fn is_constraint_file(path: &Path, robot: &Robot) -> anyhow::Result<bool> {
     let r = MeasurementReader::open(path, robot.joint_space(), Positions::Ignored)?;
     Ok(r.extra_columns()
         .iter()
@@ -58,14 +57,19 @@ pub(super) fn run(
     let count = |k: ConstraintKind| data.features.iter().filter(|f| f.kind == k).count();
     outln!(
         "robot {} ({} joints); {} constraint row(s): {} fixed point(s), {} sphere(s), {} \
-         plane(s); {} known distance(s)",
+         plane(s); {} known distance(s){}",
         robot.name(),
         robot.dof(),
         data.rows.len(),
         count(ConstraintKind::Point),
         count(ConstraintKind::Sphere),
         count(ConstraintKind::Plane),
-        data.distances.len()
+        data.distances.len(),
+        if data.tracker.is_empty() {
+            String::new()
+        } else {
+            format!("; {} tracker row(s)", data.tracker.len())
+        }
     )?;
     let opts = ConstraintOptions {
         accept_unknown_scale,
@@ -89,7 +93,8 @@ pub(super) fn run(
             s.out.display()
         )));
     }
-    let mut json = result_json(s, &cal, &data);
+    let mut res = cal.to_result(robot, &data)?;
+    res.inputs = Some(record_inputs(s, distances)?);
     if !cal.implausible.is_empty() {
         let summary = common::indent(&cal.implausible.join("\n"));
         if !s.accept_implausible {
@@ -101,14 +106,11 @@ pub(super) fn run(
                 s.out.display()
             )));
         }
-        json["status"] = "implausible".into();
-        json["implausible"] = cal.implausible.clone().into();
         errln!(
             "WARNING: IMPLAUSIBLE FIT WRITTEN (--accept-implausible): failed checks:\n{summary}"
         )?;
     }
-    let bytes = serde_json::to_vec_pretty(&json)?;
-    robocal_core::io::atomic::write_atomic(&s.out, &bytes)?;
+    res.write(&s.out)?;
     outln!("result written to {}", s.out.display())?;
     Ok(())
 }
@@ -168,6 +170,22 @@ fn print(nominal: &Robot, cal: &ConstraintCalibration) -> anyhow::Result<()> {
     for d in &cal.distance_residuals_mm {
         outln!("  known distance residual {d:+.4} mm")?;
     }
+    if let Some(f) = &cal.frame {
+        let v = robocal_core::frame::TrackerFrame::new(*f).vector_deg();
+        let n = cal.tracker_residuals_mm.len().max(1) as f64;
+        let rms = (cal.tracker_residuals_mm.iter().map(|x| x * x).sum::<f64>() / n).sqrt();
+        outln!(
+            "tracker frame registered by {} tracker row(s): x={:.3} y={:.3} z={:.3} mm, A={:.4} \
+             B={:.4} C={:.4} deg; tracker rows' residual RMS {rms:.4} mm",
+            cal.tracker_residuals_mm.len(),
+            v[0],
+            v[1],
+            v[2],
+            v[3],
+            v[4],
+            v[5]
+        )?;
+    }
     match &cal.scale {
         Scale::Known { from } => outln!("scale: from {from}")?,
         Scale::Assumed { held } => errln!(
@@ -186,54 +204,21 @@ fn print(nominal: &Robot, cal: &ConstraintCalibration) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The result file: what was identified, the features, what the data cannot see.
-fn result_json(
+/// The result's `inputs`: the robot file (not a preset), the data and the distances file, each
+/// with its path and SHA-256.
+fn record_inputs(
     s: &Settings,
-    cal: &ConstraintCalibration,
-    data: &ConstraintData,
-) -> serde_json::Value {
-    let params: serde_json::Map<String, serde_json::Value> = cal
-        .robot
-        .param_list()
-        .iter()
-        .map(|p| (p.name(), json!(cal.robot.get_display(*p))))
-        .collect();
-    let features: Vec<serde_json::Value> = cal
-        .features
-        .iter()
-        .zip(&cal.feature_rms_mm)
-        .map(|(f, rms)| {
-            json!({
-                "label": f.label(),
-                "position_mm": [f.position.x, f.position.y, f.position.z],
-                "radius_mm": f.radius_mm,
-                "radius_given": f.radius_known,
-                "normal": f.normal.map(|n| [n.x, n.y, n.z]),
-                "offset_mm": f.offset_mm,
-                "residual_rms_mm": rms,
-            })
-        })
-        .collect();
-    json!({
-        "kind": "constraint-calibration",
-        "robot": s.robot_arg,
-        "data": s.data.display().to_string(),
-        "frame": "base frame of the nominal robot: the calibration is up to the base pose",
-        "rows": data.rows.len(),
-        "known_distances": data.distances.len(),
-        "scale": match &cal.scale {
-            Scale::Known { from } => json!({ "from": from }),
-            Scale::Assumed { held } => json!({ "assumed": true, "held": held.name() }),
-        },
-        "identified": cal.identified.iter().map(|p| p.name()).collect::<Vec<_>>(),
-        "fixed": cal.fixed.iter().map(|f| json!({ "param": f.param.name(), "reason": f.reason })).collect::<Vec<_>>(),
-        "unseen": cal.unseen,
-        "parameters": params,
-        "features": features,
-        "residual_rms_mm": cal.residual_rms_mm,
-        "residual_max_mm": cal.residual_max_mm,
-        "distance_residuals_mm": cal.distance_residuals_mm,
-        "condition_number": cal.condition_number,
-        "iterations": cal.fit.iterations,
-    })
+    distances: Option<&Path>,
+) -> anyhow::Result<robocal_core::io::inputs::Inputs> {
+    use robocal_core::io::inputs::{InputFile, Inputs};
+    let mut inputs = Inputs::new();
+    let robot = Path::new(&s.robot_arg);
+    if robot.is_file() {
+        inputs.insert("robot".into(), InputFile::of(robot)?);
+    }
+    inputs.insert("data".into(), InputFile::of(&s.data)?);
+    if let Some(d) = distances {
+        inputs.insert("distances".into(), InputFile::of(d)?);
+    }
+    Ok(inputs)
 }

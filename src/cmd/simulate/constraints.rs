@@ -11,7 +11,7 @@ use robocal_core::io::measurements::measurements_csv;
 use robocal_core::io::write_all_atomic;
 use robocal_core::observations::constraint::ConstraintKind;
 use robocal_core::simulation::constraint::{
-    constraint_measurements, distances_csv, simulate_constraints, ConstraintSimulation,
+    constraint_measurements, distances_csv, simulate_constraints, truth_json, ConstraintSimulation,
 };
 use robocal_core::simulation::{
     check_truth_matches, stream_rng, GeometricErrors, PoseSampler, Stream, TruthSource,
@@ -42,7 +42,7 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
              random",
         ));
     }
-    let truth = match truth {
+    let (truth, errors) = match truth {
         TruthSource::Random => {
             let d = GeometricErrors::default();
             let e = GeometricErrors {
@@ -50,11 +50,12 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
                 angle_sigma_deg: a.angle_error_deg.unwrap_or(d.angle_sigma_deg),
                 tilt_parallel_axes: a.tilt_parallel_axes,
             };
-            e.apply(&nominal, &mut stream_rng(a.seed, Stream::Truth))?
+            let t = e.apply(&nominal, &mut stream_rng(a.seed, Stream::Truth))?;
+            (t, Some(e))
         }
         TruthSource::Robot(t) | TruthSource::File { robot: t, .. } => {
             check_truth_matches(&nominal, &t)?;
-            t
+            (t, None)
         }
     };
     let spec = ConstraintSimulation {
@@ -80,7 +81,21 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
     let set = constraint_measurements(&nominal, &sim.data);
     let csv = measurements_csv(&set)?;
     let dist = distances_csv(&sim.data).into_bytes();
-    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&a.out, &csv)];
+    let truth_out = super::truth_path(&a.out);
+    let file_name = a
+        .out
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let truth_json = truth_json(
+        (&nominal, &truth),
+        (&a.truth, errors),
+        &spec,
+        &sim,
+        &file_name,
+    )?
+    .into_bytes();
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&a.out, &csv), (&truth_out, &truth_json)];
     if let Some(d) = &a.distances_out {
         files.push((d, &dist));
     }
@@ -99,6 +114,10 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
             sim.data.distances.len(),
             d.display()
         ))
+    )?;
+    outln!(
+        "truth (the true robot and the true features, base frame of the true robot): {}",
+        truth_out.display()
     )?;
     Ok(())
 }

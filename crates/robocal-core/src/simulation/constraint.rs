@@ -12,7 +12,7 @@ use crate::io::{Measurement, MeasurementSet};
 use crate::model::Robot;
 use crate::observations::constraint::{ConstraintData, ConstraintKind, KnownDistance};
 use crate::registration::rigid::fit_rigid;
-use crate::simulation::{random_poses, PoseSampler};
+use crate::simulation::{random_poses, GeometricErrors, PoseSampler};
 use nalgebra::{Rotation3, Translation3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, StandardNormal};
@@ -339,4 +339,93 @@ pub fn aligned_model_error(model: &Robot, truth: &Robot, poses: &[Vec<f64>]) -> 
         .collect();
     let mean = d.iter().sum::<f64>() / d.len().max(1) as f64;
     Ok((mean, d.iter().cloned().fold(0.0, f64::max)))
+}
+
+/// The truth file of a constraint simulation (`FILE.truth.json` beside the data): the one the
+/// other simulate modes write (the true robot's parameters; the tracker frame the identity, as
+/// there is no tracker), with a `constraint` section holding the true features (base frame of
+/// the true robot) and the simulation's settings. `truth_label` is the truth as given
+/// (`random`, a preset, a file), `errors` the random errors' sizes (random truth), `data_file`
+/// the data file's name.
+pub fn truth_json(
+    (nominal, truth): (&Robot, &Robot),
+    (truth_label, errors): (&str, Option<GeometricErrors>),
+    spec: &ConstraintSimulation,
+    sim: &SimulatedConstraints,
+    data_file: &str,
+) -> Result<String> {
+    use crate::io::result::{FrameVec, RobotInfo};
+    use crate::simulation::{SetInfo, SimulationConfig, TruthFile};
+    let identity = FrameVec {
+        x: 0.0,
+        y: 0.0,
+        z: 0.0,
+        a: 0.0,
+        b: 0.0,
+        c: 0.0,
+    };
+    let tf = TruthFile {
+        generator: format!("robocal-core {}", env!("CARGO_PKG_VERSION")),
+        robot: RobotInfo::shape_of(truth),
+        nominal: nominal.name().to_owned(),
+        truth: truth_label.to_owned(),
+        parameters: TruthFile::parameter_entries(nominal, truth),
+        tracker_frame: identity,
+        settings: SimulationConfig {
+            seed: spec.seed,
+            poses: sim.data.rows.len(),
+            validation_poses: 0,
+            plane_points: false,
+            plane_z_mm: None,
+            tracker_frame: identity,
+            noise_mm: spec.noise_mm,
+            noise_per_m: 0.0,
+            ..SimulationConfig::default()
+        },
+        geometric_errors: errors,
+        joints_file: None,
+        sets: [(
+            "constraint".to_owned(),
+            SetInfo {
+                rows: sim.data.rows.len(),
+                file: data_file.to_owned(),
+            },
+        )]
+        .into_iter()
+        .collect(),
+        plane_z_mm: None,
+        outliers: Vec::new(),
+        gravity_effect: None,
+        warnings: Vec::new(),
+    };
+    let ser = |e: serde_json::Error| Error::Numerical(format!("cannot serialize truth file: {e}"));
+    let mut v = serde_json::to_value(&tf).map_err(ser)?;
+    let features: Vec<serde_json::Value> = sim
+        .data
+        .features
+        .iter()
+        .zip(sim.true_positions.iter().zip(&sim.true_normals))
+        .map(|(f, (p, n))| {
+            serde_json::json!({
+                "kind": f.kind.key(),
+                "name": f.name,
+                "position_mm": [p.x, p.y, p.z],
+                "radius_mm": (f.kind == ConstraintKind::Sphere).then_some(spec.radius_mm),
+                "radius_given": f.radius_mm.is_some(),
+                "normal": n.map(|n| [n.x, n.y, n.z]),
+            })
+        })
+        .collect();
+    v["constraint"] = serde_json::json!({
+        "frame": "base frame of the true robot",
+        "kind": spec.kind.key(),
+        "features": features,
+        "per_feature": spec.per_feature,
+        "tilt_deg": spec.tilt_deg,
+        "span_mm": spec.span_mm,
+        "distances": sim.data.distances.len(),
+    });
+    let mut s = serde_json::to_string_pretty(&v).map_err(ser)?;
+    s.push('\n');
+    Ok(s)
 }

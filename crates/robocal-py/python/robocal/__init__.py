@@ -60,6 +60,7 @@ __all__ = [
     "evaluate",
     "compensate",
     "simulate",
+    "simulate_constraints",
     "Simulation",
     "plan",
     "Plan",
@@ -191,6 +192,14 @@ class Result:
         error, and a ``remark`` when families given explicitly look like overfitting (None when
         no choice was made)."""
         v = self._data.get("model_selection")
+        return None if v is None else json.loads(json.dumps(v))
+
+    @property
+    def constraint(self) -> Optional[Dict[str, Any]]:
+        """A calibration from constraint data (no tracker): the features as estimated, where the
+        scale came from, what the data cannot see, and the frame (up to the base pose); None for
+        a tracker calibration."""
+        v = self._data.get("constraint")
         return None if v is None else json.loads(json.dumps(v))
 
     @property
@@ -381,17 +390,55 @@ def calibrate_files(
     robot: Robot,
     data: Union[str, os.PathLike],
     validate: Optional[Union[str, os.PathLike]] = None,
+    *,
+    distances: Optional[Union[str, os.PathLike]] = None,
+    accept_unknown_scale: bool = False,
     **options: Any,
 ) -> Result:
     """Calibrates ``robot`` from measurement CSV files, as ``robocal calibrate --data DATA
     [--validate VALIDATE]``: the rows' ``set`` column (plane, validation), ``target``, 6-DoF
     ``a,b,c`` and ``sigma_mm`` columns, and the files' names in errors, all as the CLI reads
     them. ``options`` are those of :func:`calibrate`.
+
+    A file with a ``constraint`` column (fixed points, spheres, planes; no tracker) is
+    calibrated as ``robocal calibrate --data DATA [--distances DISTANCES]
+    [--accept-unknown-scale]``: ``distances`` a CSV ``from,to,distance_mm``; without a known
+    distance or sphere radius the scale is undetermined and :class:`NumericalError` is raised
+    unless ``accept_unknown_scale``. The result is up to the base pose (its ``constraint``
+    section says so, with the features and what the data cannot see). Of ``options`` only
+    ``accept_implausible``, ``nominal_limits`` and ``rank_tol`` apply to such data.
     """
     known = calibrate.__kwdefaults__ or {}
     for k in options:
         if k not in known or k in ("validate", "plane"):
             raise TypeError(f"calibrate_files() got an unexpected keyword argument {k!r}")
+    if _robocal.is_constraint_file(robot, os.fspath(data)):
+        if validate is not None:
+            raise UsageError(
+                "validate: constraint data have no tracker points to validate against (not "
+                "supported with a constraint file)"
+            )
+        applies = ("accept_implausible", "nominal_limits", "rank_tol")
+        given = {k: v for k, v in options.items() if v != known.get(k)}
+        for k in given:
+            if k not in applies:
+                raise UsageError(f"{k}: does not apply to constraint data (a constraint column)")
+        return _finish(
+            _robocal.calibrate_constraint_file(
+                robot,
+                os.fspath(data),
+                None if distances is None else os.fspath(distances),
+                accept_unknown_scale,
+                bool(given.get("accept_implausible", False)),
+                bool(given.get("nominal_limits", False)),
+                given.get("rank_tol"),
+            )
+        )
+    if distances is not None or accept_unknown_scale:
+        raise UsageError(
+            "distances and accept_unknown_scale apply to constraint data (a measurement file "
+            "with a constraint column)"
+        )
     opts = _options(**options)
     return _finish(
         _robocal.calibrate_files(
@@ -399,6 +446,48 @@ def calibrate_files(
             os.fspath(data),
             None if validate is None else os.fspath(validate),
             opts,
+        )
+    )
+
+
+def simulate_constraints(
+    robot: Robot,
+    out: Union[str, os.PathLike],
+    constraint: str = "point",
+    *,
+    truth: Union[str, "os.PathLike[str]", Robot] = "random",
+    features: int = 4,
+    per_feature: int = 20,
+    noise_mm: float = 0.010,
+    radius_mm: float = 25.0,
+    unknown_radius: bool = False,
+    tilt_deg: float = 60.0,
+    span_mm: float = 300.0,
+    seed: int = 1,
+    distances_out: Optional[Union[str, os.PathLike]] = None,
+) -> str:
+    """Constraint data without a tracker: the CLI's ``robocal simulate --constraint
+    point|sphere|plane`` (the same files for the same settings). The true robot brings its tool
+    point to ``features`` fixed points, onto spheres (``radius_mm``; ``unknown_radius`` leaves
+    ``radius_mm`` empty in the file) or onto planes, in ``per_feature`` configurations each;
+    writes the measurement CSV to ``out``, the truth file beside it (returned: its path) and,
+    with ``distances_out``, the true distances between the points or sphere centres.
+    """
+    return os.fspath(
+        _robocal.simulate_constraints(
+            robot,
+            os.fspath(out),
+            truth,
+            constraint,
+            features,
+            per_feature,
+            noise_mm,
+            radius_mm,
+            unknown_radius,
+            tilt_deg,
+            span_mm,
+            seed,
+            None if distances_out is None else os.fspath(distances_out),
         )
     )
 

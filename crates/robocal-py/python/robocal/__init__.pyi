@@ -126,6 +126,8 @@ class Result:
     @property
     def identifiability(self) -> Optional[Dict[str, Any]]: ...
     @property
+    def constraint(self) -> Optional[Dict[str, Any]]: ...
+    @property
     def prediction(self) -> Optional[Dict[str, Any]]: ...
     def evaluate(
         self, q: ArrayLike, xyz: ArrayLike, *, nominal: Optional[Robot] = None, nominal_limits: bool = False
@@ -184,9 +186,31 @@ def calibrate_files(
     robot: Robot,
     data: PathLike,
     validate: Optional[PathLike] = None,
+    *,
+    distances: Optional[PathLike] = None,
+    accept_unknown_scale: bool = False,
     **options: Any,
 ) -> Result:
-    """The CLI's ``robocal calibrate --data DATA [--validate VALIDATE]``."""
+    """The CLI's ``robocal calibrate --data DATA [--validate VALIDATE]``; a constraint file with
+    ``[--distances DISTANCES] [--accept-unknown-scale]``."""
+
+def simulate_constraints(
+    robot: Robot,
+    out: PathLike,
+    constraint: str = "point",
+    *,
+    truth: Union[str, PathLike, Robot] = "random",
+    features: int = 4,
+    per_feature: int = 20,
+    noise_mm: float = 0.010,
+    radius_mm: float = 25.0,
+    unknown_radius: bool = False,
+    tilt_deg: float = 60.0,
+    span_mm: float = 300.0,
+    seed: int = 1,
+    distances_out: Optional[PathLike] = None,
+) -> str:
+    """The CLI's ``robocal simulate --constraint point|sphere|plane``."""
 
 def evaluate(result: Result, q: ArrayLike, xyz: ArrayLike, **options: Any) -> Dict[str, Dict[str, Any]]:
     """The CLI's ``robocal evaluate --against model`` on arrays."""

@@ -2,13 +2,16 @@
 //! residuals, dense: constraint data sets have hundreds of rows, not millions).
 //!
 //! Rows, in order: each constraint row's feature rows ([`FeatureEstimate::residual`] at the
-//! model's tool point `p(q; theta)`), then one row per known distance, `|c_a - c_b| - D`. The
+//! model's tool point `p(q; theta)`), then one row per known distance, `|c_a - c_b| - D`, then
+//! (mixed data) three rows per tracker row, `F m - p(q; theta)` with the tracker frame `F`
+//! estimated too (its update `F' = (exp(w), dt) F`: derivatives `-[F m]x` and `I`). The
 //! Jacobian's robot columns are the feature rows' derivatives with respect to `p` times the
 //! parameters' tool-point screws ([`Robot::tool_screw_jacobians`]); the feature columns are the
 //! features' own derivatives.
 
 use super::features::FeatureEstimate;
 use crate::error::{Error, Result};
+use crate::frame::Frame;
 use crate::model::{Param, Robot};
 use crate::observations::constraint::ConstraintData;
 use nalgebra::{DMatrix, DVector, Vector3};
@@ -22,6 +25,9 @@ pub(crate) struct Layout {
     pub index: Vec<usize>,
     /// The first column of each feature.
     pub feature_col: Vec<usize>,
+    /// The first of the tracker frame's six columns (rotation, then translation), when the
+    /// data have tracker rows.
+    pub frame_col: Option<usize>,
     /// Number of unknowns.
     pub n: usize,
 }
@@ -42,8 +48,16 @@ impl Layout {
             params: params.to_vec(),
             index,
             feature_col,
+            frame_col: None,
             n: col,
         }
+    }
+
+    /// The layout with the tracker frame's six columns added (mixed data).
+    pub fn with_frame(mut self) -> Layout {
+        self.frame_col = Some(self.n);
+        self.n += 6;
+        self
     }
 }
 
@@ -54,15 +68,17 @@ pub(crate) fn row_count(data: &ConstraintData, features: &[FeatureEstimate]) -> 
         .map(|r| features[r.feature].rows())
         .sum::<usize>()
         + data.distances.len()
+        + 3 * data.tracker.len()
 }
 
-/// The residual vector and, when asked, the Jacobian (rows x unknowns) at `robot` and
-/// `features`.
+/// The residual vector and, when asked, the Jacobian (rows x unknowns) at `robot`, `features`
+/// and the tracker `frame` (needed when the data have tracker rows).
 pub(crate) fn evaluate(
     robot: &Robot,
     layout: &Layout,
     data: &ConstraintData,
     features: &[FeatureEstimate],
+    frame: Option<&Frame>,
     jacobian: bool,
 ) -> (DVector<f64>, Option<DMatrix<f64>>) {
     let m = row_count(data, features);
@@ -110,6 +126,39 @@ pub(crate) fn evaluate(
         }
         row += 1;
     }
+    if !data.tracker.is_empty() {
+        let f = frame.expect("a tracker frame for tracker rows");
+        for t in &data.tracker {
+            let p = if j.is_some() {
+                robot.tool_screw_jacobians(&t.q, None, Some(&mut jp), None)
+            } else {
+                robot.tool_position(&t.q)
+            };
+            let w = f * nalgebra::Point3::from(t.m);
+            let r = w.coords - p;
+            for a in 0..3 {
+                e[row + a] = r[a];
+            }
+            if let Some(j) = &mut j {
+                for (c, &i) in layout.index.iter().enumerate() {
+                    for a in 0..3 {
+                        j[(row + a, c)] = -jp[i][a];
+                    }
+                }
+                if let Some(c0) = layout.frame_col {
+                    // d(w)/d(rotation) = -[w]x; d(w)/d(translation) = I.
+                    let wx = w.coords.cross_matrix();
+                    for a in 0..3 {
+                        for b in 0..3 {
+                            j[(row + a, c0 + b)] = -wx[(a, b)];
+                        }
+                        j[(row + a, c0 + 3 + a)] = 1.0;
+                    }
+                }
+            }
+            row += 3;
+        }
+    }
     (e, j)
 }
 
@@ -124,6 +173,19 @@ pub struct FitReport {
     pub cost: f64,
 }
 
+/// Applies step `dx` to the tracker frame (the layout's frame columns).
+pub(crate) fn apply_frame(frame: &mut Frame, layout: &Layout, dx: &[f64]) {
+    if let Some(c0) = layout.frame_col {
+        let w = nalgebra::Vector3::new(dx[c0], dx[c0 + 1], dx[c0 + 2]);
+        let t = nalgebra::Vector3::new(dx[c0 + 3], dx[c0 + 4], dx[c0 + 5]);
+        let r = nalgebra::Rotation3::new(w);
+        *frame = Frame::from_parts(
+            nalgebra::Translation3::from(r * frame.translation.vector + t),
+            r * frame.rotation,
+        );
+    }
+}
+
 /// Applies step `dx` to the robot's identified parameters and the features.
 fn apply(robot: &mut Robot, layout: &Layout, features: &mut [FeatureEstimate], dx: &DVector<f64>) {
     for (c, p) in layout.params.iter().enumerate() {
@@ -135,17 +197,18 @@ fn apply(robot: &mut Robot, layout: &Layout, features: &mut [FeatureEstimate], d
     }
 }
 
-/// Levenberg-Marquardt (Marquardt's diagonal scaling) from the current values; updates `robot`
-/// and `features` in place.
+/// Levenberg-Marquardt (Marquardt's diagonal scaling) from the current values; updates `robot`,
+/// `features` and the tracker `frame` (mixed data) in place.
 pub(crate) fn solve(
     robot: &mut Robot,
     layout: &Layout,
     data: &ConstraintData,
     features: &mut [FeatureEstimate],
+    frame: &mut Option<Frame>,
     max_iterations: usize,
 ) -> Result<FitReport> {
     let mut lambda = 1e-3;
-    let (mut e, mut j) = evaluate(robot, layout, data, features, true);
+    let (mut e, mut j) = evaluate(robot, layout, data, features, frame.as_ref(), true);
     let mut cost = e.norm_squared();
     let mut converged = false;
     let mut iterations = 0;
@@ -173,14 +236,19 @@ pub(crate) fn solve(
             let mut r2 = robot.clone();
             let mut f2 = features.to_vec();
             apply(&mut r2, layout, &mut f2, &dx);
-            let (e2, _) = evaluate(&r2, layout, data, &f2, false);
+            let mut fr2 = *frame;
+            if let Some(fr) = &mut fr2 {
+                apply_frame(fr, layout, dx.as_slice());
+            }
+            let (e2, _) = evaluate(&r2, layout, data, &f2, fr2.as_ref(), false);
             let c2 = e2.norm_squared();
             if c2.is_finite() && c2 <= cost {
                 let gain = cost - c2;
                 *robot = r2;
                 features.clone_from_slice(&f2);
+                *frame = fr2;
                 converged = gain <= 1e-12 * cost || cost < 1e-24;
-                let (e3, j3) = evaluate(robot, layout, data, features, true);
+                let (e3, j3) = evaluate(robot, layout, data, features, frame.as_ref(), true);
                 e = e3;
                 j = j3;
                 cost = c2;

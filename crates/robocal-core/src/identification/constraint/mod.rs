@@ -22,6 +22,8 @@
 
 pub mod features;
 pub mod fit;
+mod gate;
+pub mod result;
 
 pub use features::FeatureEstimate;
 pub use fit::FitReport;
@@ -124,6 +126,12 @@ pub struct ConstraintCalibration {
     pub feature_rms_mm: Vec<f64>,
     /// Each known distance's residual, fitted minus given (mm), in file order.
     pub distance_residuals_mm: Vec<f64>,
+    /// The tracker frame registered by the tracker rows of mixed data (a measured point `m`
+    /// maps to `frame * m` in the base frame); `None` without tracker rows (up to the base
+    /// pose).
+    pub frame: Option<crate::frame::Frame>,
+    /// Each tracker row's residual norm (mm), in file order (mixed data).
+    pub tracker_residuals_mm: Vec<f64>,
     /// Condition number of the column-scaled Jacobian of the final fit.
     pub condition_number: f64,
     /// How the final fit ended.
@@ -188,7 +196,17 @@ pub fn calibrate_constraints(
                 .into(),
         });
     }
-    let mut unseen = vec![UP_TO_BASE.to_string()];
+    let start_frame = start_frame(&robot, data)?;
+    let mut unseen = vec![if data.tracker.is_empty() {
+        UP_TO_BASE.to_string()
+    } else {
+        format!(
+            "the base frame's own parameters: the {} tracker row(s) register the base to the \
+             tracker frame (estimated with the robot, as for tracker data), which takes up any \
+             move of the base, so they are held at their nominal values",
+            data.tracker.len()
+        )
+    }];
     if let Scale::Assumed { held } = &scale {
         unseen.push(format!(
             "the robot's scale: no known length in the data; {} is held at its nominal value",
@@ -201,15 +219,20 @@ pub fn calibrate_constraints(
     loop {
         robot = start_robot.clone();
         features = start_features.clone();
-        let layout = Layout::new(&robot, &identified, &features);
+        let mut frame = start_frame;
+        let mut layout = Layout::new(&robot, &identified, &features);
+        if frame.is_some() {
+            layout = layout.with_frame();
+        }
         let report = fit::solve(
             &mut robot,
             &layout,
             data,
             &mut features,
+            &mut frame,
             opts.max_iterations,
         )?;
-        let (e, j) = fit::evaluate(&robot, &layout, data, &features, true);
+        let (e, j) = fit::evaluate(&robot, &layout, data, &features, frame.as_ref(), true);
         let j = j.expect("asked for");
         let (cond, weak) = weakest(&j, opts.weak_tolerance);
         if let Some(v) = weak {
@@ -268,8 +291,17 @@ pub fn calibrate_constraints(
             per_feature[r.feature].0 += n * n;
             per_feature[r.feature].1 += 1;
         }
-        let distance_residuals_mm = e.as_slice()[row..].to_vec();
-        let implausible = gate(&start_robot, &robot, &features);
+        let distance_residuals_mm = e.as_slice()[row..row + data.distances.len()].to_vec();
+        let tracker: Vec<f64> = (0..data.tracker.len())
+            .map(|i| e.rows(row + data.distances.len() + 3 * i, 3).norm())
+            .collect();
+        let implausible = gate::checks(
+            &start_robot,
+            &robot,
+            &features,
+            data,
+            &distance_residuals_mm,
+        );
         let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
         return Ok(ConstraintCalibration {
             robot,
@@ -285,50 +317,13 @@ pub fn calibrate_constraints(
             scale,
             unseen,
             distance_residuals_mm,
+            frame,
+            tracker_residuals_mm: tracker,
             condition_number: cond,
             fit: report,
             implausible,
         });
     }
-}
-
-/// The plausibility gate on constraint data: each identified parameter's move within its
-/// family's plausible range, each feature within twice the robot's reach of the base, each
-/// sphere's radius below the reach.
-fn gate(start: &Robot, robot: &Robot, features: &[FeatureEstimate]) -> Vec<String> {
-    let mut out = Vec::new();
-    for &p in start.param_list() {
-        let (was, now) = (start.get_display(p), robot.get_display(p));
-        let range = crate::model::family::plausible::of(start, p);
-        let u = p.unit().as_str();
-        if (now - was).abs() > range.max_move || !range.contains(now) {
-            out.push(format!(
-                "{} moved from {was:.4} to {now:.4} {u}, beyond its plausible range ({})",
-                p.name(),
-                range.why
-            ));
-        }
-    }
-    let reach = robot.reach_mm();
-    for f in features {
-        if f.position.norm() > 2.0 * reach {
-            out.push(format!(
-                "{} is {:.0} mm from the base, beyond twice the robot's reach ({reach:.0} mm)",
-                f.label(),
-                f.position.norm()
-            ));
-        }
-        if let Some(r) = f
-            .radius_mm
-            .filter(|r| r.is_nan() || *r <= 0.0 || *r >= reach)
-        {
-            out.push(format!(
-                "{}'s radius {r:.3} mm is not between 0 and the robot's reach",
-                f.label()
-            ));
-        }
-    }
-    out
 }
 
 /// The features' start values from the nominal tool points of their rows.
@@ -344,9 +339,34 @@ fn start_values(robot: &Robot, data: &ConstraintData) -> Result<Vec<FeatureEstim
         .collect()
 }
 
+/// The tracker frame's start value for mixed data: the rigid fit of the tracker rows' points to
+/// the nominal tool points (`None` without tracker rows).
+fn start_frame(robot: &Robot, data: &ConstraintData) -> Result<Option<crate::frame::Frame>> {
+    if data.tracker.is_empty() {
+        return Ok(None);
+    }
+    let m: Vec<_> = data.tracker.iter().map(|t| t.m).collect();
+    let p: Vec<_> = data
+        .tracker
+        .iter()
+        .map(|t| robot.tool_position(&t.q))
+        .collect();
+    let f = crate::registration::rigid::fit_rigid(&m, &p, None).map_err(|e| {
+        data.parse_error(
+            data.tracker[0].line,
+            "x",
+            format!("the tracker rows cannot register the tracker frame: {e}"),
+        )
+    })?;
+    Ok(Some(*f.pose()))
+}
+
 /// What gives the data a length scale, if anything.
 fn scale_source(data: &ConstraintData) -> Option<String> {
     let mut from = Vec::new();
+    if !data.tracker.is_empty() {
+        from.push(format!("{} tracker row(s)", data.tracker.len()));
+    }
     if !data.distances.is_empty() {
         from.push(format!(
             "{} known distance{}",
@@ -384,6 +404,9 @@ fn structural(
     let mut obs = Observations::new(robot.dof());
     for r in &data.rows {
         obs.push(&r.q, robot.tool_position(&r.q), r.line)?;
+    }
+    for t in &data.tracker {
+        obs.push(&t.q, robot.tool_position(&t.q), t.line)?;
     }
     let id = analyze(
         robot,
@@ -461,6 +484,9 @@ fn column_name(layout: &Layout, features: &[FeatureEstimate], k: usize) -> Strin
         if (c0..c0 + f.param_count()).contains(&k) {
             return f.param_names()[k - c0].clone();
         }
+    }
+    if let Some(c0) = layout.frame_col.filter(|c0| (*c0..c0 + 6).contains(&k)) {
+        return format!("tracker frame {}", ["a", "b", "c", "x", "y", "z"][k - c0]);
     }
     format!("unknown {k}")
 }

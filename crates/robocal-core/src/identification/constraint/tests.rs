@@ -11,6 +11,7 @@ use crate::simulation::constraint::{
 use crate::simulation::{random_poses, GeometricErrors, PoseSampler};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use std::path::Path;
 
 fn nominal() -> Robot {
     preset("kuka-kr480-r3330").unwrap()
@@ -87,7 +88,7 @@ fn analytic_derivatives_match_finite_differences() {
         .copied()
         .collect();
     let layout = Layout::new(&robot, &params, &features);
-    let (_, j) = fit::evaluate(&robot, &layout, &data, &features, true);
+    let (_, j) = fit::evaluate(&robot, &layout, &data, &features, None, true);
     let j = j.unwrap();
     let h = 1e-6;
     let mut worst: f64 = 0.0;
@@ -103,7 +104,7 @@ fn analytic_derivatives_match_finite_differences() {
                 dx[c - layout.feature_col[k]] = s;
                 f[k].apply(&dx);
             }
-            fit::evaluate(&r, &layout, &data, &f, false).0
+            fit::evaluate(&r, &layout, &data, &f, None, false).0
         };
         let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
         let scale = fd.amax().max(1.0);
@@ -428,4 +429,111 @@ fn the_gate_flags_a_parameter_moved_beyond_its_plausible_range() {
     )
     .unwrap();
     assert!(good.implausible.is_empty(), "{:?}", good.implausible);
+}
+
+/// Tracker rows of the true robot `t` at `n` random poses, measured from the tracker frame
+/// `frame` (a base point `p` reads `frame^-1 p`), noise-free.
+fn tracker_rows(
+    t: &Robot,
+    frame: &crate::frame::Frame,
+    n: usize,
+    seed: u64,
+) -> Vec<crate::observations::constraint::TrackerRow> {
+    let mut rng = ChaCha8Rng::seed_from_u64(9500 + seed);
+    random_poses(&nominal(), n, &sampler(), &mut rng)
+        .unwrap()
+        .into_iter()
+        .enumerate()
+        .map(|(i, q)| crate::observations::constraint::TrackerRow {
+            m: (frame.inverse() * nalgebra::Point3::from(t.tool_position(&q))).coords,
+            q,
+            line: 1000 + i,
+        })
+        .collect()
+}
+
+fn some_frame() -> crate::frame::Frame {
+    crate::frame::pose(&[2500.0, -800.0, 300.0, 0.4, -0.02, 0.03])
+}
+
+#[test]
+fn the_tracker_frame_derivatives_match_finite_differences() {
+    let t = truth(2);
+    let mut data = simulate(&t, &spec(ConstraintKind::Point, 0.0, 2)).data;
+    data.tracker = tracker_rows(&t, &some_frame(), 10, 2);
+    let robot = nominal();
+    let features = start_values(&robot, &data).unwrap();
+    let frame = start_frame(&robot, &data).unwrap().unwrap();
+    let params = vec![Param::a(1), Param::d(3)];
+    let layout = Layout::new(&robot, &params, &features).with_frame();
+    let (_, j) = fit::evaluate(&robot, &layout, &data, &features, Some(&frame), true);
+    let j = j.unwrap();
+    let c0 = layout.frame_col.unwrap();
+    let h = 1e-6;
+    let mut worst: f64 = 0.0;
+    for c in (c0..c0 + 6).chain(0..params.len()) {
+        let shifted = |s: f64| {
+            let mut dx = vec![0.0; layout.n];
+            dx[c] = s;
+            let mut f = frame;
+            fit::apply_frame(&mut f, &layout, &dx);
+            let mut r = robot.clone();
+            if c < params.len() {
+                r.set(params[c], r.get(params[c]) + s);
+            }
+            fit::evaluate(&r, &layout, &data, &features, Some(&f), false).0
+        };
+        let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
+        let scale = fd.amax().max(1.0);
+        worst = worst.max((&fd - j.column(c)).amax() / scale);
+    }
+    assert!(worst < 1e-5, "largest relative derivative error {worst:e}");
+}
+
+#[test]
+fn mixed_noise_free_data_recover_the_truth_without_a_known_distance() {
+    // Fixed points without distances (alone: the scale refused) and 30 tracker rows: the
+    // tracker rows give the scale and register the base; the model comes back exactly.
+    let t = truth(4);
+    let s = ConstraintSimulation {
+        distances: false,
+        ..spec(ConstraintKind::Point, 0.0, 4)
+    };
+    let mut data = simulate(&t, &s).data;
+    assert!(calibrate_constraints(&nominal(), &data, &ConstraintOptions::default()).is_err());
+    let frame = some_frame();
+    data.tracker = tracker_rows(&t, &frame, 30, 4);
+    let cal = calibrate_constraints(&nominal(), &data, &ConstraintOptions::default()).unwrap();
+    assert!(cal.fit.converged);
+    assert!(
+        matches!(&cal.scale, Scale::Known { from } if from.contains("30 tracker row")),
+        "{:?}",
+        cal.scale
+    );
+    assert!(cal.residual_rms_mm < 1e-7, "rms {}", cal.residual_rms_mm);
+    let worst = cal.tracker_residuals_mm.iter().cloned().fold(0.0, f64::max);
+    assert!(worst < 1e-7, "tracker residual {worst}");
+    let (mean, _) = aligned_model_error(&cal.robot, &t, &check_poses(4)).unwrap();
+    assert!(mean < 1e-6, "aligned model error {mean}");
+    // The registered frame maps the readings onto the calibrated model: with the truth's base
+    // error taken up by the frame, the calibrated model at a reading's joints is the reading.
+    let f = cal.frame.unwrap();
+    for r in &data.tracker {
+        let w = f * nalgebra::Point3::from(r.m);
+        assert!((w.coords - cal.robot.tool_position(&r.q)).norm() < 1e-6);
+    }
+    assert!(
+        !cal.unseen[0].contains("up to the base pose"),
+        "{:?}",
+        cal.unseen
+    );
+    // The result file says the base pose is registered, and records the frame.
+    let res = cal.to_result(&nominal(), &data).unwrap();
+    let section = crate::io::result_constraint::ConstraintSection::of(&res, Path::new("r.json"))
+        .unwrap()
+        .unwrap();
+    assert!(section.base_pose_known);
+    assert_eq!(section.tracker_rows, 30);
+    let back = res.tracker_frame().pose().translation.vector;
+    assert!((back - f.translation.vector).norm() < 1e-9);
 }

@@ -10,6 +10,10 @@
 //! [`crate::io::Positions::Ignored`] into such data, rejecting (file, line, column named) an
 //! unknown kind, an empty name, a label used on one row only, a sphere given two radii, and
 //! `x,y,z` given on a constraint row.
+//!
+//! Mixed data: a row with an empty `constraint` cell and `x,y,z` is a tracker row
+//! ([`TrackerRow`]); calibrated with the constraint rows, such rows fix the scale and register
+//! the base to the tracker frame.
 
 mod distances;
 
@@ -97,6 +101,21 @@ pub struct ConstraintRow {
     pub line: usize,
 }
 
+/// A tracker row among constraint rows (mixed data): joint values and the measured tool point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrackerRow {
+    /// Joint values (model values: rad, or mm for a prismatic joint).
+    pub q: Vec<f64>,
+    /// The measured point (mm, tracker frame).
+    pub m: nalgebra::Vector3<f64>,
+    /// 1-based line in the file (0 when not from a file).
+    pub line: usize,
+}
+
+/// Fewest tracker rows of mixed data: the tracker frame's registration needs three points not
+/// on one line.
+pub const MIN_TRACKER_ROWS: usize = 3;
+
 /// Constraint measurements: rows, the features they refer to and known distances.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ConstraintData {
@@ -110,6 +129,8 @@ pub struct ConstraintData {
     pub rows: Vec<ConstraintRow>,
     /// Known distances between points or sphere centres.
     pub distances: Vec<KnownDistance>,
+    /// Tracker rows calibrated with the constraint rows (mixed data), in file order.
+    pub tracker: Vec<TrackerRow>,
 }
 
 impl ConstraintData {
@@ -220,10 +241,12 @@ impl ConstraintData {
         self.features.iter().position(|f| f.name == name)
     }
 
-    /// Whether the data carry a length scale of their own: a known distance, or a sphere of
-    /// known radius (without one the robot's scale is not determined).
+    /// Whether the data carry a length scale of their own: a known distance, a sphere of known
+    /// radius, or tracker rows (without one the robot's scale is not determined).
     pub fn has_known_length(&self) -> bool {
-        !self.distances.is_empty() || self.features.iter().any(|f| f.radius_mm.is_some())
+        !self.distances.is_empty()
+            || self.features.iter().any(|f| f.radius_mm.is_some())
+            || !self.tracker.is_empty()
     }
 
     /// Checks that every feature has enough rows ([`ConstraintKind::min_rows`]); a label used
@@ -295,10 +318,14 @@ impl ConstraintData {
         };
         for r in &set.rows {
             let cell = r.extra[kc].trim();
+            if cell.is_empty() && xyz.iter().any(|(k, _)| !r.extra[*k].trim().is_empty()) {
+                data.tracker.push(tracker_row(set, &xyz, r)?);
+                continue;
+            }
             let Some((kind, name)) = cell.split_once(':') else {
                 let msg = if cell.is_empty() {
-                    "empty: every row of a constraint file names its feature (rows with a \
-                     tracker point beside constraint rows are not supported yet)"
+                    "empty: every row of a constraint file names its feature, or is a tracker \
+                     row with x,y,z (mm)"
                         .to_string()
                 } else {
                     format!("`{cell}` is not kind:NAME (point:NAME, sphere:NAME or plane:NAME)")
@@ -365,8 +392,56 @@ impl ConstraintData {
             data.push(r.q.clone(), k, r.line)?;
         }
         data.check_counts()?;
+        if !data.tracker.is_empty() && data.tracker.len() < MIN_TRACKER_ROWS {
+            return Err(perr(
+                data.tracker[0].line,
+                "x",
+                format!(
+                    "{} tracker row(s) among constraint rows: registering the tracker frame \
+                     needs at least {MIN_TRACKER_ROWS} (not on one line)",
+                    data.tracker.len()
+                ),
+            ));
+        }
         Ok(data)
     }
+}
+
+/// A tracker row of mixed data: `x,y,z` all given, numbers within the plausible range.
+fn tracker_row(
+    set: &MeasurementSet,
+    xyz: &[(usize, &str)],
+    r: &crate::io::Measurement,
+) -> Result<TrackerRow> {
+    let perr = |field: &str, msg: String| Error::parse(&set.path, Some(r.line), Some(field), msg);
+    let mut m = nalgebra::Vector3::zeros();
+    for (i, axis) in ["x", "y", "z"].iter().enumerate() {
+        let Some((k, _)) = xyz.iter().find(|(_, a)| a == axis) else {
+            return Err(perr(
+                axis,
+                "missing column: a tracker row among constraint rows needs x,y,z (mm)".into(),
+            ));
+        };
+        let s = r.extra[*k].trim();
+        if s.is_empty() {
+            return Err(perr(
+                axis,
+                "empty: a row without a constraint is a tracker row and needs x,y,z (mm)".into(),
+            ));
+        }
+        let v: f64 = s
+            .parse()
+            .map_err(|_| perr(axis, format!("`{s}` is not a number")))?;
+        crate::ranges::LENGTH
+            .check(v)
+            .map_err(|msg| perr(axis, msg))?;
+        m[i] = v;
+    }
+    Ok(TrackerRow {
+        q: r.q.clone(),
+        m,
+        line: r.line,
+    })
 }
 
 /// The position of an extra column by name (any case).

@@ -66,7 +66,26 @@ fn bad_rows_are_errors_naming_file_line_and_column() {
     assert!(e.contains("already the point"), "{e}");
     let e = err("q1,q2,constraint\n1,2,point:A\n3,4,\n");
     assert!(
-        e.contains("c.csv:3") && e.contains("not supported yet"),
+        e.contains("c.csv:3") && e.contains("tracker row with x,y,z"),
+        "{e}"
+    );
+    // Mixed data: a tracker row needs all of x,y,z, as numbers; at least three of them.
+    let pts = "1,2,point:A,,,\n3,4,point:A,,,\n";
+    let e = err(&format!("q1,q2,constraint,x,y,z\n{pts}5,6,,1,,3\n"));
+    assert!(
+        e.contains("c.csv:4") && e.contains("field `y`") && e.contains("tracker row"),
+        "{e}"
+    );
+    let e = err(&format!("q1,q2,constraint,x,y,z\n{pts}5,6,,1,a,3\n"));
+    assert!(
+        e.contains("c.csv:4") && e.contains("`a` is not a number"),
+        "{e}"
+    );
+    let e = err(&format!(
+        "q1,q2,constraint,x,y,z\n{pts}5,6,,1,2,3\n7,8,,4,5,6\n"
+    ));
+    assert!(
+        e.contains("c.csv:4") && e.contains("2 tracker row(s)") && e.contains("at least 3"),
         "{e}"
     );
 }
