@@ -151,3 +151,75 @@ fn evaluate_reads_the_conditions_and_compensate_folds_them_and_writes_the_approa
         assert!(!out.exists());
     }
 }
+
+/// `evaluate` of the honest demo's verification (measured from another station, registered
+/// again): the gap to the prediction split in quadrature into the registration's share and
+/// what is left, with the repeatability beside the prediction's noise.
+#[test]
+fn evaluate_splits_the_verification_gap() {
+    let dir = Dir::new();
+    let demo = dir.join("demo");
+    ok(&["demo", "--seed", "1", "--out", p(&demo)]);
+    let (res, verify) = (demo.join("result.json"), demo.join("verify.csv"));
+    let run = |extra: &[&str]| {
+        let mut a = vec![
+            "evaluate",
+            "--params",
+            p(&res),
+            "--data",
+            p(&verify),
+            "--refit-frame",
+        ];
+        a.extend_from_slice(extra);
+        robocal(&a)
+    };
+    let o = run(&["--json"]);
+    o.assert_ok();
+    let v: serde_json::Value = serde_json::from_str(&o.stdout()).unwrap();
+    let g = &v["gap"];
+    let f = |x: &serde_json::Value| x.as_f64().unwrap();
+    let (ver, pred, gap, left) = (
+        f(&g["verified_rms_mm"]),
+        f(&g["predicted_rms_mm"]),
+        f(&g["gap_rms_mm"]),
+        f(&g["left_rms_mm"]),
+    );
+    let s = &g["station"];
+    let (n, sigma, station) = (
+        f(&s["points"]),
+        f(&s["residual_sigma_mm"]),
+        f(&s["rms_mm"]),
+    );
+    eprintln!(
+        "verification {ver:.4} mm RMS, predicted {pred:.4}, gap {gap:.4}: station {station:.4} \
+         ({n} points, sigma {sigma:.4}), left {left:.4}; repeatability {}",
+        g["repeatability"]
+    );
+    // The measured RMS is evaluate's own; the prediction the result's.
+    assert_eq!(ver, f(&v["desired"]["rms_mm"]));
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&res).unwrap()).unwrap();
+    assert_eq!(pred, f(&r["prediction"]["rms_mm"]));
+    // The parts add in quadrature; the registration of 75 points takes a small share.
+    assert!((gap * gap - (ver * ver - pred * pred)).abs() < 1e-12);
+    assert!((left * left + station * station - gap * gap).abs() < 1e-12);
+    assert_eq!(n, 75.0);
+    assert!((station - sigma * (6.0 / n).sqrt()).abs() < 1e-12);
+    assert!(station > 0.0 && station < 0.5 * gap, "{station} vs {gap}");
+    // Repeatability: the class default, or the given RP as an isotropic scatter's RMS.
+    let rep = f(&g["repeatability"]["rms_mm"]);
+    assert!(rep > 0.0 && rep < f(&g["repeatability"]["predicted_noise_rms_mm"]));
+    let o = run(&["--json", "--repeatability-mm", "0.08"]);
+    let w: serde_json::Value = serde_json::from_str(&o.stdout()).unwrap();
+    let given = f(&w["gap"]["repeatability"]["rms_mm"]);
+    assert!((given - 3.0_f64.sqrt() * 0.08 / 3.6161).abs() < 1e-12, "{given}");
+    // The table says it in words; a repeatability that is none is a usage error.
+    let text = run(&[]).stdout();
+    assert!(
+        text.contains("the fresh station's registration (75 points"),
+        "{text}"
+    );
+    let o = run(&["--repeatability-mm", "-1"]);
+    o.assert_code(2);
+    assert!(o.stderr().contains("--repeatability-mm"), "{}", o.stderr());
+}
