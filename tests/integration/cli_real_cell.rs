@@ -185,11 +185,7 @@ fn evaluate_splits_the_verification_gap() {
         f(&g["left_rms_mm"]),
     );
     let s = &g["station"];
-    let (n, sigma, station) = (
-        f(&s["points"]),
-        f(&s["residual_sigma_mm"]),
-        f(&s["rms_mm"]),
-    );
+    let (n, sigma, station) = (f(&s["points"]), f(&s["residual_sigma_mm"]), f(&s["rms_mm"]));
     eprintln!(
         "verification {ver:.4} mm RMS, predicted {pred:.4}, gap {gap:.4}: station {station:.4} \
          ({n} points, sigma {sigma:.4}), left {left:.4}; repeatability {}",
@@ -212,7 +208,10 @@ fn evaluate_splits_the_verification_gap() {
     let o = run(&["--json", "--repeatability-mm", "0.08"]);
     let w: serde_json::Value = serde_json::from_str(&o.stdout()).unwrap();
     let given = f(&w["gap"]["repeatability"]["rms_mm"]);
-    assert!((given - 3.0_f64.sqrt() * 0.08 / 3.6161).abs() < 1e-12, "{given}");
+    assert!(
+        (given - 3.0_f64.sqrt() * 0.08 / 3.6161).abs() < 1e-12,
+        "{given}"
+    );
     // The table says it in words; a repeatability that is none is a usage error.
     let text = run(&[]).stdout();
     assert!(

@@ -190,6 +190,9 @@ mod tests {
             (predicted / f64::from(draws)).sqrt(),
         );
         eprintln!("station: formula {predicted:.5} mm, Monte Carlo {added:.5} mm");
-        assert!((added / predicted - 1.0).abs() < 0.05, "{added} vs {predicted}");
+        assert!(
+            (added / predicted - 1.0).abs() < 0.05,
+            "{added} vs {predicted}"
+        );
     }
 }

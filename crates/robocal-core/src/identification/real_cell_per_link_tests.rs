@@ -52,7 +52,11 @@ fn per_link_columns_match_central_differences() {
             if !(p.family_id() == thermal::ID || thermal::grows(*p)) {
                 continue;
             }
-            let h = if p.family_id() == thermal::ID { 1e-7 } else { 1e-4 };
+            let h = if p.family_id() == thermal::ID {
+                1e-7
+            } else {
+                1e-4
+            };
             let at = |d: f64| {
                 let mut s = r.clone();
                 s.set(*p, r.get(*p) + d);
@@ -153,7 +157,10 @@ fn noise_free_uneven_warm_up_is_recovered_per_link_and_not_by_the_lumped_coeffic
         let why = c.identifiability.fixed_reason(p).map(|f| f.describe());
         eprintln!("class default session, thermal_k{j}: {why:?}");
         if j == 5 {
-            assert!(why.as_deref().is_some_and(|w| w.starts_with("no effect")), "{why:?}");
+            assert!(
+                why.as_deref().is_some_and(|w| w.starts_with("no effect")),
+                "{why:?}"
+            );
         } else if why.is_some() {
             assert!(
                 why.as_deref()
@@ -178,7 +185,11 @@ fn noise_free_uneven_warm_up_is_recovered_per_link_and_not_by_the_lumped_coeffic
         .iter()
         .map(|f| format!("{} ({})", f.param.name(), f.describe()))
         .collect();
-    assert!(v.max_mm < 1e-8, "validation max {} mm; fixed {fixed:?}", v.max_mm);
+    assert!(
+        v.max_mm < 1e-8,
+        "validation max {} mm; fixed {fixed:?}",
+        v.max_mm
+    );
     let k5 = Param::parse("thermal_k5").unwrap();
     assert!(c.identifiability.fixed_reason(k5).is_some());
     for (j, g) in GAIN.iter().enumerate() {
@@ -197,6 +208,9 @@ fn noise_free_uneven_warm_up_is_recovered_per_link_and_not_by_the_lumped_coeffic
     // The lumped coefficient cannot follow an uneven warm-up.
     let lumped = fit_model(&with_families(reference_c), &sim);
     let lv = lumped.validation.as_ref().unwrap().after_stats();
-    eprintln!("uneven warm-up: lumped validation mean {:.2e} mm", lv.mean_mm);
+    eprintln!(
+        "uneven warm-up: lumped validation mean {:.2e} mm",
+        lv.mean_mm
+    );
     assert!(lv.mean_mm > 1e-3, "{}", lv.mean_mm);
 }

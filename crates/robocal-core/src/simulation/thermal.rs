@@ -118,7 +118,10 @@ impl ThermalModel {
         if g.len() != dof {
             return Err(Error::invalid(
                 name,
-                format!("{} values for a robot with {dof} links (one per link)", g.len()),
+                format!(
+                    "{} values for a robot with {dof} links (one per link)",
+                    g.len()
+                ),
             ));
         }
         for (i, v) in g.iter().enumerate() {

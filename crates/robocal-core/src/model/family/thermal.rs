@@ -122,9 +122,7 @@ impl ParameterFamily for Thermal {
         let reference = reference_c(robot).unwrap_or(DEFAULT_REFERENCE_C);
         match (p.template(), robot.family_values(KEY).map(is_per_link)) {
             (0, None) => enable(robot, reference),
-            (1, None | Some(false)) if p.index() < robot.dof() => {
-                enable_per_link(robot, reference)
-            }
+            (1, None | Some(false)) if p.index() < robot.dof() => enable_per_link(robot, reference),
             _ => Ok(()),
         }
     }
