@@ -61,7 +61,7 @@ pub struct EvaluateArgs {
     refit_frame: bool,
     /// The robot's pose repeatability (mm, ISO 9283 RP) for the verification's gap split
     /// [default: the class default of the robot's reach].
-    #[arg(long, value_name = "MM")]
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     repeatability_mm: Option<f64>,
 }
 

@@ -218,7 +218,13 @@ fn evaluate_splits_the_verification_gap() {
         text.contains("the fresh station's registration (75 points"),
         "{text}"
     );
-    let o = run(&["--repeatability-mm", "-1"]);
-    o.assert_code(2);
-    assert!(o.stderr().contains("--repeatability-mm"), "{}", o.stderr());
+    for bad in ["-1", "0", "nan"] {
+        let o = run(&["--repeatability-mm", bad]);
+        o.assert_code(2);
+        assert!(
+            o.stderr().contains("--repeatability-mm: repeatability_mm"),
+            "{}",
+            o.stderr()
+        );
+    }
 }
