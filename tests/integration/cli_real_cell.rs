@@ -228,3 +228,104 @@ fn evaluate_splits_the_verification_gap() {
         );
     }
 }
+
+/// An arm that warms unevenly (`simulate --thermal-link-gain`), measured across its whole
+/// warm-up without noise: `calibrate --thermal per-link` recovers each link's coefficient (the
+/// simulated 11.5 ppm/K times its gain), link 5 (no length) fixed with its reason; the lumped
+/// coefficient leaves an error the per-link model does not.
+#[test]
+fn per_link_thermal_follows_an_uneven_warm_up() {
+    let dir = Dir::new();
+    let (cell, val) = (dir.join("cell.csv"), dir.join("val.csv"));
+    ok(&[
+        "simulate",
+        "--robot",
+        KUKA,
+        "--truth",
+        TRUTH,
+        "--poses",
+        "300",
+        "--validation",
+        "40",
+        "--seed",
+        "4",
+        "--noise-mm",
+        "0",
+        "--noise-per-m",
+        "0",
+        "--thermal",
+        "auto",
+        "--thermal-rise-c",
+        "30",
+        "--seconds-per-pose",
+        "30",
+        "--thermal-link-gain",
+        "0.6,1.5,1.3,0.8,0,1.1",
+        "--out",
+        p(&cell),
+        "--validation-out",
+        p(&val),
+    ]);
+    let fit = |thermal: &str| {
+        let out = dir.join(format!("{thermal}.json"));
+        ok(&[
+            "calibrate",
+            "--robot",
+            KUKA,
+            "--data",
+            p(&cell),
+            "--validate",
+            p(&val),
+            "--model",
+            "geometric",
+            "--objective",
+            "least-squares",
+            "--thermal",
+            thermal,
+            "--out",
+            p(&out),
+        ]);
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+        v
+    };
+    let (per, lumped) = (fit("per-link"), fit("auto"));
+    let val_mean = |v: &serde_json::Value| {
+        v["errors"]["validation"]["after"]["mean_mm"]
+            .as_f64()
+            .unwrap()
+    };
+    let (vp, vl) = (val_mean(&per), val_mean(&lumped));
+    eprintln!("uneven warm-up: validation {vp:.5} mm per link, {vl:.5} mm lumped");
+    assert!(vp < 0.2 * vl && vp < 0.005, "{vp} vs {vl}");
+    let k = |j: usize| &per["parameters"][format!("thermal_k{j}")];
+    assert_eq!(k(5)["fixed"], true, "{}", k(5));
+    for (j, g) in [(1, 0.6), (2, 1.5), (3, 1.3), (4, 0.8), (6, 1.1)] {
+        let got = k(j)["calibrated"].as_f64().unwrap();
+        let want = 11.5 * g;
+        eprintln!("thermal_k{j}: {got:.4} ppm/K, simulated {want:.4}");
+        assert!(
+            (got - want).abs() < 0.02 * want,
+            "thermal_k{j}: {got} vs {want}"
+        );
+    }
+    // A gain for a link the robot does not have is refused by name.
+    let o = robocal(&[
+        "simulate",
+        "--robot",
+        KUKA,
+        "--truth",
+        TRUTH,
+        "--poses",
+        "10",
+        "--thermal",
+        "auto",
+        "--thermal-link-gain",
+        "1,1,1",
+        "--out",
+        p(&dir.join("never.csv")),
+    ]);
+    assert_ne!(o.code(), Some(0));
+    assert!(o.stderr().contains("thermal.link_gain"), "{}", o.stderr());
+    assert!(!dir.join("never.csv").exists());
+}
