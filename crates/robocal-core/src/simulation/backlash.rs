@@ -54,7 +54,7 @@ impl BacklashModel {
     ///   from either side keeps half the bidirectional error in its residual, and the paper's
     ///   KR 480 calibration left 0.174 mm (its Table IV), which the IRB 4600's play (0.7 mm of
     ///   residual) rules out for that cell; with these defaults the honest cell's geometric
-    ///   residual is already 0.23 to 0.28 mm over seeds 1..8 (with its gravity sag).
+    ///   residual is already 0.24 to 0.28 mm over seeds 1..8 (with its gravity sag).
     pub fn for_robot(robot: &Robot) -> BacklashModel {
         let reach = robot.reach_mm();
         let (main, wrist) = if reach >= 2000.0 {
