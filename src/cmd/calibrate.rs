@@ -95,9 +95,10 @@ pub struct CalibrateArgs {
     backlash: Option<String>,
     /// Thermal expansion: `auto` fits one coefficient (`thermal_k`, ppm/K) by which the links'
     /// lengths and the base column grow with the data's `temperature_c`, referred to the
-    /// calibration rows' mean temperature (the result's `reference_temperature_c`), or `none`
-    /// [default: none, or chosen by --model auto when the data have temperature_c].
-    #[arg(long, value_parser = ["auto", "none"])]
+    /// calibration rows' mean temperature (the result's `reference_temperature_c`); `per-link`
+    /// one coefficient per link (`thermal_k1`..), for an arm that warms unevenly; or `none`
+    /// [default: none, or chosen by --model auto (lumped) when the data have temperature_c].
+    #[arg(long, value_parser = ["auto", "per-link", "none"])]
     thermal: Option<String>,
     /// Also fit the paper's 12-parameter affine Tr (eq. 8-11) and report it (the tracker frame
     /// stays rigid).

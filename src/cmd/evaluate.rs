@@ -4,6 +4,7 @@
 
 mod conditions;
 mod constraints;
+mod gap;
 
 use super::common;
 use super::io_plan::{self, IoPlan};
@@ -59,6 +60,10 @@ pub struct EvaluateArgs {
     /// Without it, data that clearly come from another station are refused (exit code 3).
     #[arg(long)]
     refit_frame: bool,
+    /// The robot's pose repeatability (mm, ISO 9283 RP) for the verification's gap split
+    /// [default: the class default of the robot's reach].
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    repeatability_mm: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -94,6 +99,7 @@ struct Settings {
     json: bool,
     nominal_limits: bool,
     refit_frame: bool,
+    repeatability_mm: Option<f64>,
 }
 
 impl TryFrom<&EvaluateArgs> for Settings {
@@ -114,6 +120,10 @@ impl TryFrom<&EvaluateArgs> for Settings {
             .input("--data", &a.data);
         if let Some(p) = &a.per_point {
             plan.output_or_stdout("--per-point", p);
+        }
+        if let Some(rp) = a.repeatability_mm {
+            robocal_core::evaluation::gap::check_rp(rp)
+                .map_err(|e| crate::exit::usage(format!("--repeatability-mm: {e}")))?;
         }
         let outputs = plan.check()?;
         let (nominal, mut calibrated, result) = calibrated_model(a.robot.as_deref(), &a.params)?;
@@ -136,6 +146,7 @@ impl TryFrom<&EvaluateArgs> for Settings {
             json: a.json,
             nominal_limits: a.nominal_limits,
             refit_frame: a.refit_frame,
+            repeatability_mm: a.repeatability_mm,
         })
     }
 }
@@ -153,6 +164,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         json,
         nominal_limits,
         refit_frame,
+        repeatability_mm,
     } = Settings::try_from(&a)?;
     if let Some(inputs) = &res.inputs {
         robocal_core::io::inputs::check_unchanged(inputs, &data, &params)?;
@@ -267,6 +279,20 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         .collect();
     let reference = ev.reference();
     let means_without: Vec<f64> = sums_without.iter().map(|s| s / n.max(1) as f64).collect();
+    let gap = if reference == Reference::Desired {
+        let set = whole().with_context(context)?;
+        gap::split(
+            &nominal,
+            &cal,
+            &res,
+            &set,
+            series[0].stats.rms_mm,
+            refit_frame.then_some(&frame),
+            repeatability_mm,
+        )?
+    } else {
+        None
+    };
     if json {
         let mut o = serde_json::Map::new();
         o.insert("data".into(), data.display().to_string().into());
@@ -309,6 +335,9 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
                 }),
             );
         }
+        if let Some(g) = &gap {
+            o.insert("gap".into(), g.json());
+        }
         if !without.is_empty() {
             o.insert(
                 "calibrated_without".into(),
@@ -333,6 +362,9 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             &res,
             refit_frame.then_some(&frame),
         )?;
+        if let Some(g) = &gap {
+            gap::print(g)?;
+        }
         conditions::print(&without, &means_without, series[1].stats.mean_mm)?;
     }
     Ok(())

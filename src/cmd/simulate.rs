@@ -130,7 +130,7 @@ pub struct SimulateArgs {
     #[arg(long, allow_hyphen_values = true)]
     backlash_deg: Option<String>,
     /// Thermal growth: `auto` warms the arm up over the session with the robot class's default
-    /// (a KR 480: 8 K with a one-hour time constant, 20 s per pose, steel); its links and base
+    /// (a KR 480: 15 K with a one-hour time constant, 20 s per pose, steel); its links and base
     /// column grow with the temperature; writes `temperature_c` and `time_s`.
     #[arg(long, value_parser = ["auto", "none"])]
     thermal: Option<String>,
@@ -144,6 +144,16 @@ pub struct SimulateArgs {
     /// Thermal growth: seconds between two measured poses [default: the class's].
     #[arg(long, allow_hyphen_values = true, requires = "thermal")]
     seconds_per_pose: Option<f64>,
+    /// Thermal growth: how much each link warms relative to the measured temperature, one
+    /// value for all links or one per link (e.g. `0.6,1.5,1.3,0.8,0,1.1`: an arm warming
+    /// unevenly, for `calibrate --thermal per-link`) [default: 1, evenly].
+    #[arg(
+        long,
+        value_name = "G|G1,..",
+        allow_hyphen_values = true,
+        requires = "thermal"
+    )]
+    thermal_link_gain: Option<String>,
     /// Measure from a fresh tracker set-up: station K (1, 2, ..) is the tracker carried
     /// elsewhere around the robot (turned 15 to 45 degrees about the base axis) and set up
     /// again; evaluate such data with --refit-frame [default: 0, the --tracker pose].
@@ -256,6 +266,11 @@ fn builder(a: &SimulateArgs) -> anyhow::Result<SimulationBuilder> {
         thermal_rise_c: a.thermal_rise_c,
         thermal_start_s: a.thermal_start_s,
         seconds_per_pose: a.seconds_per_pose,
+        thermal_link_gain: a
+            .thermal_link_gain
+            .as_deref()
+            .map(|s| numbers("--thermal-link-gain", s))
+            .transpose()?,
         station: a.station,
     })
 }

@@ -276,6 +276,7 @@ pub fn check_result_nominal(
     Ok(())
 }
 
+pub mod gap;
 mod station;
 mod stream;
 pub use station::{check_data_matches, check_station, observations_of, station_frames};

@@ -301,9 +301,11 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
         None | Some("none") => {}
         Some("auto") => thermal::enable(robot, thermal::DEFAULT_REFERENCE_C)
             .map_err(|e| usage(crate::errors::message(&e)))?,
+        Some("per-link") => thermal::enable_per_link(robot, thermal::DEFAULT_REFERENCE_C)
+            .map_err(|e| usage(crate::errors::message(&e)))?,
         Some(other) => {
             return Err(usage(format!(
-                "thermal: {other:?}: expected \"auto\" or \"none\""
+                "thermal: {other:?}: expected \"auto\", \"per-link\" or \"none\""
             )))
         }
     }

@@ -192,6 +192,7 @@ pub fn simulate_session(
         thermal_rise_c,
         thermal_start_s,
         seconds_per_pose,
+        thermal_link_gain: None,
         station,
     };
     let truth = truth_arg(truth, nominal)?;

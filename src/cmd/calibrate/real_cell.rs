@@ -7,7 +7,7 @@ use robocal_core::model::family::{backlash, thermal};
 use robocal_core::Robot;
 use std::path::Path;
 
-/// Applies `--backlash auto|none|J,..` and `--thermal auto|none` to `robot` (the thermal
+/// Applies `--backlash auto|none|J,..` and `--thermal auto|per-link|none` to `robot` (the thermal
 /// reference is set from the data by [`fit_to_data`]).
 pub(super) fn apply(
     robot: &mut Robot,
@@ -18,10 +18,12 @@ pub(super) fn apply(
         (0..r.dof()).collect()
     })?;
     backlash::enable(robot, &joints).map_err(|e| exit::usage(e.to_string()))?;
-    if thermal_arg == Some("auto") {
-        thermal::enable(robot, thermal::DEFAULT_REFERENCE_C)
-            .map_err(|e| exit::usage(e.to_string()))?;
+    match thermal_arg {
+        Some("auto") => thermal::enable(robot, thermal::DEFAULT_REFERENCE_C),
+        Some("per-link") => thermal::enable_per_link(robot, thermal::DEFAULT_REFERENCE_C),
+        _ => Ok(()),
     }
+    .map_err(|e| exit::usage(e.to_string()))?;
     Ok(())
 }
 
@@ -42,7 +44,7 @@ pub(super) fn fit_to_data(
         };
         let Some(t) = selection::reference_temperature_c(&cd) else {
             return Err(exit::input(format!(
-                "--thermal auto: {} has no temperature_c column (the arm's temperature at each \
+                "--thermal: {} has no temperature_c column (the arm's temperature at each \
                  row, deg C)",
                 path.display()
             )));

@@ -14,7 +14,7 @@ use crate::simulation::{
 };
 
 /// When the verification starts on the warm-up curve (s since the arm started working): a
-/// later session of the same day, four hours in, the arm warm (within 0.2 K of its plateau
+/// later session of the same day, four hours in, the arm warm (within 0.3 K of its plateau
 /// with the KR 480's one-hour time constant).
 pub const VERIFICATION_START_S: f64 = 4.0 * 3600.0;
 
@@ -188,9 +188,13 @@ mod tests {
                 floor(e)
             );
         }
-        // The geometric calibration verifies well above its prediction (the paper's: Table IV;
-        // the paper: +68%).
-        assert!(ratio(&geo) >= 1.3, "geometric {}", ratio(&geo));
+        // The geometric calibration verifies well above its prediction at new poses (the
+        // paper: +68% above Table IV, +21% above its validation at new poses).
+        assert!(
+            ratio_to_prediction(&geo) >= 1.3,
+            "geometric {}",
+            ratio_to_prediction(&geo)
+        );
         // The families verify within 15% of the calibration's prediction at new poses.
         assert!(
             ratio_to_prediction(&fam) <= 1.15,
@@ -216,38 +220,52 @@ mod tests {
         d.iter().sum::<f64>() / d.len() as f64
     }
 
-    /// Over seeds: the real cell's families verify on average within 15% of their prediction,
-    /// each seed within 1.5 times (a fresh station farther from the poses reads noisier than the
-    /// calibration's tracker did, which no prediction from the calibration can know).
+    /// Over seeds 1..8: the geometric calibration verifies on average at least 1.3 times its
+    /// prediction at new poses; the real cell's families verify on average within 15% of
+    /// theirs, each seed within 1.5 times (a fresh station farther from the poses reads noisier
+    /// than the calibration's tracker did, which no prediction from the calibration can know),
+    /// and validate within 1.3 times the true model's floor.
     #[test]
     fn over_seeds_the_families_verify_as_predicted() {
-        let mut ratios = Vec::new();
+        let (mut geo, mut fam) = (Vec::new(), Vec::new());
         for seed in 1..=8 {
-            let cfg = ExperimentConfig::honest(seed)
-                .unwrap()
-                .with_real_cell_families()
-                .unwrap();
-            let mut cfg = cfg;
+            let honest = ExperimentConfig::honest(seed).unwrap();
+            let g = run_experiment(honest.clone(), &()).unwrap();
+            let mut cfg = honest.with_real_cell_families().unwrap();
             let joints = compliance::auto_joints(&cfg.nominal);
             compliance::enable(&mut cfg.nominal, &joints, Some(300.0)).unwrap();
             let e = run_experiment(cfg, &()).unwrap();
             let p = e.result.prediction.as_ref().unwrap();
             eprintln!(
-                "seed {seed}: verified {:.4} predicted {:.4} ({:.3}); Table IV {:.4} ({:.3}); \
-                 verification floor {:.4}, validation floor {:.4}",
+                "seed {seed}: geometric verified {:.4} predicted {:.4} ({:.3}); families \
+                 verified {:.4} predicted {:.4} ({:.3}); Table IV {:.4} ({:.3}); verification \
+                 floor {:.4}; validation {:.4}, floor {:.4}",
+                g.verified().mean_mm,
+                g.result.prediction.as_ref().unwrap().mean_mm,
+                ratio_to_prediction(&g),
                 e.verified().mean_mm,
                 p.mean_mm,
                 ratio_to_prediction(&e),
                 e.predicted().mean_mm,
                 ratio(&e),
                 verification_floor(&e),
+                validation(&e),
                 floor(&e)
             );
-            ratios.push(ratio_to_prediction(&e));
+            assert!(
+                validation(&e) <= 1.3 * floor(&e),
+                "seed {seed}: validation {} vs floor {}",
+                validation(&e),
+                floor(&e)
+            );
+            geo.push(ratio_to_prediction(&g));
+            fam.push(ratio_to_prediction(&e));
         }
-        let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
-        eprintln!("mean verification / prediction over 8 seeds: {mean:.3}");
-        assert!((0.85..=1.15).contains(&mean), "{mean}");
-        assert!(ratios.iter().all(|r| (0.7..1.5).contains(r)), "{ratios:?}");
+        let mean = |r: &[f64]| r.iter().sum::<f64>() / r.len() as f64;
+        let (g, f) = (mean(&geo), mean(&fam));
+        eprintln!("mean verification / prediction over 8 seeds: geometric {g:.3}, families {f:.3}");
+        assert!(g >= 1.3, "geometric {g}: {geo:?}");
+        assert!((0.85..=1.15).contains(&f), "{f}");
+        assert!(fam.iter().all(|r| (0.7..1.5).contains(r)), "{fam:?}");
     }
 }

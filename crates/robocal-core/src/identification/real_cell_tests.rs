@@ -465,3 +465,7 @@ fn a_bidirectional_test_reaches_the_floor_with_the_backlash_family_only() {
     assert!(f <= 1.3 * floor, "with backlash {f} vs floor {floor}");
     assert!(g > 2.0 * floor, "geometric {g} vs floor {floor}");
 }
+
+/// The per-link variant of the thermal family: one coefficient per link.
+#[path = "real_cell_per_link_tests.rs"]
+mod per_link;

@@ -16,8 +16,8 @@ impl Robot {
     /// The model as it stands at `c`'s temperature: itself, or with its lengths grown by the
     /// thermal family.
     fn at_temperature(&self, c: &Conditions) -> Cow<'_, Robot> {
-        match thermal::scale(self, c.temperature_c) {
-            Some(s) => Cow::Owned(thermal::scaled_lengths(self, s)),
+        match thermal::link_scales(self, c.temperature_c) {
+            Some(s) => Cow::Owned(thermal::scaled_links(self, &s)),
             None => Cow::Borrowed(self),
         }
     }
@@ -90,16 +90,19 @@ impl Robot {
 
     /// Scales the columns of the lengths thermal growth scales (each link's `d` and `a`) by the
     /// growth factor at `c`'s temperature: the columns of the families are
-    /// taken at the grown lengths, while the parameters are the lengths at the reference.
+    /// taken at the grown lengths, while the parameters are the lengths at the reference (each
+    /// link's by its own factor when the family has one coefficient per link).
     pub(crate) fn scale_grown_columns(&self, c: &Conditions, jp: &mut [Vector3<f64>]) {
-        let Some(s) = thermal::scale(self, c.temperature_c) else {
+        let Some(s) = thermal::link_scales(self, c.temperature_c) else {
             return;
         };
         let n = self.dof();
         for (id, span) in self.family_spans() {
             if *id == link::ID {
-                for v in &mut jp[span.start + n..span.start + 3 * n] {
-                    *v *= s;
+                // The link family's d (n columns) then a (n columns), after alpha.
+                for (i, si) in s.iter().enumerate() {
+                    jp[span.start + n + i] *= *si;
+                    jp[span.start + 2 * n + i] *= *si;
                 }
             }
         }

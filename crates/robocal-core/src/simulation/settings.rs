@@ -140,6 +140,9 @@ pub struct SimulationBuilder {
     pub thermal_start_s: Option<f64>,
     /// Seconds between poses; `None`: the class's.
     pub seconds_per_pose: Option<f64>,
+    /// How much each link warms relative to the measured temperature (one value for all
+    /// links or one per link, [`ThermalModel::link_gain`]); `None`: evenly.
+    pub thermal_link_gain: Option<Vec<f64>>,
     /// The tracker station (0: `tracker_frame`).
     pub station: u32,
 }
@@ -177,6 +180,7 @@ impl Default for SimulationBuilder {
             thermal_rise_c: None,
             thermal_start_s: None,
             seconds_per_pose: None,
+            thermal_link_gain: None,
             station: 0,
         }
     }
@@ -261,12 +265,17 @@ impl SimulationBuilder {
                 half_play_deg: per_joint("backlash.half_play_deg", v, dof)?,
             }),
         };
+        let link_gain = match &self.thermal_link_gain {
+            Some(g) => Some(per_joint("thermal.link_gain", g, dof)?),
+            None => None,
+        };
         let thermal = self.thermal.then(|| {
             let t = ThermalModel::for_robot(nominal);
             ThermalModel {
                 rise_c: self.thermal_rise_c.unwrap_or(t.rise_c),
                 start_s: self.thermal_start_s.unwrap_or(t.start_s),
                 seconds_per_pose: self.seconds_per_pose.unwrap_or(t.seconds_per_pose),
+                link_gain,
                 ..t
             }
         });
@@ -381,10 +390,11 @@ impl SimulationBuilder {
             !self.thermal
                 && (self.thermal_rise_c.is_some()
                     || self.thermal_start_s.is_some()
-                    || self.seconds_per_pose.is_some()),
+                    || self.seconds_per_pose.is_some()
+                    || self.thermal_link_gain.is_some()),
             "thermal.rise_c",
-            "`thermal.rise_c`, `thermal.start_s` and `thermal.seconds_per_pose` shape the \
-             thermal growth: turn it on too",
+            "`thermal.rise_c`, `thermal.start_s`, `thermal.seconds_per_pose` and \
+             `thermal.link_gain` shape the thermal growth: turn it on too",
         )?;
         let random_given = self.length_sigma_mm.is_some()
             || self.angle_sigma_deg.is_some()

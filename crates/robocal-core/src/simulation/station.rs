@@ -59,7 +59,7 @@ impl SimulationConfig {
             b.validate(dof)?;
         }
         if let Some(t) = &self.thermal {
-            t.validate()?;
+            t.validate_for(dof)?;
         }
         if self.station > MAX_STATION {
             return Err(Error::invalid(

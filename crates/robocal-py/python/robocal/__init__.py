@@ -350,8 +350,8 @@ def calibrate(
     ``result`` records the choice in ``model_selection``) or "geometric"; ``compliance`` "auto",
     "none" or joint numbers, with ``payload_kg``, ``harmonics`` 0..8, ``backlash`` "auto", "none"
     or joint numbers (against each row's approach direction: a file's ``dir1..dirN``, else the
-    row order) and ``thermal`` "auto" or "none" (against a file's ``temperature_c``, referred to
-    the calibration rows' mean temperature) fix that family (None: chosen by ``model="auto"``,
+    row order) and ``thermal`` "auto", "per-link" (one coefficient per link) or "none" (against
+    a file's ``temperature_c``, referred to the calibration rows' mean temperature) fix that family (None: chosen by ``model="auto"``,
     none with "geometric"); ``tracker_sigma=(fixed_mm, per_m_mm)``; and so on.
 
     Rows outside the joint limits raise :class:`InputError` unless ``nominal_limits``. A solver
