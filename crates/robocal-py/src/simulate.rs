@@ -105,7 +105,8 @@ fn joints_arg(robot: &PyRobot, joints: &Bound<'_, PyAny>) -> PyResult<Measuremen
     footprint_mm = None, compliance = None, link_masses_kg = None, payload_kg = None,
     outlier_fraction = None, outlier_min_mm = None, outlier_max_mm = None, all_targets = false,
     orientation_sigma_deg = None, repeatability_deg = None, backlash_deg = None, thermal = None,
-    thermal_rise_c = None, thermal_start_s = None, seconds_per_pose = None, station = 0
+    thermal_rise_c = None, thermal_start_s = None, seconds_per_pose = None,
+    thermal_link_gain = None, station = 0
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate_session(
@@ -140,6 +141,7 @@ pub fn simulate_session(
     thermal_rise_c: Option<f64>,
     thermal_start_s: Option<f64>,
     seconds_per_pose: Option<f64>,
+    thermal_link_gain: Option<&Bound<'_, PyAny>>,
     station: u32,
 ) -> PyResult<PySimulation> {
     let nominal = &robot.inner;
@@ -192,7 +194,7 @@ pub fn simulate_session(
         thermal_rise_c,
         thermal_start_s,
         seconds_per_pose,
-        thermal_link_gain: None,
+        thermal_link_gain: list(thermal_link_gain, "thermal_link_gain")?,
         station,
     };
     let truth = truth_arg(truth, nominal)?;

@@ -250,3 +250,25 @@ def test_real_cell_session_and_families_are_the_cli(cli, tmp_path):
         robocal.simulate(kr, "random", 10, backlash_deg="some")
     with pytest.raises((robocal.UsageError, robocal.InputError), match="station"):
         robocal.simulate(kr, "random", 10, station=100000)
+
+
+def test_links_growing_unevenly_are_the_cli(cli, tmp_path):
+    """``thermal_link_gain`` (one gain per link) writes the CLI's files for --thermal-link-gain,
+    and is refused as the CLI refuses it: without thermal growth, or with a wrong count."""
+    kr = robocal.Robot.preset(KR)
+    gains = [1.0, 1.5, 0.5, 1.0, 1.0, 2.0]
+    _, c, p = run_both(cli, tmp_path, KR, kr,
+                       ["--truth", "kuka-kr480-r3330-table3", "--poses", "30", "--seed", "4",
+                        "--thermal", "auto", "--thermal-link-gain", ",".join(map(str, gains))],
+                       truth="kuka-kr480-r3330-table3", poses=30, seed=4, thermal="auto",
+                       thermal_link_gain=gains)
+    same_files(c, p)
+    same_files(c.with_suffix(".truth.json"), p.with_suffix(".truth.json"))
+    even = robocal.simulate(kr, "kuka-kr480-r3330-table3", 30, seed=4, thermal="auto")
+    uneven = robocal.simulate(kr, "kuka-kr480-r3330-table3", 30, seed=4, thermal="auto",
+                              thermal_link_gain=gains)
+    assert (even.xyz != uneven.xyz).any()
+    with pytest.raises(robocal.UsageError, match="link_gain"):
+        robocal.simulate(kr, "random", 10, thermal_link_gain=gains)
+    with pytest.raises((robocal.UsageError, robocal.InputError), match="link_gain"):
+        robocal.simulate(kr, "random", 10, thermal="auto", thermal_link_gain=[1.0, 2.0])

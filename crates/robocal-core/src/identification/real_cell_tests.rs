@@ -464,6 +464,21 @@ fn a_bidirectional_test_reaches_the_floor_with_the_backlash_family_only() {
     eprintln!("bidirectional: geometric {g:.4} mm, with backlash {f:.4} mm, floor {floor:.4} mm");
     assert!(f <= 1.3 * floor, "with backlash {f} vs floor {floor}");
     assert!(g > 2.0 * floor, "geometric {g} vs floor {floor}");
+    // The figures README.md quotes ("Backlash and thermal expansion" under the families).
+    let quoted = [
+        (f, "0.058"),
+        (floor, "0.052"),
+        (g, "0.364"),
+        (f / floor, "1.12"),
+    ];
+    for (v, text) in quoted {
+        let printed = if text == "1.12" {
+            format!("{v:.2}")
+        } else {
+            format!("{v:.3}")
+        };
+        assert_eq!(printed, text, "README's bidirectional figure");
+    }
 }
 
 /// The per-link variant of the thermal family: one coefficient per link.

@@ -539,6 +539,7 @@ def simulate(
     thermal_rise_c: Optional[float] = None,
     thermal_start_s: Optional[float] = None,
     seconds_per_pose: Optional[float] = None,
+    thermal_link_gain: Optional[PerJoint] = None,
     station: int = 0,
 ) -> Simulation:
     """Measures a virtual robot with a virtual laser tracker: the CLI's ``robocal simulate``.
@@ -564,7 +565,8 @@ def simulate(
     ``repeatability_deg`` (a random error per joint and move, 1-sigma deg; ``"default"`` for the
     class default), ``backlash_deg`` (half the gear play per joint, deg; ``"auto"`` for the
     class default; writes ``dir1..dirN``), ``thermal="auto"`` (the arm warming up over the
-    session, shaped by ``thermal_rise_c``, ``thermal_start_s`` and ``seconds_per_pose``; writes
+    session, shaped by ``thermal_rise_c``, ``thermal_start_s`` and ``seconds_per_pose``, and
+    with ``thermal_link_gain`` (one value or one per link) the links growing unevenly; writes
     ``temperature_c`` and ``time_s``) and ``station`` (a fresh tracker set-up, 1, 2, ..).
 
     Returns a :class:`Simulation` whose arrays hold the values ``robocal simulate --out`` writes
@@ -606,6 +608,7 @@ def simulate(
         thermal_rise_c=thermal_rise_c,
         thermal_start_s=thermal_start_s,
         seconds_per_pose=seconds_per_pose,
+        thermal_link_gain=thermal_link_gain,
         station=station,
     )
     for w in sim.warnings:

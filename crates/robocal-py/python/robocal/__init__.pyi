@@ -368,6 +368,7 @@ def simulate(
     thermal_rise_c: Optional[float] = None,
     thermal_start_s: Optional[float] = None,
     seconds_per_pose: Optional[float] = None,
+    thermal_link_gain: Optional[PerJoint] = None,
     station: int = 0,
 ) -> Simulation:
     """The CLI's ``robocal simulate``: random poses (``poses``, ``validation``, the plane
