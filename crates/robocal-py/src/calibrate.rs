@@ -389,8 +389,8 @@ fn run(
         ));
     }
     let status = res.status().map_or("calibrated", |s| s.as_str()).to_owned();
-    let mut text = serde_json::to_string_pretty(&res)
+    let text = res
+        .to_text()
         .map_err(|e| raise(1, format!("cannot serialize the result: {e}")))?;
-    text.push('\n');
     Ok((text, status, warnings, library_seconds))
 }

@@ -11,10 +11,8 @@ use std::path::Path;
 const TEXT: &str = "<result json>";
 
 fn to_text(res: &CalibrationResult) -> PyResult<String> {
-    let mut s = serde_json::to_string_pretty(res)
-        .map_err(|e| raise(1, format!("cannot serialize the result: {e}")))?;
-    s.push('\n');
-    Ok(s)
+    res.to_text()
+        .map_err(|e| raise(1, format!("cannot serialize the result: {e}")))
 }
 
 /// Checks result JSON `text` (as `robocal` reads a result file) and returns it as robocal

@@ -382,9 +382,7 @@ pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Resu
         })
         .collect(),
     );
-    let mut result_json = serde_json::to_string_pretty(&result)
-        .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
-    result_json.push('\n');
+    let result_json = result.to_text()?;
     let result = CalibrationResult::parse(&result_json, Path::new(files::RESULT))?;
     let calibrated = result.calibrated_robot(nominal, Path::new(files::RESULT))?;
     observer.progress(Stage::Calibration, 1, 1);

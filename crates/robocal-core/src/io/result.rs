@@ -276,11 +276,10 @@ impl CalibrationResult {
         Ok((r, nominal))
     }
 
-    /// Writes the result atomically as pretty JSON (each per-point entry on one line), after reading the text back as every command
-    /// that takes a result does ([`CalibrationResult::parse`], then the calibrated model): what
-    /// robocal writes, robocal reads. A result its readers would refuse (a value outside its
-    /// range) is not written: [`Error::Implausible`] names the field.
-    pub fn write(&self, path: &Path) -> Result<()> {
+    /// The result's text as robocal writes it: pretty JSON with each per-point entry on one
+    /// line, ending with a newline. Every writer of a result (the CLI, the demo's files, the
+    /// Python bindings) uses it, so that the same result is the same bytes wherever it is made.
+    pub fn to_text(&self) -> Result<String> {
         // Sized for the per-point entries (one line of at most about 90 bytes each: two errors
         // written to the last digit and a line number), so that a million points' text is
         // neither copied as it grows nor given twice the room it needs.
@@ -295,8 +294,16 @@ impl CalibrationResult {
         serde::Serialize::serialize(self, &mut ser)
             .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
         buf.push(b'\n');
-        let s = String::from_utf8(buf)
-            .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))?;
+        String::from_utf8(buf)
+            .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))
+    }
+
+    /// Writes the result atomically as pretty JSON (each per-point entry on one line), after reading the text back as every command
+    /// that takes a result does ([`CalibrationResult::parse`], then the calibrated model): what
+    /// robocal writes, robocal reads. A result its readers would refuse (a value outside its
+    /// range) is not written: [`Error::Implausible`] names the field.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let s = self.to_text()?;
         let readable =
             Self::parse_with_nominal(&s, path).and_then(|(back, nominal)| match nominal {
                 Some(nominal) => back.calibrated_robot(&nominal, path).map(|_| ()),
