@@ -96,17 +96,15 @@ pub struct DownWeighted {
 }
 
 impl DownWeighted {
-    /// The observations whose residual as the loss sees it (position and orientation rows,
-    /// weighted; [`Problem::fit_norms`]) exceeds the robust scale `c` (mm), worst first: an
-    /// orientation row far off is listed like a position far off.
+    /// The observations whose residual as the loss sees it (`norms`: position and orientation
+    /// rows, weighted; [`Problem::fit_norms`] at the calibrated model) exceeds the robust scale
+    /// `c` (mm), worst first: an orientation row far off is listed like a position far off.
     pub(crate) fn list(
-        problem: &Problem,
-        robot: &Robot,
+        norms: &[f64],
         errors: &SetErrors,
         loss: &Loss,
         c: f64,
     ) -> Vec<DownWeighted> {
-        let norms = problem.fit_norms(robot);
         let mut out: Vec<(f64, DownWeighted)> = norms
             .iter()
             .enumerate()

@@ -308,6 +308,7 @@ pub(crate) fn complete(
         stages: cal.stages,
         robust_scale: cal.robust_scale_mm,
         final_pass: None,
+        final_norms: None,
     };
     let job = Job {
         nominal: &nominal,

@@ -79,7 +79,11 @@ pub(super) fn assemble(
     );
     let (validation, validation_frame) = validation_errors(nominal, data, settings, &start, robot)?;
     let downweighted = solved.robust_scale.map_or_else(Vec::new, |c| {
-        DownWeighted::list(&problem, robot, &calibration, &solved.loss, c)
+        let norms = match &solved.final_norms {
+            Some(n) => std::borrow::Cow::Borrowed(n),
+            None => std::borrow::Cow::Owned(problem.fit_norms(robot)),
+        };
+        DownWeighted::list(&norms, &calibration, &solved.loss, c)
     });
     observer.progress(progress::Stage::Plausibility, 0, 1);
     let errors = Errors {

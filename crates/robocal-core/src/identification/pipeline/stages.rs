@@ -27,6 +27,9 @@ pub(super) struct Solved {
     /// The last run's full pass at `robot` with `loss`, when it ended on one (the covariance's
     /// pass, not repeated then).
     pub final_pass: Option<Accumulated>,
+    /// The fit's residual norms at `robot` ([`Problem::fit_norms`]), when the reweighting
+    /// computed them there (the down-weighted points' list, not computed again then).
+    pub final_norms: Option<Vec<f64>>,
 }
 
 /// The solver runs of one identification, with the iteration limit shared by all.
@@ -93,6 +96,7 @@ pub(super) fn solve_stages(
     let son = Loss::SumOfNorms {
         delta: SUM_OF_NORMS_SMOOTHING_MM,
     };
+    let mut final_norms = None;
     let (loss, robust_scale) = match settings.objective {
         Objective::LeastSquares => {
             runs.run(Loss::Squared)?;
@@ -111,7 +115,8 @@ pub(super) fn solve_stages(
             let start_loss = if tools_fit { Loss::Squared } else { son };
             runs.run(start_loss)?;
             if runs.converged() {
-                let (loss, c) = robust_rounds(&mut runs)?;
+                let (loss, c, norms) = robust_rounds(&mut runs)?;
+                final_norms = norms;
                 (loss, Some(c))
             } else {
                 (start_loss, None)
@@ -124,6 +129,7 @@ pub(super) fn solve_stages(
         loss,
         robust_scale,
         final_pass: runs.final_pass,
+        final_norms,
     })
 }
 
@@ -131,7 +137,7 @@ pub(super) fn solve_stages(
 /// re-estimated after every reweighted fit until it settles (within 5%; the adaptive objective,
 /// whose threshold decides which points count fully, within 1%). Returns the last loss and its
 /// scale (mm).
-fn robust_rounds(runs: &mut Runs) -> Result<(Loss, f64)> {
+fn robust_rounds(runs: &mut Runs) -> Result<(Loss, f64, Option<Vec<f64>>)> {
     let settings = runs.settings;
     let make = |c: f64| match settings.objective {
         Objective::Robust(RobustLoss::Cauchy) => Loss::Cauchy { c },
@@ -144,24 +150,28 @@ fn robust_rounds(runs: &mut Runs) -> Result<(Loss, f64)> {
     };
     let problem = runs.problem;
     let rows = problem.kind().rows();
-    let scale_of = |r: &Robot| {
-        (sigmas * robust_sigma(&problem.fit_norms(r), rows)).max(SUM_OF_NORMS_SMOOTHING_MM)
-    };
+    let scale_of =
+        |norms: &[f64]| (sigmas * robust_sigma(norms, rows)).max(SUM_OF_NORMS_SMOOTHING_MM);
     let mut c = settings
         .robust_scale_mm
-        .unwrap_or_else(|| scale_of(&runs.robot));
+        .unwrap_or_else(|| scale_of(&problem.fit_norms(&runs.robot)));
     let mut loss = make(c);
+    // The fit's residual norms at the current model, once a run has been followed by them.
+    let mut norms = None;
     for _ in 0..rounds {
         loss = make(c);
         runs.run(loss)?;
+        norms = None;
         if settings.robust_scale_mm.is_some() || !runs.converged() {
             break;
         }
-        let c2 = scale_of(&runs.robot);
+        let at_model = problem.fit_norms(&runs.robot);
+        let c2 = scale_of(&at_model);
+        norms = Some(at_model);
         if (c2 - c).abs() <= settle * c {
             break;
         }
         c = c2;
     }
-    Ok((loss, c))
+    Ok((loss, c, norms))
 }
