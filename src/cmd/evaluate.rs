@@ -10,12 +10,14 @@ use super::common;
 use super::io_plan::{self, IoPlan};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
+use robocal_core::evaluation::gap::Repeatability;
 use robocal_core::evaluation::{Against, Evaluator, PerPointWriter, Reference};
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::measurements::read_measurements;
 use robocal_core::io::{
     CalibrationResult, Measurement, MeasurementReader, MeasurementSet, Positions,
 };
+use robocal_core::simulation::RepeatabilityModel;
 use robocal_core::{ErrorStats, Robot};
 
 use std::path::{Path, PathBuf};
@@ -281,14 +283,22 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     let means_without: Vec<f64> = sums_without.iter().map(|s| s / n.max(1) as f64).collect();
     let gap = if reference == Reference::Desired {
         let set = whole().with_context(context)?;
-        gap::split(
+        // The robot's repeatability: the RP given, else its class's default per joint.
+        let repeatability = match repeatability_mm {
+            Some(rp) => Repeatability::Rp(rp),
+            None => Repeatability::PerJoint {
+                std_deg: RepeatabilityModel::default_for(&nominal).std_deg,
+                source: "the class default".to_owned(),
+            },
+        };
+        robocal_core::evaluation::gap::split(
             &nominal,
             &cal,
             &res,
             &set,
             series[0].stats.rms_mm,
             refit_frame.then_some(&frame),
-            repeatability_mm,
+            repeatability,
         )?
     } else {
         None

@@ -13,7 +13,10 @@
 //!   `sum_j s_j^2 |J_j(q)|^2`, averaged over the poses. The calibration's residuals hold the
 //!   calibration session's own draw, so the prediction's noise already contains it.
 
+use crate::error::Result;
+use crate::evaluation::observations_of;
 use crate::frame::TrackerFrame;
+use crate::io::{CalibrationResult, MeasurementSet};
 use crate::model::{JointType, Robot};
 use crate::observations::Observations;
 use nalgebra::Vector3;
@@ -112,6 +115,110 @@ pub fn check_rp(rp_mm: f64) -> crate::error::Result<()> {
 /// `sqrt(3) RP / RP_PER_SIGMA`.
 pub fn rms_of_rp(rp_mm: f64) -> f64 {
     3.0_f64.sqrt() * rp_mm / RP_PER_SIGMA
+}
+
+/// The robot's repeatability, for [`split`].
+#[derive(Debug, Clone, PartialEq)]
+pub enum Repeatability {
+    /// An ISO 9283 pose repeatability RP (mm), given.
+    Rp(f64),
+    /// A standard deviation per joint and move (deg), and where it comes from (e.g. the
+    /// robot class's default, `simulation::RepeatabilityModel::default_for`).
+    PerJoint {
+        /// 1-sigma per joint (deg).
+        std_deg: Vec<f64>,
+        /// In words, for the report.
+        source: String,
+    },
+}
+
+/// The split of one verification.
+pub struct Gap {
+    /// RMS error norm measured (mm).
+    pub verified_rms_mm: f64,
+    /// RMS error norm the calibration predicted at new poses (mm).
+    pub predicted_rms_mm: f64,
+    /// The registration's share, when the frame was fitted to these data.
+    pub station: Option<StationShare>,
+    /// The repeatability's RMS displacement at these poses (mm), and where the figure comes
+    /// from.
+    pub repeatability_mm: f64,
+    /// Where the repeatability figure comes from (`RP .. mm, given`, the class default).
+    pub repeatability_source: String,
+    /// The prediction's noise as an RMS error norm (mm): `sqrt(3) sigma`.
+    pub predicted_noise_mm: f64,
+}
+
+impl Gap {
+    /// The gap in quadrature: `sqrt(max(0, verified^2 - predicted^2))` (mm).
+    pub fn total_mm(&self) -> f64 {
+        (self.verified_rms_mm.powi(2) - self.predicted_rms_mm.powi(2))
+            .max(0.0)
+            .sqrt()
+    }
+
+    /// What the station does not explain of the gap (mm, in quadrature).
+    pub fn left_mm(&self) -> f64 {
+        let s = self.station.map_or(0.0, |s| s.rms_mm);
+        (self.total_mm().powi(2) - s * s).max(0.0).sqrt()
+    }
+
+    /// The split as JSON.
+    pub fn json(&self) -> serde_json::Value {
+        serde_json::json!({
+            "verified_rms_mm": self.verified_rms_mm,
+            "predicted_rms_mm": self.predicted_rms_mm,
+            "gap_rms_mm": self.total_mm(),
+            "station": self.station.map(|s| serde_json::json!({
+                "points": s.points,
+                "residual_sigma_mm": s.residual_sigma_mm,
+                "rms_mm": s.rms_mm,
+            })),
+            "left_rms_mm": self.left_mm(),
+            "repeatability": {
+                "rms_mm": self.repeatability_mm,
+                "source": self.repeatability_source,
+                "predicted_noise_rms_mm": self.predicted_noise_mm,
+            },
+        })
+    }
+}
+
+/// The split of the verification `set` (RMS error norm `verified_rms_mm`) against `res`'s
+/// prediction; `frame`: the frame fitted to these data (a fresh station registered again), if
+/// any; `repeatability`: the robot's, given as an ISO 9283 RP or per joint. `None` when the
+/// result has no prediction.
+pub fn split(
+    nominal: &Robot,
+    calibrated: &Robot,
+    res: &CalibrationResult,
+    set: &MeasurementSet,
+    verified_rms_mm: f64,
+    frame: Option<&TrackerFrame>,
+    repeatability: Repeatability,
+) -> Result<Option<Gap>> {
+    let Some(p) = res.prediction.as_ref().filter(|p| p.rms_mm.is_finite()) else {
+        return Ok(None);
+    };
+    let station = match frame {
+        Some(f) => station_share(calibrated, f, &observations_of(set)?),
+        None => None,
+    };
+    let (repeatability_mm, repeatability_source) = match repeatability {
+        Repeatability::Rp(rp) => (rms_of_rp(rp), format!("RP {rp} mm, given")),
+        Repeatability::PerJoint { std_deg, source } => {
+            let qs = set.rows.iter().map(|r| r.q.as_slice());
+            (repeatability_rms(nominal, qs, &std_deg), source)
+        }
+    };
+    Ok(Some(Gap {
+        verified_rms_mm,
+        predicted_rms_mm: p.rms_mm,
+        station,
+        repeatability_mm,
+        repeatability_source,
+        predicted_noise_mm: 3.0_f64.sqrt() * p.noise_sigma_mm,
+    }))
 }
 
 #[cfg(test)]
