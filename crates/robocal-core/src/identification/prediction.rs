@@ -437,15 +437,25 @@ pub fn noise_sigma(
     threshold_mm: Option<f64>,
     leverage: &dyn Fn(&[usize]) -> Option<Vec<f64>>,
 ) -> f64 {
-    let kept: Vec<usize> = (0..norms.len())
-        .filter(|&i| threshold_mm.map_or(true, |t| norms[i] <= t))
-        .collect();
+    let kept = kept_points(norms, threshold_mm);
     let Some(h) = leverage(&kept) else {
         return f64::NAN;
     };
+    noise_from_leverages(norms, rows, &kept, &h)
+}
+
+/// The points [`noise_sigma`] keeps: those at or below `threshold_mm` (all when `None`).
+fn kept_points(norms: &[f64], threshold_mm: Option<f64>) -> Vec<usize> {
+    (0..norms.len())
+        .filter(|&i| threshold_mm.map_or(true, |t| norms[i] <= t))
+        .collect()
+}
+
+/// [`noise_sigma`] from the kept points' leverages `h` (in `kept` order).
+fn noise_from_leverages(norms: &[f64], rows: usize, kept: &[usize], h: &[f64]) -> f64 {
     let rows = rows as f64;
     let mut sum = 0.0;
-    for (&i, hi) in kept.iter().zip(&h) {
+    for (&i, hi) in kept.iter().zip(h) {
         let dof = rows - hi;
         if dof.is_nan() || dof <= 1e-6 {
             return f64::NAN;
@@ -455,65 +465,53 @@ pub fn noise_sigma(
     (sum / kept.len() as f64).sqrt()
 }
 
-/// The leverages `h_i = tr(J_i S^-1 J_i^T)` of points `kept` (each point's Jacobian block of
-/// `rows x k`, row-major, written by `jacobian(scratch, i, out)`), `S = sum J^T J` over them;
-/// `None` when `S` is singular. With `S = L L^T`, `h_i` is the squared norm of `L^-1 J_i^T`, by
-/// forward substitution row by row. The blocks are computed twice (for `S`, then for `h`)
-/// rather than stored: the memory stays flat however many points there are.
-fn leverages<S: Send>(
-    k: usize,
-    rows: usize,
-    kept: &[usize],
-    scratch: &(dyn Fn() -> S + Sync),
-    jacobian: &(dyn Fn(&mut S, usize, &mut [f64]) + Sync),
-) -> Option<Vec<f64>> {
-    // S in chunks (in parallel for many points, the same bits on any number of threads).
-    let (_, _, upper) = crate::identification::system::chunked(
-        kept.len(),
-        || (scratch(), vec![0.0; rows * k], vec![0.0; k * k]),
-        |(s, j, m), n| {
-            jacobian(s, kept[n], j);
-            add_gram(m, j, rows, k, 1.0);
-        },
-        |mut a, b| {
-            a.2.iter_mut().zip(&b.2).for_each(|(x, y)| *x += y);
-            a
-        },
-    );
-    // Parameters that do not move the points (a tool orientation identified from 6-DoF data)
-    // have no leverage on them: their rows and columns are left out of S.
-    let max_diag = (0..k).map(|a| upper[a * k + a]).fold(0.0, f64::max);
-    let cols: Vec<usize> = (0..k)
-        .filter(|&a| upper[a * k + a] > 1e-12 * max_diag)
-        .collect();
-    let m = cols.len();
-    let s = DMatrix::from_fn(m, m, |r, c| {
-        let (a, b) = (cols[r.min(c)], cols[r.max(c)]);
-        upper[a * k + b]
-    });
-    let l = s.cholesky()?.unpack();
-    let l: Vec<f64> = (0..m * m).map(|i| l[(i / m, i % m)]).collect();
-    let h = map_poses(
-        kept.len(),
-        || (scratch(), vec![0.0; rows * k], vec![0.0; rows * m]),
-        |(s, j, y), n| {
-            jacobian(s, kept[n], j);
-            // The rows' forward substitutions side by side (independent sums in flight).
-            let mut h = 0.0;
-            for a in 0..m {
-                let la = &l[a * m..a * m + a];
-                for r in 0..rows {
-                    let yr = &y[r * m..r * m + a];
-                    let dot: f64 = la.iter().zip(yr).map(|(u, v)| u * v).sum();
-                    let v = (j[r * k + cols[a]] - dot) / l[a * m + a];
-                    y[r * m + a] = v;
-                    h += v * v;
-                }
+/// The Cholesky factor of a Gram matrix `S = sum J^T J` over the columns that move the points.
+struct GramFactor {
+    /// The columns kept: parameters that do not move the points (a tool orientation identified
+    /// from 6-DoF data) have no leverage on them, and their rows and columns are left out of S.
+    cols: Vec<usize>,
+    /// `L` (lower, row-major, `m x m`), `S = L L^T` over `cols`.
+    l: Vec<f64>,
+    /// `cols.len()`.
+    m: usize,
+}
+
+impl GramFactor {
+    /// The factor of `S` given by its upper triangle (`k x k`, row-major); `None` when singular.
+    fn new(upper: &[f64], k: usize) -> Option<GramFactor> {
+        let max_diag = (0..k).map(|a| upper[a * k + a]).fold(0.0, f64::max);
+        let cols: Vec<usize> = (0..k)
+            .filter(|&a| upper[a * k + a] > 1e-12 * max_diag)
+            .collect();
+        let m = cols.len();
+        let s = DMatrix::from_fn(m, m, |r, c| {
+            let (a, b) = (cols[r.min(c)], cols[r.max(c)]);
+            upper[a * k + b]
+        });
+        let l = s.cholesky()?.unpack();
+        let l: Vec<f64> = (0..m * m).map(|i| l[(i / m, i % m)]).collect();
+        Some(GramFactor { cols, l, m })
+    }
+
+    /// The leverage `tr(J S^-1 J^T)` of the block `j` (`rows x k`, row-major); `y` is scratch of
+    /// `rows x m`.
+    #[inline(always)]
+    fn leverage(&self, j: &[f64], rows: usize, k: usize, y: &mut [f64]) -> f64 {
+        let (l, m) = (&self.l, self.m);
+        // The rows' forward substitutions side by side (independent sums in flight).
+        let mut h = 0.0;
+        for a in 0..m {
+            let la = &l[a * m..a * m + a];
+            for r in 0..rows {
+                let yr = &y[r * m..r * m + a];
+                let dot: f64 = la.iter().zip(yr).map(|(u, v)| u * v).sum();
+                let v = (j[r * k + self.cols[a]] - dot) / l[a * m + a];
+                y[r * m + a] = v;
+                h += v * v;
             }
-            h
-        },
-    );
-    Some(h)
+        }
+        h
+    }
 }
 
 /// The prediction of a calibrated model from its calibration points (see the module docs);
@@ -570,42 +568,61 @@ pub(crate) fn predict_with(
             },
         )
     };
+    // Two passes over the points, each computing every Jacobian it needs once (a Jacobian is
+    // most of a prediction's cost): the first sums `S = sum J^T J` over the points kept for the
+    // noise estimate and finds the lowest tool point (the map's floor); the second gives the
+    // kept points' leverages and the model parts `J C J^T` at the poses averaged over.
     // (The leverages come from the tool point's rows: exact for point measurements.)
-    let sigma = noise_sigma(residual_norms, rows, threshold_mm, &|kept| {
-        leverages(k, 3, kept, &|| pred.scratch(), &|s, i, out| {
-            jacobian(s, i, out);
-        })
-    });
+    let kept = kept_points(residual_norms, threshold_mm);
+    let mut is_kept = vec![false; n];
+    kept.iter().for_each(|&i| is_kept[i] = true);
+    let (_, _, upper, floor) = crate::identification::system::chunked(
+        n,
+        || {
+            (
+                pred.scratch(),
+                vec![0.0; rows * k],
+                vec![0.0; k * k],
+                f64::INFINITY,
+            )
+        },
+        |(s, j, m, lowest), i| {
+            let p = jacobian(s, i, j);
+            *lowest = lowest.min(p.z);
+            if is_kept[i] {
+                add_gram(m, j, rows, k, 1.0);
+            }
+        },
+        |mut a, b| {
+            a.2.iter_mut().zip(&b.2).for_each(|(x, y)| *x += y);
+            a.3 = a.3.min(b.3);
+            a
+        },
+    );
+    let g = GramFactor::new(&upper, k)?;
+    let picked = averaged_poses(n);
+    let mut is_picked = vec![false; n];
+    picked.iter().for_each(|&i| is_picked[i] = true);
+    let needed: Vec<usize> = (0..n).filter(|&i| is_kept[i] || is_picked[i]).collect();
+    let parts = map_poses(
+        needed.len(),
+        || (pred.scratch(), vec![0.0; rows * g.m]),
+        |(s, y), n| {
+            let i = needed[n];
+            let mut j = std::mem::take(&mut s.j);
+            jacobian(s, i, &mut j);
+            let h = is_kept[i].then(|| g.leverage(&j, rows, k, y));
+            let model = is_picked[i].then(|| pred.model_covariance(&j, &mut s.x));
+            s.j = j;
+            (h, model)
+        },
+    );
+    let h: Vec<f64> = parts.iter().filter_map(|p| p.0).collect();
+    let models: Vec<Matrix3<f64>> = parts.iter().filter_map(|p| p.1).collect();
+    let sigma = noise_from_leverages(residual_norms, rows, &kept, &h);
     if !sigma.is_finite() {
         return None;
     }
-    // The lowest tool point (the map's floor), and the model parts at the poses averaged over.
-    let floor = crate::identification::system::chunked(
-        n,
-        || f64::INFINITY,
-        |lowest, i| {
-            let c = calibration.conditions(i);
-            let p = calibrated.target_position_in(calibration.q(i), calibration.target(i), &c);
-            *lowest = lowest.min(p.z);
-        },
-        f64::min,
-    );
-    let picked = averaged_poses(n);
-    let models = map_poses(
-        picked.len(),
-        || pred.scratch(),
-        |s, i| {
-            let i = picked[i];
-            with_avx(
-                #[inline(always)]
-                || {
-                    let c = calibration.conditions(i);
-                    pred.model_at(s, calibration.q(i), calibration.target(i), &c)
-                        .1
-                },
-            )
-        },
-    );
     let pred = Predictor { sigma, ..pred };
     Some(pred.predict_from(&models, floor, map))
 }

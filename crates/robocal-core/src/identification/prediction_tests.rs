@@ -151,3 +151,106 @@ fn noise_sigma_counts_degrees_of_freedom_and_skips_outliers() {
     assert!(noise_sigma(&norms, 3, Some(10.0), &full).is_nan());
     assert!(noise_sigma(&norms, 3, Some(10.0), &|_| None).is_nan());
 }
+
+/// The prediction's two passes (the Gram matrix and floor, then the leverages and the model
+/// parts) give the noise and the mean of a direct computation: `S = sum J^T J` over the kept
+/// points, `h_i = tr(J_i S^-1 J_i^T)`, `sigma = sqrt(mean r_i^2 / (3 - h_i))`, and the mean of
+/// `E|e|` with `e ~ N(0, J C J^T + sigma^2 I)` over every pose (fewer than the thinning's
+/// bound). One residual above the threshold is left out of the noise, not of the mean.
+#[test]
+fn prediction_matches_a_direct_computation() {
+    use rand::Rng;
+    let robot = crate::model::presets::preset("kuka-kr480-r3330").unwrap();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let sampler = PoseSampler {
+        floor_z_mm: f64::NEG_INFINITY,
+        footprint_radius_mm: 0.0,
+        max_tries_per_pose: 1000,
+    };
+    // More poses than the parallel bound, so the passes' threads are exercised too.
+    let qs = random_poses(&robot, 300, &sampler, &mut rng).unwrap();
+    let mut obs = Observations::new(robot.dof());
+    for (i, q) in qs.iter().enumerate() {
+        obs.push(q, robot.tool_position(q), i + 2).unwrap();
+    }
+    // The parameters whose columns are independent over these poses (the first of each
+    // dependent group), as an identification would keep.
+    let all: Vec<usize> = (0..robot.param_count()).collect();
+    let mut jp = vec![Vector3::zeros(); robot.param_count()];
+    let mut jall = vec![0.0; 3 * all.len()];
+    let mut full = DMatrix::zeros(all.len(), all.len());
+    for q in &qs {
+        point_jacobian(&robot, &all, q, &mut jp, &mut jall);
+        let ji = DMatrix::from_row_slice(3, all.len(), &jall);
+        full += ji.transpose() * ji;
+    }
+    let mut index: Vec<usize> = Vec::new();
+    for a in all {
+        let mut trial = index.clone();
+        trial.push(a);
+        let g = DMatrix::from_fn(trial.len(), trial.len(), |r, c| {
+            full[(trial[r], trial[c])]
+                / (full[(trial[r], trial[r])] * full[(trial[c], trial[c])]).sqrt()
+        });
+        if full[(a, a)] > 0.0 && g.symmetric_eigenvalues().min() > 1e-9 {
+            index = trial;
+        }
+    }
+    let params: Vec<Param> = index.iter().map(|&i| robot.params()[i]).collect();
+    let k = params.len();
+    assert!(k >= 20, "{k} independent parameters");
+    let a = DMatrix::from_fn(k, k, |_, _| rng.gen_range(-1e-3..1e-3));
+    let c = &a * a.transpose() + DMatrix::identity(k, k) * 1e-8;
+    let cov = Covariance {
+        params: params.clone(),
+        matrix: c.clone(),
+        sigma_mm: 0.02,
+        unavailable: None,
+    };
+    let mut norms: Vec<f64> = (0..qs.len()).map(|_| rng.gen_range(0.005..0.05)).collect();
+    norms[17] = 5.0;
+    let threshold = Some(0.5);
+    let p = predict(&robot, &cov, &obs, &norms, threshold).expect("a prediction");
+
+    let mut j = vec![0.0; 3 * k];
+    let jac = |q: &[f64], jp: &mut [Vector3<f64>], j: &mut [f64]| {
+        point_jacobian(&robot, &index, q, jp, j);
+        DMatrix::from_row_slice(3, k, j)
+    };
+    let kept: Vec<usize> = (0..qs.len()).filter(|&i| norms[i] <= 0.5).collect();
+    let mut s = DMatrix::zeros(k, k);
+    for &i in &kept {
+        let ji = jac(&qs[i], &mut jp, &mut j);
+        s += ji.transpose() * &ji;
+    }
+    let s_inv = s.try_inverse().unwrap();
+    let mut sum = 0.0;
+    for &i in &kept {
+        let ji = jac(&qs[i], &mut jp, &mut j);
+        let h = (&ji * &s_inv * ji.transpose()).trace();
+        sum += norms[i] * norms[i] / (3.0 - h);
+    }
+    let sigma = (sum / kept.len() as f64).sqrt();
+    assert!(
+        (p.noise_sigma_mm / sigma - 1.0).abs() < 1e-9,
+        "{} vs {sigma}",
+        p.noise_sigma_mm
+    );
+    let ne = NormExpectation::new();
+    let mean = qs
+        .iter()
+        .map(|q| {
+            let ji = jac(q, &mut jp, &mut j);
+            let m = &ji * &c * ji.transpose();
+            let m = Matrix3::from_fn(|r, cc| m[(r, cc)]);
+            ne.mean_norm(&(m + Matrix3::identity() * sigma * sigma))
+        })
+        .sum::<f64>()
+        / qs.len() as f64;
+    assert!(
+        (p.mean_mm / mean - 1.0).abs() < 1e-9,
+        "{} vs {mean}",
+        p.mean_mm
+    );
+    assert_eq!(p.map.len(), MAP_POSES);
+}
