@@ -258,12 +258,26 @@ pub(super) fn print_report(
     }
     outln!()?;
     let s = c.solver();
+    let whole = c.whole_solve();
+    let warm = c
+        .stages
+        .iter()
+        .filter_map(|s| s.points.map(|p| (p, s.report.iterations)))
+        .fold(None, |acc: Option<(usize, usize)>, (p, it)| {
+            Some((p, acc.map_or(0, |a| a.1) + it))
+        });
+    let warm = warm.map_or(String::new(), |(points, iterations)| {
+        format!(
+            " ({iterations} of them on an even {points} of the {} points, to start)",
+            c.calibration.after.len()
+        )
+    });
     outln!(
-        "solver ({}): {} after {} iteration(s); objective {:.6} -> {:.6}",
+        "solver ({}): {} after {} iteration(s){warm}; objective {:.6} -> {:.6}",
         c.settings.objective.name(),
         s.termination.describe(),
-        c.stages.iter().map(|s| s.report.iterations).sum::<usize>(),
-        c.stages[0].report.initial_objective,
+        whole.iterations,
+        whole.initial_objective,
         s.final_objective
     )?;
     if let Some(scale) = c.robust_scale_mm {

@@ -465,13 +465,19 @@ fn noise_from_leverages(norms: &[f64], rows: usize, kept: &[usize], h: &[f64]) -
     (sum / kept.len() as f64).sqrt()
 }
 
-/// The Cholesky factor of a Gram matrix `S = sum J^T J` over the columns that move the points.
+/// A Gram matrix `S = sum J^T J` ready for leverages `tr(J S^-1 J^T)`: over the columns that move
+/// the points, scaled to a unit diagonal (the leverage does not change, the factor's condition
+/// does), `S = D L L^T D`, with `L^-1` explicit so that each point's leverage is the squared norm
+/// of `L^-1 D^-1 J^T`, a product of contiguous rows (vectorized) rather than a forward
+/// substitution (a chain of dependent divisions).
 struct GramFactor {
     /// The columns kept: parameters that do not move the points (a tool orientation identified
     /// from 6-DoF data) have no leverage on them, and their rows and columns are left out of S.
     cols: Vec<usize>,
-    /// `L` (lower, row-major, `m x m`), `S = L L^T` over `cols`.
-    l: Vec<f64>,
+    /// `1 / sqrt(S_aa)` of the kept columns.
+    scale: Vec<f64>,
+    /// `L^-1` (lower, row-major, `m x m`).
+    linv: Vec<f64>,
     /// `cols.len()`.
     m: usize,
 }
@@ -484,34 +490,60 @@ impl GramFactor {
             .filter(|&a| upper[a * k + a] > 1e-12 * max_diag)
             .collect();
         let m = cols.len();
+        let scale: Vec<f64> = cols
+            .iter()
+            .map(|&a| 1.0 / upper[a * k + a].sqrt())
+            .collect();
         let s = DMatrix::from_fn(m, m, |r, c| {
             let (a, b) = (cols[r.min(c)], cols[r.max(c)]);
-            upper[a * k + b]
+            upper[a * k + b] * scale[r] * scale[c]
         });
         let l = s.cholesky()?.unpack();
-        let l: Vec<f64> = (0..m * m).map(|i| l[(i / m, i % m)]).collect();
-        Some(GramFactor { cols, l, m })
+        let linv = l.solve_lower_triangular(&DMatrix::identity(m, m))?;
+        let linv: Vec<f64> = (0..m * m).map(|i| linv[(i / m, i % m)]).collect();
+        Some(GramFactor {
+            cols,
+            scale,
+            linv,
+            m,
+        })
     }
 
     /// The leverage `tr(J S^-1 J^T)` of the block `j` (`rows x k`, row-major); `y` is scratch of
     /// `rows x m`.
     #[inline(always)]
     fn leverage(&self, j: &[f64], rows: usize, k: usize, y: &mut [f64]) -> f64 {
-        let (l, m) = (&self.l, self.m);
-        // The rows' forward substitutions side by side (independent sums in flight).
+        let m = self.m;
+        for r in 0..rows {
+            for (a, (&c, &d)) in self.cols.iter().zip(&self.scale).enumerate() {
+                y[r * m + a] = j[r * k + c] * d;
+            }
+        }
         let mut h = 0.0;
         for a in 0..m {
-            let la = &l[a * m..a * m + a];
+            let la = &self.linv[a * m..a * m + a + 1];
             for r in 0..rows {
-                let yr = &y[r * m..r * m + a];
-                let dot: f64 = la.iter().zip(yr).map(|(u, v)| u * v).sum();
-                let v = (j[r * k + self.cols[a]] - dot) / l[a * m + a];
-                y[r * m + a] = v;
+                let v = dot(la, &y[r * m..r * m + a + 1]);
                 h += v * v;
             }
         }
         h
     }
+}
+
+/// `a . b` with four sums in flight (the compiler keeps a plain sum's order, so one chain).
+#[inline(always)]
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 4];
+    let (a4, b4) = (a.chunks_exact(4), b.chunks_exact(4));
+    let (ra, rb) = (a4.remainder(), b4.remainder());
+    for (x, y) in a4.zip(b4) {
+        for t in 0..4 {
+            acc[t] += x[t] * y[t];
+        }
+    }
+    let tail: f64 = ra.iter().zip(rb).map(|(x, y)| x * y).sum();
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// The prediction of a calibrated model from its calibration points (see the module docs);
@@ -603,22 +635,38 @@ pub(crate) fn predict_with(
     let picked = averaged_poses(n);
     let mut is_picked = vec![false; n];
     picked.iter().for_each(|&i| is_picked[i] = true);
-    let needed: Vec<usize> = (0..n).filter(|&i| is_kept[i] || is_picked[i]).collect();
-    let parts = map_poses(
-        needed.len(),
-        || (pred.scratch(), vec![0.0; rows * g.m]),
-        |(s, y), n| {
-            let i = needed[n];
+    // In chunks (the same bits on any number of threads), each chunk's leverages and model parts
+    // appended in order: nothing is held per point but the leverage.
+    let (_, _, h, models) = crate::identification::system::chunked(
+        n,
+        || {
+            (
+                pred.scratch(),
+                vec![0.0; rows * g.m],
+                Vec::new(),
+                Vec::new(),
+            )
+        },
+        |(s, y, h, models), i| {
+            if !(is_kept[i] || is_picked[i]) {
+                return;
+            }
             let mut j = std::mem::take(&mut s.j);
             jacobian(s, i, &mut j);
-            let h = is_kept[i].then(|| g.leverage(&j, rows, k, y));
-            let model = is_picked[i].then(|| pred.model_covariance(&j, &mut s.x));
+            if is_kept[i] {
+                h.push(g.leverage(&j, rows, k, y));
+            }
+            if is_picked[i] {
+                models.push(pred.model_covariance(&j, &mut s.x));
+            }
             s.j = j;
-            (h, model)
+        },
+        |mut a, b| {
+            a.2.extend(b.2);
+            a.3.extend(b.3);
+            a
         },
     );
-    let h: Vec<f64> = parts.iter().filter_map(|p| p.0).collect();
-    let models: Vec<Matrix3<f64>> = parts.iter().filter_map(|p| p.1).collect();
     let sigma = noise_from_leverages(residual_norms, rows, &kept, &h);
     if !sigma.is_finite() {
         return None;

@@ -204,6 +204,7 @@ impl Calibration {
                     final_objective: r.final_objective,
                     final_gradient: r.final_gradient,
                     last_step_mm: r.last_step_mm,
+                    points: s.points,
                 }
             })
             .collect();

@@ -307,6 +307,29 @@ impl<'a> Problem<'a> {
         self.obs.len()
     }
 
+    /// The observations.
+    pub(crate) fn observations(&self) -> &'a Observations {
+        self.obs
+    }
+
+    /// This problem on `sub`, the observations `kept` of this problem's (ascending): the same
+    /// parameters, kind and targets.
+    pub(crate) fn restricted<'b>(&self, sub: &'b Observations, kept: &[usize]) -> Problem<'b> {
+        let tl = self.kind.target_len();
+        let mut targets = Vec::with_capacity(tl * kept.len());
+        for &i in kept {
+            targets.extend_from_slice(&self.targets[tl * i..tl * (i + 1)]);
+        }
+        Problem {
+            params: self.params.clone(),
+            index: self.index.clone(),
+            obs: sub,
+            kind: self.kind,
+            targets,
+            angular: self.angular,
+        }
+    }
+
     /// Whether there are no observations.
     pub fn is_empty(&self) -> bool {
         self.obs.is_empty()

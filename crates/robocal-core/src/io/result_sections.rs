@@ -402,6 +402,10 @@ pub struct StageEntry {
     /// Last step (mm).
     #[serde(deserialize_with = "nullable::f64")]
     pub last_step_mm: f64,
+    /// The points the stage used when fewer than all (a large set's warm start on an even
+    /// subsample); absent: every point.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<usize>,
 }
 
 /// `solver`: how the identification ended.

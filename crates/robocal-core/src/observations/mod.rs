@@ -109,29 +109,30 @@ impl Observations {
     /// Adds a point: joint values (rad), measured position (mm, tracker frame), CSV line (0 when
     /// the point does not come from a file). Rejects a wrong joint count and non-finite values.
     pub fn push(&mut self, q: &[f64], m: Vector3<f64>, line: usize) -> Result<()> {
-        let at = self.describe(line);
+        // Named only when a check fails (a million rows' names are a million allocations).
+        let at = || self.describe(line);
         if q.len() != self.dof {
             return Err(Error::JointCount {
-                context: at,
+                context: at(),
                 expected: self.dof,
                 got: q.len(),
             });
         }
         if let Some(i) = q.iter().position(|v| !v.is_finite()) {
             return Err(Error::invalid(
-                format!("{at}: q{}", i + 1),
+                format!("{}: q{}", at(), i + 1),
                 "not a finite number",
             ));
         }
         if let Some(k) = m.iter().position(|v| !v.is_finite()) {
             return Err(Error::invalid(
-                format!("{at}: {}", ["x", "y", "z"][k]),
+                format!("{}: {}", at(), ["x", "y", "z"][k]),
                 "not a finite number",
             ));
         }
         if let Some(k) = m.iter().position(|v| v.abs() > MAX_COORDINATE_MM) {
             return Err(Error::invalid(
-                format!("{at}: {}", ["x", "y", "z"][k]),
+                format!("{}: {}", at(), ["x", "y", "z"][k]),
                 format!(
                     "{:.3e} mm is not a plausible tracker reading (more than {} km away)",
                     m[k],
@@ -166,30 +167,30 @@ impl Observations {
         extras: RowExtras,
         line: usize,
     ) -> Result<()> {
-        let at = self.describe(line);
+        let at = || self.describe(line);
         let first = self.is_empty();
         if extras.target >= MAX_TARGETS {
             return Err(Error::invalid(
-                format!("{at}: target"),
+                format!("{}: target", at()),
                 format!("{} is more targets than {MAX_TARGETS}", extras.target + 1),
             ));
         }
         if !first && extras.rotation.is_some() != self.rotation.is_some() {
             return Err(Error::invalid(
-                format!("{at}: a"),
+                format!("{}: a", at()),
                 "every row of a set is a 6-DoF measurement (a,b,c) or none is",
             ));
         }
         if !first && extras.sigma_mm.is_some() != self.sigma.is_some() {
             return Err(Error::invalid(
-                format!("{at}: sigma_mm"),
+                format!("{}: sigma_mm", at()),
                 "every row of a set has an uncertainty or none has",
             ));
         }
         if let Some(s) = extras.sigma_mm {
             if !(s > 0.0 && s.is_finite()) {
                 return Err(Error::invalid(
-                    format!("{at}: sigma_mm"),
+                    format!("{}: sigma_mm", at()),
                     format!("{s} is not a positive length (mm)"),
                 ));
             }
@@ -199,7 +200,7 @@ impl Observations {
                 && (r.determinant() - 1.0).abs() < 1e-6;
             if !orthonormal {
                 return Err(Error::invalid(
-                    format!("{at}: a"),
+                    format!("{}: a", at()),
                     "the orientation is not a rotation",
                 ));
             }

@@ -80,7 +80,12 @@ pub struct Stage {
     pub loss: Loss,
     /// What the solver did.
     pub report: SolverReport,
+    /// The points the run used when fewer than all: a large set's solve starts on an even
+    /// subsample of this many ([`WARM_START_MIN_POINTS`]); `None`: every point.
+    pub points: Option<usize>,
 }
+
+pub use stages::{WARM_START_MIN_POINTS, WARM_START_POINTS};
 
 /// The outcome of [`calibrate_model`].
 #[derive(Debug, Clone)]
@@ -329,7 +334,14 @@ pub fn whole_solve(stages: &[Stage]) -> SolverReport {
         termination: last.termination.clone(),
         iterations: stages.iter().map(|s| s.report.iterations).sum(),
         evaluations: stages.iter().map(|s| s.report.evaluations).sum(),
-        initial_objective: stages[0].report.initial_objective,
+        // The objective at the start of the first run on every point (a warm start's runs on a
+        // subsample have an objective of their own).
+        initial_objective: stages
+            .iter()
+            .find(|s| s.points.is_none())
+            .unwrap_or(&stages[0])
+            .report
+            .initial_objective,
         ..last.clone()
     }
 }

@@ -1,6 +1,12 @@
 //! The pipeline's fourth step: the identification itself (paper, eq. 4), as one or more solver
 //! runs ([`Stage`]s): a robust or adaptive objective starts from a least-squares fit and
 //! re-estimates its scale from the residuals until it settles.
+//!
+//! A large set (from [`WARM_START_MIN_POINTS`] points) starts on an even subsample of about
+//! [`WARM_START_POINTS`]: the same runs there reach a model within the subsample's noise of the
+//! minimum, from which the runs on every point need an iteration or two instead of the whole
+//! way (each iteration a pass over a million points). The minimum is the same: the last runs
+//! are on every point, to the solver's own tolerance.
 
 use super::{CalibrationSettings, Stage};
 use crate::error::{Error, Result};
@@ -32,6 +38,14 @@ pub(super) struct Solved {
     pub final_norms: Option<Vec<f64>>,
 }
 
+/// From this many points, the solve starts on an even subsample (see the module docs).
+pub const WARM_START_MIN_POINTS: usize = 100_000;
+
+/// About this many points make the subsample of a warm start: enough that its minimum is within
+/// a fraction of the noise of the whole set's, few enough that its runs cost a few passes over
+/// the whole set.
+pub const WARM_START_POINTS: usize = 25_000;
+
 /// The solver runs of one identification, with the iteration limit shared by all.
 struct Runs<'p, 'a> {
     problem: &'p Problem<'a>,
@@ -62,7 +76,11 @@ impl Runs<'_, '_> {
                 report.iterations
             )));
         }
-        self.stages.push(Stage { loss, report });
+        self.stages.push(Stage {
+            loss,
+            report,
+            points: None,
+        });
         Ok(())
     }
 
@@ -78,6 +96,7 @@ impl Runs<'_, '_> {
 
 /// Identifies the parameters of `problem` from `start` with the settings' objective. `tools_fit`:
 /// whether the start model fits the data (the tools fitted to the nominal geometry were applied).
+/// A large problem starts on a subsample (see the module docs).
 pub(super) fn solve_stages(
     problem: &Problem,
     start: &Robot,
@@ -85,12 +104,54 @@ pub(super) fn solve_stages(
     settings: &CalibrationSettings,
     observer: &dyn Observer,
 ) -> Result<Solved> {
+    let n = problem.len();
+    if n >= WARM_START_MIN_POINTS {
+        let step = n.div_ceil(WARM_START_POINTS);
+        let kept: Vec<usize> = (0..n).step_by(step).collect();
+        let sub_obs =
+            crate::identification::cross_validation::subset(problem.observations(), |i| {
+                i % step == 0
+            })?;
+        let sub = problem.restricted(&sub_obs, &kept);
+        let warm = solve_from(&sub, start, tools_fit, settings, observer, None)?;
+        if warm
+            .stages
+            .last()
+            .is_some_and(|s| s.report.termination.converged())
+        {
+            let mut stages = warm.stages;
+            stages.iter_mut().for_each(|s| s.points = Some(kept.len()));
+            return solve_from(
+                problem,
+                &warm.robot,
+                tools_fit,
+                settings,
+                observer,
+                Some(stages),
+            );
+        }
+        // A subsample that does not converge says nothing of the whole: the whole way then.
+    }
+    solve_from(problem, start, tools_fit, settings, observer, None)
+}
+
+/// The runs of [`solve_stages`] from `start`; after a warm start (its runs `warm`), the
+/// objective's last runs only: the model is already near the starting fit's minimum.
+fn solve_from(
+    problem: &Problem,
+    start: &Robot,
+    tools_fit: bool,
+    settings: &CalibrationSettings,
+    observer: &dyn Observer,
+    warm: Option<Vec<Stage>>,
+) -> Result<Solved> {
+    let warm_started = warm.is_some();
     let mut runs = Runs {
         problem,
         settings,
         observer,
         robot: start.clone(),
-        stages: Vec::new(),
+        stages: warm.unwrap_or_default(),
         final_pass: None,
     };
     let son = Loss::SumOfNorms {
@@ -111,9 +172,11 @@ pub(super) fn solve_stages(
             // iterations, and the scale comes from the median residual, which gross outliers
             // do not move. Where the nominal geometry misses the data (the tool fit not
             // applied: another robot, wrong units) the sum of norms, which huge residuals do
-            // not dominate, finds the way.
+            // not dominate, finds the way. After a warm start the model is past that.
             let start_loss = if tools_fit { Loss::Squared } else { son };
-            runs.run(start_loss)?;
+            if !warm_started {
+                runs.run(start_loss)?;
+            }
             if runs.converged() {
                 let (loss, c, norms) = robust_rounds(&mut runs)?;
                 final_norms = norms;
