@@ -36,7 +36,17 @@ pub struct SolverOptions {
     pub objective_tolerance: f64,
     /// Initial damping, relative to `diag(A)`.
     pub initial_lambda: f64,
+    /// From this many observations, a calibration's solve starts on an even subsample of them
+    /// (see [`crate::identification::pipeline`]'s stages); `usize::MAX`: never.
+    pub warm_start_min_points: usize,
+    /// About this many observations make that subsample (at least
+    /// [`MIN_WARM_START_POINTS`]).
+    pub warm_start_points: usize,
 }
+
+/// The smallest warm-start subsample accepted: fewer points would leave its minimum too far
+/// from the whole set's for the last runs to be short.
+pub const MIN_WARM_START_POINTS: usize = 1_000;
 
 impl Default for SolverOptions {
     fn default() -> Self {
@@ -46,6 +56,8 @@ impl Default for SolverOptions {
             gradient_tolerance: 1e-10,
             objective_tolerance: 1e-9,
             initial_lambda: 1e-3,
+            warm_start_min_points: crate::identification::pipeline::WARM_START_MIN_POINTS,
+            warm_start_points: crate::identification::pipeline::WARM_START_POINTS,
         }
     }
 }

@@ -43,6 +43,21 @@ pub(super) fn check(
 
 /// The settings' own checks (independent of the data).
 fn check_settings(settings: &CalibrationSettings) -> Result<()> {
+    let solver = &settings.solver;
+    if solver.warm_start_points < crate::identification::solver::MIN_WARM_START_POINTS
+        || solver.warm_start_points >= solver.warm_start_min_points
+    {
+        return Err(Error::invalid(
+            "solver.warm_start_points",
+            format!(
+                "{} is not within [{}, solver.warm_start_min_points = {}): the subsample a \
+                 large set's solve starts on",
+                solver.warm_start_points,
+                crate::identification::solver::MIN_WARM_START_POINTS,
+                solver.warm_start_min_points
+            ),
+        ));
+    }
     let idopts = &settings.identifiability;
     if let Some(p) = idopts.fix.iter().find(|p| idopts.free.contains(p)) {
         return Err(Error::invalid(

@@ -2,8 +2,8 @@
 //! runs ([`Stage`]s): a robust or adaptive objective starts from a least-squares fit and
 //! re-estimates its scale from the residuals until it settles.
 //!
-//! A large set (from [`WARM_START_MIN_POINTS`] points) starts on an even subsample of about
-//! [`WARM_START_POINTS`]: the same runs there reach a model within the subsample's noise of the
+//! A large set (from [`WARM_START_MIN_POINTS`] points, [`SolverOptions::warm_start_min_points`])
+//! starts on an even subsample of about [`WARM_START_POINTS`]: the same runs there reach a model within the subsample's noise of the
 //! minimum, from which the runs on every point need an iteration or two instead of the whole
 //! way (each iteration a pass over a million points). The minimum is the same: the last runs
 //! are on every point, to the solver's own tolerance.
@@ -105,8 +105,8 @@ pub(super) fn solve_stages(
     observer: &dyn Observer,
 ) -> Result<Solved> {
     let n = problem.len();
-    if n >= WARM_START_MIN_POINTS {
-        let step = n.div_ceil(WARM_START_POINTS);
+    if n >= settings.solver.warm_start_min_points {
+        let step = n.div_ceil(settings.solver.warm_start_points);
         let kept: Vec<usize> = (0..n).step_by(step).collect();
         let sub_obs =
             crate::identification::cross_validation::subset(problem.observations(), |i| {
@@ -238,3 +238,7 @@ fn robust_rounds(runs: &mut Runs) -> Result<(Loss, f64, Option<Vec<f64>>)> {
     }
     Ok((loss, c, norms))
 }
+
+#[cfg(test)]
+#[path = "stages_tests.rs"]
+mod tests;
