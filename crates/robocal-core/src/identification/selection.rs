@@ -33,8 +33,9 @@ use crate::identification::cross_validation::{cross_validate, CrossValidation};
 pub use crate::identification::model_choice::{
     AutoFamilies, Candidate, ModelChoice, ModelSelection,
 };
+use crate::identification::pipeline::start::same_tool_points;
 use crate::identification::pipeline::{
-    calibrate_model, calibrate_model_for, complete, Calibration, CalibrationData,
+    calibrate_model, calibrate_model_for, complete, register_for, Calibration, CalibrationData,
     CalibrationSettings, Purpose,
 };
 use crate::model::family::{backlash, compliance, thermal, transmission};
@@ -213,8 +214,13 @@ fn select_fitted(
         validation: None,
         ..data
     };
+    let given = Families::default().robot(nominal, reference_c)?;
+    // The candidates are the robot as given with families at zero: the same tool points, so
+    // the same frame and tools, registered once (checked point by point, else their own).
+    let registered = register_for(&given, data, &fit_settings)?;
     let fit = |robot: &Robot, reference: bool| -> (Candidate, Option<Calibration>) {
-        match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &()) {
+        let shared = same_tool_points(robot, &given, data.calibration).then_some(&registered);
+        match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &(), shared) {
             Err(e) => {
                 let mut cand = Candidate::new(robot, reference);
                 cand.rejected = Some(format!("the fit failed: {e}"));
@@ -224,16 +230,22 @@ fn select_fitted(
         }
     };
     let compliant = !compliance::auto_joints(nominal).is_empty();
-    let given = Families::default().robot(nominal, reference_c)?;
     // The robot as given is part of every candidate: its fit failing is the calibration's.
     let (c0, f0) = assess(
         &given,
         false,
-        calibrate_model_for(&given, data, &fit_settings, Purpose::Candidate, &())?,
+        calibrate_model_for(
+            &given,
+            data,
+            &fit_settings,
+            Purpose::Candidate,
+            &(),
+            Some(&registered),
+        )?,
         data,
     );
     let mut sets = vec![Families::default()];
-    let mut robots = vec![given];
+    let mut robots = vec![given.clone()];
     let mut candidates = vec![c0];
     let mut fits = vec![f0];
     // Forward search: from the robot as given, each round fits every set with one family more

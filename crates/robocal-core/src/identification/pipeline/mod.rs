@@ -17,7 +17,7 @@ mod identify;
 mod inputs;
 mod outcome;
 mod stages;
-mod start;
+pub(crate) mod start;
 
 use crate::error::{Error, Result};
 use crate::identification::bounds;
@@ -177,7 +177,7 @@ pub fn calibrate_model(
     settings: &CalibrationSettings,
     observer: &dyn Observer,
 ) -> Result<Calibration> {
-    calibrate_model_for(nominal, data, settings, Purpose::Result, observer)
+    calibrate_model_for(nominal, data, settings, Purpose::Result, observer, None)
 }
 
 /// What a calibration is for.
@@ -199,15 +199,38 @@ pub(super) struct Job<'a> {
     observer: &'a dyn Observer,
 }
 
-/// [`calibrate_model`] for a `purpose`.
+/// The frame and tools registered to `nominal` for a calibration of `data` (the inputs checked
+/// first), to share among models with its tool points ([`calibrate_model_for`]).
+pub(crate) fn register_for(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+) -> Result<start::Registered> {
+    inputs::check(nominal, &data, settings)?;
+    start::register_nominal(nominal, &data, settings, &())
+}
+
+/// [`calibrate_model`] for a `purpose`; `shared`: the frame and tools registered to a model
+/// with the same tool points as `nominal` at the start (see [`start::same_tool_points`]), not
+/// registered again.
 pub(crate) fn calibrate_model_for(
     nominal: &Robot,
     data: CalibrationData,
     settings: &CalibrationSettings,
     purpose: Purpose,
     observer: &dyn Observer,
+    shared: Option<&start::Registered>,
 ) -> Result<Calibration> {
-    let first = calibrate_once(nominal, data, settings, purpose, observer)?;
+    inputs::check(nominal, &data, settings)?;
+    let own;
+    let registered = match shared {
+        Some(r) => r,
+        None => {
+            own = start::register_nominal(nominal, &data, settings, observer)?;
+            &own
+        }
+    };
+    let first = calibrate_once(nominal, data, settings, purpose, observer, registered)?;
     let start = if first.tool_fit.applied {
         first.tool_fit.apply(nominal)
     } else {
@@ -222,7 +245,7 @@ pub(crate) fn calibrate_model_for(
         .identifiability
         .fix
         .extend(held.iter().map(|h| h.param));
-    let mut c = calibrate_once(nominal, data, &again, purpose, observer)?;
+    let mut c = calibrate_once(nominal, data, &again, purpose, observer, registered)?;
     for f in &mut c.identifiability.fixed {
         if let Some(h) = held.iter().find(|h| h.param == f.param) {
             f.reason = FixReason::AtBound {
@@ -236,16 +259,17 @@ pub(crate) fn calibrate_model_for(
     Ok(c)
 }
 
-/// One calibration of the model as given: its steps, each a function of its own.
+/// One calibration of the model as given, from the frame and tools `registered`: its steps,
+/// each a function of its own.
 fn calibrate_once(
     nominal: &Robot,
     data: CalibrationData,
     settings: &CalibrationSettings,
     purpose: Purpose,
     observer: &dyn Observer,
+    registered: &start::Registered,
 ) -> Result<Calibration> {
-    inputs::check(nominal, &data, settings)?;
-    let start = start::prepare(nominal, &data, settings, observer)?;
+    let start = start::prepare(nominal, &data, settings, registered)?;
     let identified = identify::identifiable(nominal, &start, &settings.identifiability, observer)?;
     let solved = {
         let problem = Problem::new(

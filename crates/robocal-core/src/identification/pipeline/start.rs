@@ -31,13 +31,24 @@ pub(super) struct StartModel {
     pub frame: TrackerFrame,
 }
 
-/// Registers the measurement frame to `nominal`, fits the tools, resolves the weights.
-pub(super) fn prepare(
+/// The measurement frame registered to the nominal model and the tools fitted to it: what
+/// every model the calibration compares shares when they have the same tool points at the
+/// start (the candidates of a model selection: the nominal with families at zero).
+#[derive(Debug, Clone)]
+pub(crate) struct Registered {
+    /// The fitted measurement frame and Table II.
+    pub registration: Registration,
+    /// The tools fitted to the nominal geometry (applied or not).
+    pub tool_fit: ToolFit,
+}
+
+/// Registers the measurement frame to `nominal` and fits the tools.
+pub(crate) fn register_nominal(
     nominal: &Robot,
     data: &CalibrationData,
     settings: &CalibrationSettings,
     observer: &dyn Observer,
-) -> Result<StartModel> {
+) -> Result<Registered> {
     let cal = data.calibration;
     observer.progress(progress::Stage::Registration, 0, 1);
     let reg_opts = RegistrationOptions {
@@ -56,6 +67,36 @@ pub(super) fn prepare(
     tool_fit.applied = tool_fit.converged
         && tool_fit.stats.rms_mm
             <= plausibility::NOMINAL_ERROR_LIMIT * plausibility::reach_mm(nominal);
+    Ok(Registered {
+        registration,
+        tool_fit,
+    })
+}
+
+/// Whether `a` and `b` put the tool points of `obs` at the same places (bit for bit): then
+/// they share a [`Registered`].
+pub(crate) fn same_tool_points(a: &Robot, b: &Robot, obs: &Observations) -> bool {
+    a.target_count() == b.target_count()
+        && (0..obs.len()).all(|i| {
+            let c = obs.conditions(i);
+            let (q, t) = (obs.q(i), obs.target(i));
+            a.target_position_in(q, t, &c) == b.target_position_in(q, t, &c)
+        })
+}
+
+/// The model the identification starts from: `registered` (the frame and tools fitted to
+/// `nominal`, or to a model with the same tool points), the weights resolved.
+pub(super) fn prepare(
+    nominal: &Robot,
+    data: &CalibrationData,
+    settings: &CalibrationSettings,
+    registered: &Registered,
+) -> Result<StartModel> {
+    let cal = data.calibration;
+    let Registered {
+        registration,
+        tool_fit,
+    } = registered.clone();
     // The weights, from here on: the registration and the tool fit weight no point, and the
     // automatic tracker model needs what they tell (where the tracker stands, whether the
     // nominal model fits the data at all).
