@@ -237,3 +237,76 @@ fn families_without_their_columns_are_refused() {
         assert!(!out.exists());
     }
 }
+
+#[test]
+fn a_sagging_robot_gets_compliance_by_default() {
+    // simulate --constraint with gravity in the truth (joints 2 and 3 compliant, the paper's
+    // masses and payload), then the default calibrate.
+    let dir = Dir::new();
+    let data = dir.join("sag.csv");
+    let dist = dir.join("d.csv");
+    ok(&[
+        "simulate",
+        "--robot",
+        KR,
+        "--truth",
+        "random",
+        "--constraint",
+        "point",
+        "--noise-mm",
+        "0.01",
+        "--compliance",
+        "0,2e-8,2e-8,0,0,0",
+        "--link-masses-kg",
+        "900,500,400,150,60,20",
+        "--payload-kg",
+        "300",
+        "--out",
+        p(&data),
+        "--distances-out",
+        p(&dist),
+    ]);
+    let truth = read_json(&dir.join("sag.truth.json"));
+    assert_eq!(truth["settings"]["gravity"]["payload_kg"], 300.0, "{truth}");
+    let out = dir.join("r.json");
+    let o = ok(&[
+        "calibrate",
+        "--robot",
+        KR,
+        "--data",
+        p(&data),
+        "--distances",
+        p(&dist),
+        "--out",
+        p(&out),
+    ]);
+    assert!(
+        o.stdout().contains("model: geometric + compliance"),
+        "{}",
+        o.stdout()
+    );
+    let r = read_json(&out);
+    let chosen: Vec<&serde_json::Value> = r["model_selection"]["candidates"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["chosen"] == true)
+        .collect();
+    assert_eq!(chosen[0]["families"], serde_json::json!(["compliance"]));
+    // Gravity without a mass is refused, as in the tracker mode.
+    let o = robocal(&[
+        "simulate",
+        "--robot",
+        KR,
+        "--truth",
+        "random",
+        "--constraint",
+        "point",
+        "--compliance",
+        "1e-8",
+        "--out",
+        p(&dir.join("x.csv")),
+    ]);
+    o.assert_code(2);
+    assert!(!dir.join("x.csv").exists());
+}
