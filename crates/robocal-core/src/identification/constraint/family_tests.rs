@@ -7,6 +7,7 @@ use super::tests::{check_poses, nominal, simulate, spec, truth};
 use super::*;
 use crate::experiment::{PAPER_LINK_MASSES_KG, PAPER_PAYLOAD_KG};
 use crate::identification::AutoFamilies;
+use crate::model::family::{compliance, transmission};
 use crate::observations::constraint::ConstraintKind;
 use crate::simulation::constraint::{aligned_model_error, ConstraintSimulation};
 use crate::simulation::GravityModel;
