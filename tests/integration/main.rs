@@ -26,6 +26,7 @@ mod cli_calibrate;
 mod cli_compensate;
 mod cli_compensate_pose;
 mod cli_compliance;
+mod cli_constraint_families;
 mod cli_constraint_mixed;
 mod cli_constraint_readers;
 mod cli_constraints;

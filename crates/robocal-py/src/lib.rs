@@ -10,6 +10,7 @@ mod args;
 mod arrays;
 mod calibrate;
 mod compensate;
+mod constraint_model;
 mod constraints;
 mod errors;
 mod evaluate;
@@ -35,6 +36,10 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(constraints::is_constraint_file, m)?)?;
     m.add_function(wrap_pyfunction!(constraints::calibrate_constraint_file, m)?)?;
     m.add_function(wrap_pyfunction!(constraints::simulate_constraints, m)?)?;
+    m.add_function(wrap_pyfunction!(
+        constraint_model::calibrate_constraint_file_model,
+        m
+    )?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(compensate::compensate_arrays, m)?)?;
     m.add_class::<simulation::PySimulation>()?;

@@ -1,6 +1,8 @@
 //! `calibrate` on constraint data (issue 31): a measurement file with a `constraint` column
 //! (fixed points, spheres, planes; no `x,y,z`) and, with `--distances`, known distances between
-//! points or sphere centres. The robot's geometric model and the features are fitted together
+//! points or sphere centres. The robot's model (its geometry and the families of `--compliance`,
+//! `--harmonics`, `--backlash`, `--thermal`, or with `--model auto` the families the data
+//! support, chosen by cross-validation by configuration) and the features are fitted together
 //! in the robot's base frame ([`robocal_core::identification::constraint`]); the result is up
 //! to the base pose, and says so.
 
@@ -8,11 +10,14 @@ use super::Settings;
 use crate::cmd::common;
 use crate::exit;
 use robocal_core::identification::constraint::{
-    calibrate_constraints, ConstraintCalibration, ConstraintOptions, Scale,
+    calibrate_constraints, calibrate_constraints_auto, ConstraintCalibration, ConstraintOptions,
+    Scale,
 };
+use robocal_core::identification::ModelChoice;
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::measurements::MeasurementReader;
 use robocal_core::io::{read_measurements, Positions};
+use robocal_core::model::family::thermal;
 use robocal_core::model::Robot;
 use robocal_core::observations::constraint::{
     read_distances, ConstraintData, ConstraintKind, CONSTRAINT_COLUMN,
@@ -76,7 +81,11 @@ pub(super) fn run(
         rank_tolerance: s.calibration.identifiability.rank_tolerance,
         ..ConstraintOptions::default()
     };
-    let cal = calibrate_constraints(robot, &data, &opts).map_err(|e| {
+    let cal = match s.calibration.model {
+        ModelChoice::Auto(auto) => calibrate_constraints_auto(robot, &data, &opts, auto),
+        ModelChoice::Given => calibrate_constraints(robot, &data, &opts),
+    };
+    let cal = cal.map_err(|e| {
         let hint = if data.has_known_length() {
             ""
         } else {
@@ -85,7 +94,14 @@ pub(super) fn run(
         };
         anyhow::Error::new(e).context(format!("calibrating from {}{hint}", s.data.display()))
     })?;
-    print(robot, &cal)?;
+    if let Some(sel) = &cal.model_selection {
+        super::print_selection(sel)?;
+        outln!()?;
+    }
+    if let Some(t) = thermal::reference_c(&cal.robot) {
+        errln!("thermal expansion referred to {t:.1} deg C (the rows' mean)")?;
+    }
+    print(&cal.nominal, &cal)?;
     if !cal.fit.converged {
         return Err(exit::numerical(format!(
             "the constraint fit did not converge in {} iterations; nothing written to {}",

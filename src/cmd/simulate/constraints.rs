@@ -1,8 +1,10 @@
 //! `simulate --constraint point|sphere|plane`: constraint data instead of tracker readings (issue
 //! 31). The true robot brings its tool point to fixed points, onto spheres or onto planes from
 //! varied orientations (inverse kinematics on the true robot); `--noise-mm` is the contact's
-//! noise (probe and repeatability). Writes the measurement CSV (`constraint`, `radius_mm`, no
-//! `x,y,z`) and, with `--distances-out`, the true distances between the points or centres.
+//! noise (probe and repeatability); `--compliance` (with `--link-masses-kg`, `--payload-kg`)
+//! makes the true robot sag under gravity, as in the tracker mode. Writes the measurement CSV
+//! (`constraint`, `radius_mm`, no `x,y,z`) and, with `--distances-out`, the true distances
+//! between the points or centres.
 
 use super::SimulateArgs;
 use crate::exit;
@@ -14,7 +16,8 @@ use robocal_core::simulation::constraint::{
     constraint_measurements, distances_csv, simulate_constraints, truth_json, ConstraintSimulation,
 };
 use robocal_core::simulation::{
-    check_truth_matches, stream_rng, GeometricErrors, PoseSampler, Stream, TruthSource,
+    check_truth_matches, stream_rng, GeometricErrors, GravityModel, PoseSampler, Stream,
+    TruthSource,
 };
 
 /// Runs the constraint simulation of `a` (`a.constraint` is set).
@@ -77,7 +80,16 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
         footprint_radius_mm: a.footprint_mm.unwrap_or(0.15 * nominal.reach_mm()),
         ..PoseSampler::default()
     };
-    let sim = simulate_constraints(&truth, &sampler, &spec)?;
+    // The robot that moves: the truth, sagging under gravity when asked (the compliance family
+    // set to the gravity model's physics).
+    let gravity = gravity(a, nominal.dof())?;
+    let moving = match &gravity {
+        Some(g) => g
+            .equivalent(&truth, false)
+            .map_err(|e| exit::usage(format!("--compliance: {e}")))?,
+        None => truth.clone(),
+    };
+    let sim = simulate_constraints(&moving, &sampler, &spec)?;
     let set = constraint_measurements(&nominal, &sim.data);
     let csv = measurements_csv(&set)?;
     let dist = distances_csv(&sim.data).into_bytes();
@@ -87,14 +99,20 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
         .file_name()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let truth_json = truth_json(
+    let mut truth_json = truth_json(
         (&nominal, &truth),
         (&a.truth, errors),
         &spec,
         &sim,
         &file_name,
-    )?
-    .into_bytes();
+    )?;
+    if let Some(g) = &gravity {
+        // The gravity model in the settings, as the tracker mode's truth file has it.
+        let mut v: serde_json::Value = serde_json::from_str(&truth_json)?;
+        v["settings"]["gravity"] = serde_json::to_value(g)?;
+        truth_json = serde_json::to_string_pretty(&v)? + "\n";
+    }
+    let truth_json = truth_json.into_bytes();
     let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&a.out, &csv), (&truth_out, &truth_json)];
     if let Some(d) = &a.distances_out {
         files.push((d, &dist));
@@ -120,4 +138,33 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
         truth_out.display()
     )?;
     Ok(())
+}
+
+/// The gravity model of `--compliance`, `--link-masses-kg` and `--payload-kg` (one value for all
+/// joints or one per joint), checked; `None` without `--compliance`.
+fn gravity(a: &SimulateArgs, dof: usize) -> anyhow::Result<Option<GravityModel>> {
+    let per_joint = |name: &str, s: &str| -> anyhow::Result<Vec<f64>> {
+        let v = super::numbers(name, s)?;
+        match v.len() {
+            1 => Ok(vec![v[0]; dof]),
+            n if n == dof => Ok(v),
+            n => Err(exit::usage(format!(
+                "{name}: {n} values: give one for every joint or one per joint ({dof})"
+            ))),
+        }
+    };
+    let Some(c) = &a.compliance else {
+        return Ok(None);
+    };
+    let g = GravityModel::new(
+        per_joint("--compliance", c)?,
+        match &a.link_masses_kg {
+            Some(m) => per_joint("--link-masses-kg", m)?,
+            None => vec![0.0; dof],
+        },
+        a.payload_kg.unwrap_or(0.0),
+    );
+    g.validate(dof)
+        .map_err(|e| exit::usage(format!("--compliance: {e}")))?;
+    Ok(Some(g))
 }

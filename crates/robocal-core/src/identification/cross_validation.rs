@@ -193,8 +193,9 @@ pub fn cross_validate(
 /// A fold: its index, its points and their share of the normal equations.
 type Part = (usize, Observations, Accumulated);
 
-/// The cross-validated mean and its standard error from each fold's left-out errors.
-fn summarize(runs: Vec<Result<(Vec<f64>, bool)>>) -> Result<CrossValidation> {
+/// The cross-validated mean and its standard error from each fold's left-out errors (and
+/// whether its refit converged).
+pub(crate) fn summarize(runs: Vec<Result<(Vec<f64>, bool)>>) -> Result<CrossValidation> {
     let mut errors = Vec::new();
     let mut converged = true;
     for r in runs {

@@ -229,23 +229,37 @@ fn select_fitted(
             Ok(cal) => assess(robot, reference, cal, data),
         }
     };
+    let given_fit = |robot: &Robot| -> Result<(Candidate, Option<Calibration>)> {
+        let shared = same_tool_points(robot, &given, data.calibration).then_some(&registered);
+        let cal = calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &(), shared)?;
+        Ok(assess(robot, false, cal, data))
+    };
+    search(nominal, auto, reference_c, given_fit, &fit)
+}
+
+/// Fits and judges one candidate model for [`search`] (`true`: the reference candidate).
+pub(crate) type FitCandidate<'a, T> = dyn Fn(&Robot, bool) -> (Candidate, Option<T>) + Sync + 'a;
+
+/// The forward search and the choice (see the module docs) over candidates that `fit` fits and
+/// judges (a [`Candidate`] with its cross-validated error, or rejected, and the fit when it
+/// stands; `true` for the reference candidate), whatever the data: tracker points here,
+/// constraint rows in [`crate::identification::constraint::selection`]. `auto` names the
+/// families to try (those the data cannot support already left out); `given` fits the robot as
+/// given, whose failure is the calibration's; thermal candidates are referred to
+/// `reference_c`.
+pub(crate) fn search<T: Send>(
+    nominal: &Robot,
+    auto: AutoFamilies,
+    reference_c: Option<f64>,
+    given: impl FnOnce(&Robot) -> Result<(Candidate, Option<T>)>,
+    fit: &FitCandidate<'_, T>,
+) -> Result<(ModelSelection, Option<T>)> {
     let compliant = !compliance::auto_joints(nominal).is_empty();
+    let given_robot = Families::default().robot(nominal, reference_c)?;
     // The robot as given is part of every candidate: its fit failing is the calibration's.
-    let (c0, f0) = assess(
-        &given,
-        false,
-        calibrate_model_for(
-            &given,
-            data,
-            &fit_settings,
-            Purpose::Candidate,
-            &(),
-            Some(&registered),
-        )?,
-        data,
-    );
+    let (c0, f0) = given(&given_robot)?;
     let mut sets = vec![Families::default()];
-    let mut robots = vec![given.clone()];
+    let mut robots = vec![given_robot];
     let mut candidates = vec![c0];
     let mut fits = vec![f0];
     // Forward search: from the robot as given, each round fits every set with one family more
@@ -262,7 +276,7 @@ fn select_fitted(
             .iter()
             .map(|f| f.robot(nominal, reference_c))
             .collect::<Result<_>>()?;
-        let outcomes: Vec<(Candidate, Option<Calibration>)> =
+        let outcomes: Vec<(Candidate, Option<T>)> =
             built.par_iter().map(|r| fit(r, false)).collect();
         let first = candidates.len();
         for ((f, r), o) in next.into_iter().zip(built).zip(outcomes) {
@@ -349,7 +363,7 @@ fn assess(
 
 impl Candidate {
     /// A candidate for `robot` not yet fitted.
-    fn new(robot: &Robot, reference: bool) -> Candidate {
+    pub(crate) fn new(robot: &Robot, reference: bool) -> Candidate {
         Candidate {
             families: families(robot),
             identified: 0,

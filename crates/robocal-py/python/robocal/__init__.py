@@ -405,7 +405,10 @@ def calibrate_files(
     [--accept-unknown-scale]``: ``distances`` a CSV ``from,to,distance_mm``; without a known
     distance or sphere radius the scale is undetermined and :class:`NumericalError` is raised
     unless ``accept_unknown_scale``. The result is up to the base pose (its ``constraint``
-    section says so, with the features and what the data cannot see). Of ``options`` only
+    section says so, with the features and what the data cannot see). Of ``options`` the model
+    (``model``, ``compliance``, ``payload_kg``, ``harmonics``, ``backlash``, ``thermal``, as
+    for tracker data: ``model="auto"``, the default, chooses the families not given by
+    cross-validation by configuration and the result has ``model_selection``),
     ``accept_implausible``, ``nominal_limits`` and ``rank_tol`` apply to such data.
     """
     known = calibrate.__kwdefaults__ or {}
@@ -418,20 +421,28 @@ def calibrate_files(
                 "validate: constraint data have no tracker points to validate against (not "
                 "supported with a constraint file)"
             )
-        applies = ("accept_implausible", "nominal_limits", "rank_tol")
+        applies = (
+            "accept_implausible",
+            "nominal_limits",
+            "rank_tol",
+            "model",
+            "compliance",
+            "payload_kg",
+            "harmonics",
+            "backlash",
+            "thermal",
+        )
         given = {k: v for k, v in options.items() if v != known.get(k)}
         for k in given:
             if k not in applies:
                 raise UsageError(f"{k}: does not apply to constraint data (a constraint column)")
         return _finish(
-            _robocal.calibrate_constraint_file(
+            _robocal.calibrate_constraint_file_model(
                 robot,
                 os.fspath(data),
                 None if distances is None else os.fspath(distances),
                 accept_unknown_scale,
-                bool(given.get("accept_implausible", False)),
-                bool(given.get("nominal_limits", False)),
-                given.get("rank_tol"),
+                given,
             )
         )
     if distances is not None or accept_unknown_scale:

@@ -6,8 +6,9 @@
 //! (mixed data) three rows per tracker row, `F m - p(q; theta)` with the tracker frame `F`
 //! estimated too (its update `F' = (exp(w), dt) F`: derivatives `-[F m]x` and `I`). The
 //! Jacobian's robot columns are the feature rows' derivatives with respect to `p` times the
-//! parameters' tool-point screws ([`Robot::tool_screw_jacobians`]); the feature columns are the
-//! features' own derivatives.
+//! parameters' tool-point screws under the row's conditions ([`Robot::target_screws_in`]: the
+//! joint families' deflection and their own columns included, the same as for tracker data);
+//! the feature columns are the features' own derivatives.
 
 use super::features::FeatureEstimate;
 use crate::error::{Error, Result};
@@ -92,9 +93,11 @@ pub(crate) fn evaluate(
     for r in &data.rows {
         let f = &features[r.feature];
         let p = if j.is_some() {
-            robot.tool_screw_jacobians(&r.q, None, Some(&mut jp), None)
+            robot
+                .target_screws_in(&r.q, 0, &r.conditions, None, Some(&mut jp), None)
+                .0
         } else {
-            robot.tool_position(&r.q)
+            robot.target_position_in(&r.q, 0, &r.conditions)
         };
         let rows = f.rows();
         let k = f.param_count();
@@ -130,9 +133,11 @@ pub(crate) fn evaluate(
         let f = frame.expect("a tracker frame for tracker rows");
         for t in &data.tracker {
             let p = if j.is_some() {
-                robot.tool_screw_jacobians(&t.q, None, Some(&mut jp), None)
+                robot
+                    .target_screws_in(&t.q, 0, &t.conditions, None, Some(&mut jp), None)
+                    .0
             } else {
-                robot.tool_position(&t.q)
+                robot.target_position_in(&t.q, 0, &t.conditions)
             };
             let w = f * nalgebra::Point3::from(t.m);
             let r = w.coords - p;

@@ -1,8 +1,15 @@
 //! Calibration without a laser tracker (issue 31): from rows that put the tool point at fixed,
 //! unknown points, on fixed spheres or on fixed planes ([`crate::observations::constraint`]),
-//! with known distances between points or sphere centres, the robot's geometric parameters and
-//! the features' own are estimated jointly ([`fit`]), in the robot's base frame: there is no
+//! with known distances between points or sphere centres, the robot's parameters and the
+//! features' own are estimated jointly ([`fit`]), in the robot's base frame: there is no
 //! tracker frame to register.
+//!
+//! The robot's parameters are those of the model as given: its geometry and the families
+//! beyond it the caller enabled (joint compliance, transmission harmonics, backlash, thermal
+//! expansion), which act through the same kinematics as for tracker data (the rows' conditions,
+//! `temperature_c` and `dir1..dirN`, read the same way). A thermal model is referred to the
+//! rows' mean temperature. [`select`] chooses the families the data support, as `--model auto`
+//! does for tracker data.
 //!
 //! What such data cannot see is said, not hidden:
 //! - **the base pose**, always: the features sit at unknown places, which take up any move of
@@ -24,17 +31,20 @@ pub mod features;
 pub mod fit;
 mod gate;
 pub mod result;
+pub mod selection;
+mod unseen;
 
 pub use features::FeatureEstimate;
 pub use fit::FitReport;
+pub use selection::{calibrate_constraints_auto, cross_validate_constraints, select};
 
 use crate::error::{Error, Result};
-use crate::identification::identifiability::{analyze, IdentifiabilityOptions};
+use crate::identification::ModelSelection;
+use crate::model::family::{backlash, thermal};
 use crate::model::{Param, Robot, Unit};
 use crate::observations::constraint::{ConstraintData, CONSTRAINT_COLUMN};
-use crate::observations::Observations;
 use fit::Layout;
-use nalgebra::DMatrix;
+use unseen::{column_name, feature_advice, structural, unseen_family_parameters, weakest};
 
 /// Settings of a constraint calibration.
 #[derive(Debug, Clone, PartialEq)]
@@ -106,7 +116,10 @@ pub struct Fixed {
 /// The result of a constraint calibration.
 #[derive(Debug, Clone)]
 pub struct ConstraintCalibration {
-    /// The calibrated robot (geometric model; base frame as the nominal's).
+    /// The model fitted, at its start values: the nominal robot with the families fitted (a
+    /// thermal model referred to the data's mean temperature).
+    pub nominal: Robot,
+    /// The calibrated robot (the families fitted included; base frame as the nominal's).
     pub robot: Robot,
     /// The robot parameters identified.
     pub identified: Vec<Param>,
@@ -141,6 +154,9 @@ pub struct ConstraintCalibration {
     /// ([`crate::model::family::plausible`]), a sphere's radius or a feature's distance from
     /// the base beyond what the robot could touch.
     pub implausible: Vec<String>,
+    /// The automatic model choice that chose this model ([`calibrate_constraints_auto`]), if
+    /// one did.
+    pub model_selection: Option<ModelSelection>,
 }
 
 /// What every result says about its frame.
@@ -150,7 +166,31 @@ pub const UP_TO_BASE: &str = "the base pose (6 degrees of freedom): constraint d
      base pose: positions are right relative to each other and to the constrained features, not \
      absolutely";
 
-/// Calibrates `nominal`'s geometric model from constraint data (see the module docs).
+/// `nominal` as a constraint calibration fits it: its families as given, a thermal model
+/// referred to the rows' mean temperature (an error without temperatures), backlash only with
+/// approach directions.
+pub fn fitted_model(nominal: &Robot, data: &ConstraintData) -> Result<Robot> {
+    let mut robot = nominal.clone();
+    if thermal::reference_c(&robot).is_some() {
+        let Some(t) = data.mean_temperature_c() else {
+            return Err(Error::invalid(
+                "thermal",
+                "thermal expansion needs the rows' temperatures (a temperature_c column, deg C)",
+            ));
+        };
+        thermal::set_reference_c(&mut robot, t)?;
+    }
+    if !backlash::joints(&robot).is_empty() && !data.has_directions() {
+        return Err(Error::invalid(
+            "backlash",
+            "backlash needs the rows' approach directions (dir1..dirN columns, +1 or -1)",
+        ));
+    }
+    Ok(robot)
+}
+
+/// Calibrates `nominal` (its geometry and the families it has) from constraint data (see the
+/// module docs).
 pub fn calibrate_constraints(
     nominal: &Robot,
     data: &ConstraintData,
@@ -168,7 +208,7 @@ pub fn calibrate_constraints(
         });
     }
     data.check_counts()?;
-    let mut robot = nominal.geometric();
+    let mut robot = fitted_model(nominal, data)?;
     let mut features = start_values(&robot, data)?;
     let scale =
         match scale_source(data) {
@@ -213,6 +253,7 @@ pub fn calibrate_constraints(
             held.name()
         ));
     }
+    unseen.extend(unseen_family_parameters(&fixed));
     // Fit; fix what the data turn out not to see; fit again.
     let start_robot = robot.clone();
     let start_features = features.clone();
@@ -304,6 +345,7 @@ pub fn calibrate_constraints(
         );
         let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
         return Ok(ConstraintCalibration {
+            nominal: start_robot,
             robot,
             identified,
             fixed,
@@ -322,6 +364,7 @@ pub fn calibrate_constraints(
             condition_number: cond,
             fit: report,
             implausible,
+            model_selection: None,
         });
     }
 }
@@ -332,7 +375,10 @@ fn start_values(robot: &Robot, data: &ConstraintData) -> Result<Vec<FeatureEstim
         .iter()
         .enumerate()
         .map(|(k, f)| {
-            let pts: Vec<_> = data.rows_of(k).map(|r| robot.tool_position(&r.q)).collect();
+            let pts: Vec<_> = data
+                .rows_of(k)
+                .map(|r| robot.target_position_in(&r.q, 0, &r.conditions))
+                .collect();
             FeatureEstimate::start(f.kind, &f.name, f.radius_mm, &pts)
                 .map_err(|m| data.parse_error(f.first_line, CONSTRAINT_COLUMN, m))
         })
@@ -349,7 +395,7 @@ fn start_frame(robot: &Robot, data: &ConstraintData) -> Result<Option<crate::fra
     let p: Vec<_> = data
         .tracker
         .iter()
-        .map(|t| robot.tool_position(&t.q))
+        .map(|t| robot.target_position_in(&t.q, 0, &t.conditions))
         .collect();
     let f = crate::registration::rigid::fit_rigid(&m, &p, None).map_err(|e| {
         data.parse_error(
@@ -394,112 +440,8 @@ fn longest_length(robot: &Robot) -> Result<Param> {
         .ok_or_else(|| Error::invalid("robot", "has no link length to hold the scale"))
 }
 
-/// The structural analysis: the parameters tool points could identify (linearized at zero
-/// residual), less the base frame and what duplicates it.
-fn structural(
-    robot: &Robot,
-    data: &ConstraintData,
-    opts: &ConstraintOptions,
-) -> Result<(Vec<Param>, Vec<Fixed>)> {
-    let mut obs = Observations::new(robot.dof());
-    for r in &data.rows {
-        obs.push(&r.q, robot.tool_position(&r.q), r.line)?;
-    }
-    for t in &data.tracker {
-        obs.push(&t.q, robot.tool_position(&t.q), t.line)?;
-    }
-    let id = analyze(
-        robot,
-        &obs,
-        &IdentifiabilityOptions {
-            rank_tolerance: opts.rank_tolerance,
-            ..IdentifiabilityOptions::default()
-        },
-    )?;
-    let base = Param::base(0).family_id();
-    let mut fixed: Vec<Fixed> = Vec::new();
-    let mut identified = Vec::new();
-    for p in &id.identified {
-        if p.family_id() == base {
-            fixed.push(Fixed {
-                param: *p,
-                reason: "base frame: no reference in constraint data (the result is up to the \
-                         base pose)"
-                    .into(),
-            });
-        } else {
-            identified.push(*p);
-        }
-    }
-    for f in &id.fixed {
-        let mut reason = f.describe();
-        if let crate::identification::identifiability::FixReason::Duplicate { of, .. } = &f.reason {
-            if of.iter().any(|(q, _)| q.family_id() == base) {
-                reason.push_str(" (moves like the base frame, which constraint data cannot see)");
-            }
-        }
-        fixed.push(Fixed {
-            param: f.param,
-            reason,
-        });
-    }
-    Ok((identified, fixed))
-}
-
-/// The condition number of `j` with unit columns and, when its smallest singular value is below
-/// `tol` times the largest, that direction (in the unscaled unknowns' columns order, unit norm
-/// in scaled units).
-fn weakest(j: &DMatrix<f64>, tol: f64) -> (f64, Option<Vec<f64>>) {
-    let n = j.ncols();
-    let norms: Vec<f64> = (0..n).map(|c| j.column(c).norm()).collect();
-    let js = DMatrix::from_fn(j.nrows(), n, |r, c| {
-        if norms[c] > 0.0 {
-            j[(r, c)] / norms[c]
-        } else {
-            0.0
-        }
-    });
-    let svd = js.svd(false, true);
-    let s = &svd.singular_values;
-    let (imin, smin) = s.argmin();
-    let smax = s.max();
-    let cond = if smin > 0.0 {
-        smax / smin
-    } else {
-        f64::INFINITY
-    };
-    if smin > tol * smax {
-        return (cond, None);
-    }
-    let vt = svd.v_t.expect("asked for");
-    (cond, Some(vt.row(imin).iter().copied().collect()))
-}
-
-/// The name of unknown `k` of a fit.
-fn column_name(layout: &Layout, features: &[FeatureEstimate], k: usize) -> String {
-    if k < layout.params.len() {
-        return layout.params[k].name();
-    }
-    for (f, &c0) in features.iter().zip(&layout.feature_col) {
-        if (c0..c0 + f.param_count()).contains(&k) {
-            return f.param_names()[k - c0].clone();
-        }
-    }
-    if let Some(c0) = layout.frame_col.filter(|c0| (*c0..c0 + 6).contains(&k)) {
-        return format!("tracker frame {}", ["a", "b", "c", "x", "y", "z"][k - c0]);
-    }
-    format!("unknown {k}")
-}
-
-/// What to change when the features themselves are undetermined.
-fn feature_advice(features: &[FeatureEstimate]) -> String {
-    let kinds: Vec<&str> = features.iter().map(|f| f.kind.key()).collect();
-    format!(
-        "the data's features ({}) need configurations that differ in orientation as well as in \
-         position",
-        kinds.join(", ")
-    )
-}
-
 #[cfg(test)]
 mod tests;
+
+#[cfg(test)]
+mod family_tests;

@@ -183,9 +183,9 @@ impl ConstraintCalibration {
     }
 
     /// The result file: `nominal`'s parameters with the calibrated values (held ones marked,
-    /// with why), the identity tracker frame, the error tables of the constraint residuals, the
+    /// with why; the families fitted, with their keys: payload, reference temperature), the identity tracker frame, the error tables of the constraint residuals, the
     /// solver's report, the status (`implausible` when the gate failed, `partial` when the fit
-    /// did not converge) and the `constraint` section.
+    /// did not converge), the `constraint` section and the model choice (`model_selection`).
     pub fn to_result(&self, nominal: &Robot, data: &ConstraintData) -> Result<CalibrationResult> {
         let mut parameters = CalibrationResult::parameter_entries(nominal, &self.robot);
         for f in &self.fixed {
@@ -198,7 +198,7 @@ impl ConstraintCalibration {
             let identified = self.identified.iter().any(|p| &p.name() == name);
             if !identified && !e.fixed {
                 e.fixed = true;
-                e.reason = Some("not part of the geometric model fitted to constraint data".into());
+                e.reason = Some("not part of the model fitted to constraint data".into());
             }
         }
         let geometric = nominal.geometric();
@@ -258,6 +258,13 @@ impl ConstraintCalibration {
             stages: Vec::new(),
         });
         self.section(data).store(&mut r);
+        // The families' own keys, as a tracker result records them.
+        crate::io::result_payload::record(&mut r, &self.robot);
+        crate::io::result_thermal::record(&mut r, &self.robot);
+        r.model_selection = self
+            .model_selection
+            .as_ref()
+            .map(crate::io::result_selection::ModelSelectionSection::of);
         Ok(r)
     }
 }

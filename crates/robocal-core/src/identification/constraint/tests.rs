@@ -13,7 +13,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
 
-fn nominal() -> Robot {
+pub(super) fn nominal() -> Robot {
     preset("kuka-kr480-r3330").unwrap()
 }
 
@@ -25,18 +25,18 @@ fn sampler() -> PoseSampler {
     }
 }
 
-fn truth(seed: u64) -> Robot {
+pub(super) fn truth(seed: u64) -> Robot {
     let mut rng = ChaCha8Rng::seed_from_u64(1000 + seed);
     GeometricErrors::default()
         .apply(&nominal(), &mut rng)
         .unwrap()
 }
 
-fn simulate(truth: &Robot, spec: &ConstraintSimulation) -> SimulatedConstraints {
+pub(super) fn simulate(truth: &Robot, spec: &ConstraintSimulation) -> SimulatedConstraints {
     simulate_constraints(truth, &sampler(), spec).unwrap()
 }
 
-fn spec(kind: ConstraintKind, noise_mm: f64, seed: u64) -> ConstraintSimulation {
+pub(super) fn spec(kind: ConstraintKind, noise_mm: f64, seed: u64) -> ConstraintSimulation {
     ConstraintSimulation {
         kind,
         noise_mm,
@@ -46,7 +46,7 @@ fn spec(kind: ConstraintKind, noise_mm: f64, seed: u64) -> ConstraintSimulation 
 }
 
 /// 300 random poses of the robot (the validation of every figure).
-fn check_poses(seed: u64) -> Vec<Vec<f64>> {
+pub(super) fn check_poses(seed: u64) -> Vec<Vec<f64>> {
     let mut rng = ChaCha8Rng::seed_from_u64(7000 + seed);
     random_poses(&nominal(), 300, &sampler(), &mut rng).unwrap()
 }
@@ -448,6 +448,7 @@ fn tracker_rows(
             m: (frame.inverse() * nalgebra::Point3::from(t.tool_position(&q))).coords,
             q,
             line: 1000 + i,
+            conditions: Default::default(),
         })
         .collect()
 }

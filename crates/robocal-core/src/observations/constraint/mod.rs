@@ -20,7 +20,9 @@ mod distances;
 pub use distances::{parse_distances, read_distances, KnownDistance};
 
 use crate::error::{Error, Result};
+use crate::io::row_conditions::ConditionsLayout;
 use crate::io::MeasurementSet;
+use crate::kinematics::Conditions;
 use std::path::{Path, PathBuf};
 
 /// The column naming a row's constraint.
@@ -99,6 +101,9 @@ pub struct ConstraintRow {
     pub feature: usize,
     /// 1-based line in the file (0 when not from a file).
     pub line: usize,
+    /// The arm's temperature and the joints' approach directions at the row (`temperature_c`,
+    /// `dir1..dirN`, read as for tracker data), unknown when the file has none.
+    pub conditions: Conditions,
 }
 
 /// A tracker row among constraint rows (mixed data): joint values and the measured tool point.
@@ -110,6 +115,8 @@ pub struct TrackerRow {
     pub m: nalgebra::Vector3<f64>,
     /// 1-based line in the file (0 when not from a file).
     pub line: usize,
+    /// The row's conditions, as for a constraint row.
+    pub conditions: Conditions,
 }
 
 /// Fewest tracker rows of mixed data: the tracker frame's registration needs three points not
@@ -202,6 +209,17 @@ impl ConstraintData {
 
     /// Adds a row touching feature `feature` (an index from [`ConstraintData::feature_index`]).
     pub fn push(&mut self, q: Vec<f64>, feature: usize, line: usize) -> Result<()> {
+        self.push_in(q, feature, line, Conditions::UNKNOWN)
+    }
+
+    /// [`ConstraintData::push`] with the row's conditions (temperature, approach directions).
+    pub fn push_in(
+        &mut self,
+        q: Vec<f64>,
+        feature: usize,
+        line: usize,
+        conditions: Conditions,
+    ) -> Result<()> {
         if q.len() != self.dof {
             return Err(Error::JointCount {
                 context: self.describe(line),
@@ -218,7 +236,12 @@ impl ConstraintData {
                 "not a finite number",
             ));
         }
-        self.rows.push(ConstraintRow { q, feature, line });
+        self.rows.push(ConstraintRow {
+            q,
+            feature,
+            line,
+            conditions,
+        });
         Ok(())
     }
 
@@ -229,6 +252,34 @@ impl ConstraintData {
             Some(p) => p.display().to_string(),
             None => format!("line {line}"),
         }
+    }
+
+    /// Whether some constraint or tracker row has a temperature.
+    pub fn has_temperature(&self) -> bool {
+        self.all_conditions().any(|c| c.temperature_c.is_finite())
+    }
+
+    /// Whether some constraint or tracker row has an approach direction.
+    pub fn has_directions(&self) -> bool {
+        self.all_conditions().any(|c| c.dir.iter().any(|d| *d != 0))
+    }
+
+    /// The mean temperature of the rows that have one, rounded to 0.1 deg C (the reference a
+    /// thermal model is referred to, as for tracker data); `None` without temperatures.
+    pub fn mean_temperature_c(&self) -> Option<f64> {
+        let t: Vec<f64> = self
+            .all_conditions()
+            .map(|c| c.temperature_c)
+            .filter(|t| t.is_finite())
+            .collect();
+        (!t.is_empty()).then(|| (t.iter().sum::<f64>() / t.len() as f64 * 10.0).round() / 10.0)
+    }
+
+    fn all_conditions(&self) -> impl Iterator<Item = &Conditions> {
+        self.rows
+            .iter()
+            .map(|r| &r.conditions)
+            .chain(self.tracker.iter().map(|t| &t.conditions))
     }
 
     /// The rows of feature `k`.
@@ -316,10 +367,14 @@ impl ConstraintData {
             source: Some(path.to_owned()),
             ..ConstraintData::new(set.dof())
         };
+        let conditions = ConditionsLayout::of(set)?;
         for r in &set.rows {
             let cell = r.extra[kc].trim();
+            let c = conditions.read(set, r)?.unwrap_or(Conditions::UNKNOWN);
             if cell.is_empty() && xyz.iter().any(|(k, _)| !r.extra[*k].trim().is_empty()) {
-                data.tracker.push(tracker_row(set, &xyz, r)?);
+                let mut t = tracker_row(set, &xyz, r)?;
+                t.conditions = c;
+                data.tracker.push(t);
                 continue;
             }
             let Some((kind, name)) = cell.split_once(':') else {
@@ -389,7 +444,7 @@ impl ConstraintData {
             let k = data
                 .feature_index(kind, name, radius, r.line)
                 .map_err(|(field, m)| perr(r.line, field, m))?;
-            data.push(r.q.clone(), k, r.line)?;
+            data.push_in(r.q.clone(), k, r.line, c)?;
         }
         data.check_counts()?;
         if !data.tracker.is_empty() && data.tracker.len() < MIN_TRACKER_ROWS {
@@ -441,6 +496,7 @@ fn tracker_row(
         q: r.q.clone(),
         m,
         line: r.line,
+        conditions: Conditions::UNKNOWN,
     })
 }
 
