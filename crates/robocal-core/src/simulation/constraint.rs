@@ -120,7 +120,7 @@ pub struct SimulatedConstraints {
 }
 
 /// Reference configurations tried per feature before giving up.
-const REFERENCE_TRIES: usize = 50;
+pub(crate) const REFERENCE_TRIES: usize = 50;
 
 /// Simulates `spec` on the true robot `truth`, reference configurations drawn by `sampler`.
 pub fn simulate_constraints(
@@ -230,6 +230,28 @@ fn feature_rows<R: Rng>(
         ConstraintKind::Sphere => (p0 - spec.radius_mm * z0, None),
         ConstraintKind::Plane => (p0, Some(z0)),
     };
+    let rows = contacts(truth, ik, q0, spec, rng)?;
+    Some((rows, position, normal))
+}
+
+/// The configurations of one feature touched from reference configuration `q0` (whose tool
+/// pose is the reference contact, its z axis the feature's normal): `spec.per_feature` of
+/// them, or `None` when the robot misses too many contacts.
+pub(crate) fn contacts<R: Rng>(
+    truth: &Robot,
+    ik: &Compensator<'_>,
+    q0: &[f64],
+    spec: &ConstraintSimulation,
+    rng: &mut R,
+) -> Option<Vec<Vec<f64>>> {
+    let t0 = truth.tool_pose(q0);
+    let r0 = t0.rotation;
+    let p0 = t0.translation.vector;
+    let z0 = r0.matrix().column(2).into_owned();
+    let position = match spec.kind {
+        ConstraintKind::Sphere => p0 - spec.radius_mm * z0,
+        _ => p0,
+    };
     let (t1, t2) = crate::identification::constraint::features::tangents(&z0);
     let cone = (spec.span_mm / spec.radius_mm).min(80f64.to_radians());
     let mut rows = Vec::with_capacity(spec.per_feature);
@@ -272,7 +294,54 @@ fn feature_rows<R: Rng>(
             }
         }
     }
-    Some((rows, position, normal))
+    Some(rows)
+}
+
+/// The rows of `planned` (configurations in which `nominal` touches the features) as the true
+/// robot `truth` measures them: each configuration moved by inverse kinematics on the truth,
+/// from the planned one, until the truth's tool frame is where the nominal's was (the operator
+/// jogs the probe into the socket or onto the surface), the contact with Gaussian noise
+/// `noise_mm` per axis (seed `seed`). Distances are kept. A contact the truth cannot reach is
+/// an error naming the row.
+pub fn touch(
+    truth: &Robot,
+    nominal: &Robot,
+    planned: &ConstraintData,
+    noise_mm: f64,
+    seed: u64,
+) -> Result<ConstraintData> {
+    if !(noise_mm >= 0.0 && noise_mm <= 10.0) {
+        return Err(Error::invalid(
+            "noise_mm",
+            format!("{noise_mm} is not within 0..10 mm"),
+        ));
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut ik = Compensator::new(truth, truth, DampedLeastSquares::default())?;
+    ik.pose_solver.tolerance_mm = 1e-10;
+    ik.pose_solver.tolerance_deg = 1e-9;
+    let mut out = planned.clone();
+    let mut q = vec![0.0; truth.dof()];
+    for (i, r) in out.rows.iter_mut().enumerate() {
+        let t = nominal.tool_pose(&r.q);
+        let noise = Vector3::from_fn(|_, _| {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            noise_mm * z
+        });
+        let target =
+            Frame::from_parts(Translation3::from(t.translation.vector + noise), t.rotation);
+        let rep = ik.reach_pose(&target, Some(&r.q), &mut q);
+        if !rep.status.reaches_target() || !truth.joints_outside_limits(&q).is_empty() {
+            return Err(Error::Numerical(format!(
+                "row {}: the true robot does not reach the planned contact of `{}` from its \
+                 planned configuration",
+                i + 1,
+                planned.features[r.feature].label()
+            )));
+        }
+        r.q.clone_from(&q);
+    }
+    Ok(out)
 }
 
 /// The measurement file of simulated constraint data: joints, `constraint` and (for spheres)
