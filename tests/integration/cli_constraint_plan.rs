@@ -197,3 +197,139 @@ fn bad_features_exit_3_naming_them() {
     .assert_code(2);
     assert!(!out.exists(), "nothing written");
 }
+
+#[test]
+fn a_plan_measured_by_the_true_robot_calibrates() {
+    // plan -> measure (simulated: the true robot touches each planned contact) -> calibrate ->
+    // evaluate on tracker points of the same true robot.
+    let dir = Dir::new();
+    let plan = dir.join("plan.csv");
+    ok(&[
+        "plan",
+        "--robot",
+        KR,
+        "--constraint",
+        "point",
+        "--features",
+        "3",
+        "--per-feature",
+        "12",
+        "--candidates-per-feature",
+        "60",
+        "--distances",
+        "--out",
+        p(&plan),
+    ]);
+    let data = dir.join("measured.csv");
+    let dist = dir.join("measured.distances.csv");
+    let o = ok(&[
+        "simulate",
+        "--robot",
+        KR,
+        "--truth",
+        "random",
+        "--constraint-plan",
+        p(&plan),
+        "--noise-mm",
+        "0.01",
+        "--out",
+        p(&data),
+        "--distances-out",
+        p(&dist),
+    ]);
+    let (planned, measured) = (read_csv(&plan).1, read_csv(&data).1);
+    // A contact the truth cannot reach within its limits is left out, with a warning.
+    let left_out = planned.len() - measured.len();
+    assert!(left_out <= 2, "{}", o.stderr());
+    assert_eq!(
+        left_out > 0,
+        o.stderr().contains("left out"),
+        "{}",
+        o.stderr()
+    );
+    assert!(
+        o.stdout()
+            .contains(&format!("{} constraint row(s)", measured.len())),
+        "{}",
+        o.stdout()
+    );
+    // Each measured row is a planned row (in order, the same feature) with the truth's
+    // configuration near the planned one (a few mm of model error: a few degrees at most, at
+    // the wrist near its singularity), never the same.
+    let dq = |a: &[String], b: &[String]| -> f64 {
+        (0..6)
+            .map(|j| (a[j].parse::<f64>().unwrap() - b[j].parse::<f64>().unwrap()).abs())
+            .fold(0.0, f64::max)
+    };
+    let mut planned = planned.iter();
+    for b in &measured {
+        let a = planned
+            .find(|a| a[6] == b[6] && dq(a, b) < 10.0)
+            .unwrap_or_else(|| panic!("no planned row near {b:?}"));
+        assert!(dq(a, b) > 0.0);
+    }
+    assert_eq!(read_csv(&dist).1.len(), 3);
+    let truth = dir.join("measured.truth.json");
+    let t = read_json(&truth);
+    assert_eq!(t["constraint"]["features"].as_array().unwrap().len(), 3);
+    let res = dir.join("result.json");
+    ok(&[
+        "calibrate",
+        "--robot",
+        KR,
+        "--data",
+        p(&data),
+        "--distances",
+        p(&dist),
+        "--out",
+        p(&res),
+    ]);
+    let check = dir.join("check.csv");
+    ok(&[
+        "simulate",
+        "--robot",
+        KR,
+        "--truth",
+        p(&truth),
+        "--poses",
+        "40",
+        "--no-plane",
+        "--noise-mm",
+        "0.01",
+        "--out",
+        p(&check),
+    ]);
+    let j: serde_json::Value = serde_json::from_str(
+        &ok(&[
+            "evaluate",
+            "--params",
+            p(&res),
+            "--data",
+            p(&check),
+            "--json",
+        ])
+        .stdout(),
+    )
+    .unwrap();
+    let (cal, nom) = (
+        j["calibrated"]["mean_mm"].as_f64().unwrap(),
+        j["nominal"]["mean_mm"].as_f64().unwrap(),
+    );
+    assert!(
+        cal < 0.1 && cal < 0.1 * nom,
+        "calibrated {cal} mm, nominal {nom} mm"
+    );
+    // The plan file is an input: not an output.
+    robocal(&[
+        "simulate",
+        "--robot",
+        KR,
+        "--truth",
+        "random",
+        "--constraint-plan",
+        p(&plan),
+        "--out",
+        p(&plan),
+    ])
+    .assert_code(2);
+}

@@ -40,7 +40,8 @@ fn calibrated_error(planned: &ConstraintData, seed: u64) -> f64 {
     let truth = GeometricErrors::default()
         .apply(&nominal(), &mut rng)
         .unwrap();
-    let data = touch(&truth, &nominal(), planned, 0.01, 5000 + seed).unwrap();
+    let (data, missed) = touch(&truth, &nominal(), planned, 0.01, 5000 + seed).unwrap();
+    assert!(missed.len() <= 2, "{missed:?}");
     let cal = calibrate_constraints(&nominal(), &data, &ConstraintOptions::default()).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(7000 + seed);
     let poses = random_poses(&nominal(), 300, &sampler(), &mut rng).unwrap();
