@@ -17,6 +17,7 @@ mod import;
 mod iso9283;
 mod options;
 mod plan;
+mod plan_constraints;
 mod result;
 mod robot;
 mod simulate;
@@ -34,6 +35,14 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate::calibrate_files, m)?)?;
     m.add_function(wrap_pyfunction!(constraints::is_constraint_file, m)?)?;
     m.add_function(wrap_pyfunction!(constraints::calibrate_constraint_file, m)?)?;
+    m.add_function(wrap_pyfunction!(
+        constraints::calibrate_constraint_arrays,
+        m
+    )?)?;
+    m.add_function(wrap_pyfunction!(
+        plan_constraints::plan_constraint_configurations,
+        m
+    )?)?;
     m.add_function(wrap_pyfunction!(constraints::simulate_constraints, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(compensate::compensate_arrays, m)?)?;
