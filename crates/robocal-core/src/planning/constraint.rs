@@ -190,7 +190,7 @@ pub fn plan_constraints(
 ) -> Result<ConstraintPlan> {
     let s = settings;
     s.spec.validate()?;
-    if !(s.spec.noise_mm > 0.0) {
+    if s.spec.noise_mm <= 0.0 || s.spec.noise_mm.is_nan() {
         return Err(Error::invalid(
             "noise_mm",
             "must be positive for a plan (the predicted errors scale with it)",

@@ -312,7 +312,7 @@ pub fn touch(
     noise_mm: f64,
     seed: u64,
 ) -> Result<(ConstraintData, Vec<usize>)> {
-    if !(noise_mm >= 0.0 && noise_mm <= 10.0) {
+    if !(0.0..=10.0).contains(&noise_mm) {
         return Err(Error::invalid(
             "noise_mm",
             format!("{noise_mm} is not within 0..10 mm"),
