@@ -1,4 +1,8 @@
-//! `robocal plan`: the poses worth measuring (I- or D-optimal selection from random candidates).
+//! `robocal plan`: the poses worth measuring (I- or D-optimal selection from random candidates);
+//! with `--constraint` or `--features-file`, the configurations touching fixed points, spheres
+//! or planes worth measuring ([`constraint`]).
+
+mod constraint;
 
 use super::common;
 use super::io_plan::IoPlan;
@@ -20,8 +24,8 @@ pub struct PlanArgs {
     #[arg(long)]
     robot: String,
     /// Number of poses to choose (besides those of --include).
-    #[arg(long)]
-    poses: usize,
+    #[arg(long, required_unless_present_any = ["constraint", "features_file"])]
+    poses: Option<usize>,
     /// Where to write the chosen poses (CSV: q1..qn in degrees, mm for a prismatic joint), a
     /// joints file for `simulate --joints` or for measuring.
     #[arg(long)]
@@ -63,6 +67,8 @@ pub struct PlanArgs {
     /// I-optimality) or `d-optimal` (the parameters' joint confidence region).
     #[arg(long, value_enum, default_value_t = CriterionArg::Workspace)]
     criterion: CriterionArg,
+    #[command(flatten)]
+    constraint: constraint::ConstraintPlanArgs,
 }
 
 #[derive(Copy, Clone, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -101,7 +107,7 @@ impl TryFrom<&PlanArgs> for Settings {
 
     fn try_from(a: &PlanArgs) -> anyhow::Result<Settings> {
         let builder = PlanBuilder {
-            poses: a.poses,
+            poses: a.poses.unwrap_or_default(),
             candidates: a.candidates,
             seed: a.seed,
             criterion: match a.criterion {
@@ -141,6 +147,9 @@ impl TryFrom<&PlanArgs> for Settings {
 }
 
 pub fn run(a: PlanArgs) -> anyhow::Result<()> {
+    if a.constraint.active() {
+        return constraint::run(&a);
+    }
     let mut s = Settings::try_from(&a)?;
     if let Some(path) = &s.include {
         let set = read_measurements(path, s.robot.joint_space(), Positions::Optional)?;

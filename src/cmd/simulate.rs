@@ -32,7 +32,7 @@ pub struct SimulateArgs {
     truth: String,
     /// Number of random calibration poses (set `calibration`); with --validation at most
     /// 10000000 in all.
-    #[arg(long, required_unless_present_any = ["joints", "constraint"])]
+    #[arg(long, required_unless_present_any = ["joints", "constraint", "constraint_plan"])]
     poses: Option<usize>,
     /// Measure the joint values of this CSV (q1..qn in degrees, mm for a prismatic joint, or
     /// axis1..axisN) instead of random poses, e.g.
@@ -162,7 +162,7 @@ pub struct SimulateArgs {
     /// Constraint data instead of tracker readings: the tool point brought to fixed points,
     /// onto spheres or onto planes from varied orientations (a `constraint` column, no x,y,z);
     /// --noise-mm is then the contact's noise (probe and repeatability).
-    #[arg(long, value_name = "point|sphere|plane", conflicts_with_all = ["poses", "joints", "validation"])]
+    #[arg(long, value_name = "point|sphere|plane", group = "constraint_mode", conflicts_with_all = ["poses", "joints", "validation"])]
     constraint: Option<String>,
     /// With --constraint: how many points, spheres or planes.
     #[arg(long, default_value_t = 4, requires = "constraint")]
@@ -184,8 +184,13 @@ pub struct SimulateArgs {
     span_mm: f64,
     /// With --constraint point|sphere: write the true distances between every pair of points
     /// or centres to this CSV (from,to,distance_mm), for calibrate --distances.
-    #[arg(long, requires = "constraint")]
+    #[arg(long, requires = "constraint_mode")]
     distances_out: Option<PathBuf>,
+    /// Measure a constraint plan (`plan --constraint` or `--features-file`'s file) instead: the
+    /// true robot moved from each planned configuration until its tool is where the nominal's
+    /// was (the planned contact), with --noise-mm; the features are where the plan put them.
+    #[arg(long, value_name = "FILE", group = "constraint_mode", conflicts_with_all = ["poses", "joints", "validation", "constraint"])]
+    constraint_plan: Option<PathBuf>,
 }
 
 /// A list of numbers `V` or `V1,..,Vn` (the library spreads one value to every joint and
@@ -352,6 +357,9 @@ impl TryFrom<&SimulateArgs> for Settings {
 }
 
 pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
+    if let Some(plan) = &a.constraint_plan {
+        return constraints::run_plan(&a, plan);
+    }
     if let Some(kind) = &a.constraint {
         return constraints::run(&a, kind);
     }

@@ -28,6 +28,7 @@ mod cli_compensate_pose;
 mod cli_compliance;
 mod cli_constraint_families;
 mod cli_constraint_mixed;
+mod cli_constraint_plan;
 mod cli_constraint_readers;
 mod cli_constraints;
 mod cli_demo;

@@ -12,8 +12,10 @@ use pyo3::prelude::*;
 use robocal_core::identification::constraint::{calibrate_constraints, ConstraintOptions};
 use robocal_core::io::inputs::{InputFile, Inputs};
 use robocal_core::io::joint_limits::OutsideLimits;
-use robocal_core::io::{read_measurements, Positions};
-use robocal_core::observations::constraint::{read_distances, ConstraintData, CONSTRAINT_COLUMN};
+use robocal_core::io::{read_measurements, Measurement, MeasurementSet, Positions};
+use robocal_core::observations::constraint::{
+    parse_distances, read_distances, ConstraintData, CONSTRAINT_COLUMN, RADIUS_COLUMN,
+};
 use std::path::PathBuf;
 
 /// Whether the measurement file at `path` has a `constraint` column.
@@ -50,7 +52,151 @@ pub fn calibrate_constraint_file(
     let mut warnings = Vec::new();
     let set = read_measurements(&data, nominal.joint_space(), Positions::Ignored).py_err()?;
     warnings.extend(set.warnings.iter().map(|w| w.to_string()));
-    let mut o = OutsideLimits::new(nominal, &data);
+    limits(nominal, &set, nominal_limits, &mut warnings)?;
+    let mut cdata = ConstraintData::from_measurements(&set).py_err()?;
+    if let Some(d) = &distances {
+        cdata.distances = read_distances(d, &cdata).py_err()?;
+    }
+    let mut inputs = Inputs::new();
+    inputs.insert("data".into(), InputFile::of(&data).py_err()?);
+    if let Some(d) = &distances {
+        inputs.insert("distances".into(), InputFile::of(d).py_err()?);
+    }
+    let opts = options(accept_unknown_scale, rank_tol);
+    let what = data.display().to_string();
+    calibrate_data(
+        py,
+        nominal,
+        &cdata,
+        &opts,
+        accept_implausible,
+        &what,
+        Some(inputs),
+        warnings,
+    )
+}
+
+/// Calibrates `robot` from arrays of constraint rows (see `robocal.calibrate_constraints`):
+/// `q` (n, dof) in degrees (mm for a prismatic joint), one `constraint` label per row
+/// (`point:NAME`, `sphere:NAME`, `plane:NAME`), `radius_mm` per row (NaN: unknown; None: no
+/// radius column), `distances` as `(from, to, mm)`. The rows go through the file form's reader
+/// (`ConstraintData::from_measurements`, `parse_distances`), so the refusals are the file's, the
+/// arrays' rows numbered from 1 and the distances' entries from 2 (their line in a file).
+#[pyfunction]
+#[pyo3(signature = (robot, q, constraint, radius_mm = None, distances = None,
+                    accept_unknown_scale = false, accept_implausible = false,
+                    nominal_limits = false, rank_tol = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn calibrate_constraint_arrays(
+    py: Python<'_>,
+    robot: &PyRobot,
+    q: &Bound<'_, PyAny>,
+    constraint: Vec<String>,
+    radius_mm: Option<Vec<f64>>,
+    distances: Option<Vec<(String, String, f64)>>,
+    accept_unknown_scale: bool,
+    accept_implausible: bool,
+    nominal_limits: bool,
+    rank_tol: Option<f64>,
+) -> PyResult<(String, String, Vec<String>, f64)> {
+    let nominal = &robot.inner;
+    let qm = robot.joints(q, "q")?;
+    if constraint.len() != qm.rows {
+        return Err(input(format!(
+            "constraint: {} label(s) for {} row(s) of q: one label per row",
+            constraint.len(),
+            qm.rows
+        )));
+    }
+    if let Some(r) = &radius_mm {
+        if r.len() != qm.rows {
+            return Err(input(format!(
+                "radius_mm: {} value(s) for {} row(s) of q: one per row (NaN where unknown or \
+                 not a sphere)",
+                r.len(),
+                qm.rows
+            )));
+        }
+        if let Some(i) = r.iter().position(|v| v.is_infinite()) {
+            return Err(input(format!(
+                "radius_mm: row {}: {} is not a length (NaN for an unknown radius)",
+                i + 1,
+                r[i]
+            )));
+        }
+    }
+    let mut extra_columns = vec![CONSTRAINT_COLUMN.to_string()];
+    if radius_mm.is_some() {
+        extra_columns.push(RADIUS_COLUMN.to_string());
+    }
+    let set = MeasurementSet {
+        path: PathBuf::from("constraint arrays"),
+        joints: nominal.joint_space().clone(),
+        extra_columns,
+        rows: (0..qm.rows)
+            .map(|i| {
+                let mut extra = vec![constraint[i].clone()];
+                if let Some(r) = &radius_mm {
+                    extra.push(if r[i].is_nan() {
+                        String::new()
+                    } else {
+                        format!("{}", r[i])
+                    });
+                }
+                Measurement {
+                    line: i + 1,
+                    q: qm.row(i).to_vec(),
+                    p: None,
+                    extra,
+                }
+            })
+            .collect(),
+        warnings: Vec::new(),
+    };
+    let mut warnings = Vec::new();
+    limits(nominal, &set, nominal_limits, &mut warnings)?;
+    let mut cdata = ConstraintData::from_measurements(&set).py_err()?;
+    if let Some(d) = distances.filter(|d| !d.is_empty()) {
+        let mut w = csv::Writer::from_writer(Vec::new());
+        let csv_err = |e: csv::Error| raise(1, format!("distances: {e}"));
+        w.write_record(["from", "to", "distance_mm"])
+            .map_err(csv_err)?;
+        for (a, b, mm) in &d {
+            w.write_record([a.as_str(), b.as_str(), &format!("{mm}")])
+                .map_err(csv_err)?;
+        }
+        let text = w
+            .into_inner()
+            .map_err(|e| raise(1, format!("distances: {e}")))?;
+        cdata.distances = parse_distances(
+            &text[..],
+            std::path::Path::new("distances (entry 1 on line 2)"),
+            &cdata,
+        )
+        .py_err()?;
+    }
+    let opts = options(accept_unknown_scale, rank_tol);
+    calibrate_data(
+        py,
+        nominal,
+        &cdata,
+        &opts,
+        accept_implausible,
+        "constraint arrays",
+        None,
+        warnings,
+    )
+}
+
+/// Refuses rows of `set` outside `nominal`'s joint limits, unless `nominal_limits` (then a
+/// warning), as the CLI does.
+fn limits(
+    nominal: &robocal_core::Robot,
+    set: &MeasurementSet,
+    nominal_limits: bool,
+    warnings: &mut Vec<String>,
+) -> PyResult<()> {
+    let mut o = OutsideLimits::new(nominal, &set.path);
     for r in &set.rows {
         o.check(r.line, &r.q);
     }
@@ -65,10 +211,11 @@ pub fn calibrate_constraint_file(
             crate::errors::message(&e)
         )));
     }
-    let mut cdata = ConstraintData::from_measurements(&set).py_err()?;
-    if let Some(d) = &distances {
-        cdata.distances = read_distances(d, &cdata).py_err()?;
-    }
+    Ok(())
+}
+
+/// The calibration's settings from the keyword arguments.
+fn options(accept_unknown_scale: bool, rank_tol: Option<f64>) -> ConstraintOptions {
     let mut opts = ConstraintOptions {
         accept_unknown_scale,
         ..ConstraintOptions::default()
@@ -76,9 +223,25 @@ pub fn calibrate_constraint_file(
     if let Some(t) = rank_tol {
         opts.rank_tolerance = t;
     }
+    opts
+}
+
+/// Calibrates from `cdata` (read from a file or from arrays, `what` in messages) with the CLI's
+/// refusals; returns what `calibrate_constraint_file` returns.
+#[allow(clippy::too_many_arguments)]
+fn calibrate_data(
+    py: Python<'_>,
+    nominal: &robocal_core::Robot,
+    cdata: &ConstraintData,
+    opts: &ConstraintOptions,
+    accept_implausible: bool,
+    what: &str,
+    inputs: Option<Inputs>,
+    mut warnings: Vec<String>,
+) -> PyResult<(String, String, Vec<String>, f64)> {
     let started = std::time::Instant::now();
     let cal = py
-        .detach(|| calibrate_constraints(nominal, &cdata, &opts))
+        .detach(|| calibrate_constraints(nominal, cdata, opts))
         .map_err(|e| {
             let hint = if cdata.has_known_length() {
                 ""
@@ -89,8 +252,7 @@ pub fn calibrate_constraint_file(
             raise(
                 crate::errors::exit_code(&e),
                 format!(
-                    "calibrating from {}: {}{hint}",
-                    data.display(),
+                    "calibrating from {what}: {}{hint}",
                     crate::errors::message(&e)
                 ),
             )
@@ -130,13 +292,8 @@ pub fn calibrate_constraint_file(
             held.name()
         ));
     }
-    let mut res = cal.to_result(nominal, &cdata).py_err()?;
-    let mut inputs = Inputs::new();
-    inputs.insert("data".into(), InputFile::of(&data).py_err()?);
-    if let Some(d) = &distances {
-        inputs.insert("distances".into(), InputFile::of(d).py_err()?);
-    }
-    res.inputs = Some(inputs);
+    let mut res = cal.to_result(nominal, cdata).py_err()?;
+    res.inputs = inputs;
     let status = res.status().map_or("calibrated", |s| s.as_str()).to_owned();
     let text = res
         .to_text()

@@ -18,6 +18,7 @@ mod import;
 mod iso9283;
 mod options;
 mod plan;
+mod plan_constraints;
 mod result;
 mod robot;
 mod simulate;
@@ -35,6 +36,14 @@ fn _robocal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calibrate::calibrate_files, m)?)?;
     m.add_function(wrap_pyfunction!(constraints::is_constraint_file, m)?)?;
     m.add_function(wrap_pyfunction!(constraints::calibrate_constraint_file, m)?)?;
+    m.add_function(wrap_pyfunction!(
+        constraints::calibrate_constraint_arrays,
+        m
+    )?)?;
+    m.add_function(wrap_pyfunction!(
+        plan_constraints::plan_constraint_configurations,
+        m
+    )?)?;
     m.add_function(wrap_pyfunction!(constraints::simulate_constraints, m)?)?;
     m.add_function(wrap_pyfunction!(
         constraint_model::calibrate_constraint_file_model,

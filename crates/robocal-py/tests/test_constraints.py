@@ -131,3 +131,120 @@ def test_simulate_constraints_writes_the_clis_files(kind, cli, tmp_path):
         robocal.simulate_constraints(kr, tmp_path / "x.csv", "plane", distances_out=py_dist)
     with pytest.raises(robocal.UsageError, match="not point, sphere or plane"):
         robocal.simulate_constraints(kr, tmp_path / "x.csv", "circle")
+
+
+def constraint_arrays(path):
+    """A constraint measurement CSV as (q degrees, labels, radii or None), as written."""
+    import csv
+
+    import numpy as np
+
+    with open(path, newline="") as f:
+        rows = list(csv.DictReader(f))
+    qcols = [k for k in rows[0] if k.startswith("q") and k[1:].isdigit()]
+    q = np.array([[float(r[k]) for k in qcols] for r in rows])
+    labels = [r["constraint"] for r in rows]
+    radii = None
+    if "radius_mm" in rows[0]:
+        radii = np.array([float(r["radius_mm"]) if r["radius_mm"] else np.nan for r in rows])
+    return q, labels, radii
+
+
+def distance_list(path):
+    import csv
+
+    with open(path, newline="") as f:
+        return [(r["from"], r["to"], float(r["distance_mm"])) for r in csv.DictReader(f)]
+
+
+def test_constraint_arrays_give_the_files_result(points):
+    _, data, dist = points
+    kr = robocal.Robot.preset(KR)
+    q, labels, radii = constraint_arrays(data)
+    a = robocal.calibrate_constraints(kr, q, labels, radius_mm=radii, distances=distance_list(dist))
+    f = robocal.calibrate_files(kr, data, distances=dist)
+    assert a.data["parameters"] == f.data["parameters"]
+    assert a.data["constraint"] == f.data["constraint"]
+    assert a.status == f.status == "calibrated"
+
+
+def test_sphere_arrays_with_unknown_radius(cli, tmp_path):
+    kr = robocal.Robot.preset(KR)
+    data = tmp_path / "s.csv"
+    cli(
+        "simulate", "--robot", KR, "--truth", "random", "--constraint", "sphere",
+        "--features", "3", "--per-feature", "12", "--unknown-radius", "--radius-mm", "150",
+        "--noise-mm", "0.01", "--out", str(data),
+    )
+    q, labels, radii = constraint_arrays(data)
+    assert radii is not None and all(r != r for r in radii)  # NaN: unknown
+    with pytest.raises(robocal.NumericalError, match="scale is not determined"):
+        robocal.calibrate_constraints(kr, q, labels, radius_mm=radii)
+    with pytest.warns(RuntimeWarning, match="scale is not determined"):
+        a = robocal.calibrate_constraints(kr, q, labels, radius_mm=radii, accept_unknown_scale=True)
+    with pytest.warns(RuntimeWarning, match="scale is not determined"):
+        f = robocal.calibrate_files(kr, data, accept_unknown_scale=True)
+    assert a.data["parameters"] == f.data["parameters"]
+    assert a.data["constraint"] == f.data["constraint"]
+
+
+def test_constraint_arrays_refuse_what_the_file_refuses(points):
+    import numpy as np
+
+    _, data, dist = points
+    kr = robocal.Robot.preset(KR)
+    q, labels, _ = constraint_arrays(data)
+    d = distance_list(dist)
+    # A label used once (a typo), named with its row.
+    typo = list(labels)
+    typo[13] = "point:P9"
+    with pytest.raises(robocal.InputError, match=r"constraint arrays:14.*used on 1 row"):
+        robocal.calibrate_constraints(kr, q, typo, distances=d)
+    # A sphere given two radii.
+    sph = ["sphere:S"] * len(labels)
+    r = np.full(len(labels), 25.0)
+    r[5] = 30.0
+    with pytest.raises(robocal.InputError, match="radius 30 mm here but 25 mm"):
+        robocal.calibrate_constraints(kr, q, sph, radius_mm=r)
+    # A radius on a point's row.
+    with pytest.raises(robocal.InputError, match="not a sphere"):
+        robocal.calibrate_constraints(kr, q, labels, radius_mm=np.full(len(labels), 25.0), distances=d)
+    # A bad label, counts that do not match, an unknown name in the distances.
+    with pytest.raises(robocal.InputError, match="unknown constraint kind `line`"):
+        robocal.calibrate_constraints(kr, q, ["line:A"] * len(labels))
+    with pytest.raises(robocal.InputError, match="one label per row"):
+        robocal.calibrate_constraints(kr, q, labels[:-1], distances=d)
+    with pytest.raises(robocal.InputError, match="one per row"):
+        robocal.calibrate_constraints(kr, q, labels, radius_mm=[1.0], distances=d)
+    with pytest.raises(robocal.InputError, match="`P7` is not a point or sphere"):
+        robocal.calibrate_constraints(kr, q, labels, distances=d + [("P1", "P7", 100.0)])
+    with pytest.raises(robocal.InputError, match="not a positive length"):
+        robocal.calibrate_constraints(kr, q, labels, distances=[("P1", "P2", -1.0)])
+    # Without distances: the scale, as the file.
+    with pytest.raises(robocal.NumericalError, match="accept_unknown_scale=True"):
+        robocal.calibrate_constraints(kr, q, labels)
+
+
+def test_plan_constraints_writes_the_clis_file(cli, tmp_path):
+    kr = robocal.Robot.preset(KR)
+    py_out, cli_out = tmp_path / "py.csv", tmp_path / "cli.csv"
+    p = robocal.plan_constraints(
+        kr, "point", features=3, per_feature=8, candidates_per_feature=40, distances=True,
+        seed=3, out=py_out,
+    )
+    cli(
+        "plan", "--robot", KR, "--constraint", "point", "--features", "3", "--per-feature", "8",
+        "--candidates-per-feature", "40", "--distances", "--seed", "3", "--out", str(cli_out),
+    )
+    assert py_out.read_bytes() == cli_out.read_bytes()
+    q, labels, radii = constraint_arrays(cli_out)
+    assert (p.q == q).all() and p.constraint == labels and p.radius_mm is None
+    assert p.scale_known and "base pose" in p.unseen[0]
+    assert p.planned["workspace_rms_mm"] < p.random["workspace_rms_mm"]
+    assert len(p.planned["std"]) == len(p.parameters)
+    with pytest.raises(robocal.UsageError, match="not point, sphere or plane"):
+        robocal.plan_constraints(kr, "line")
+    bad = tmp_path / "f.csv"
+    bad.write_text("constraint,x,y,z\npoint:A,20000,0,0\n")
+    with pytest.raises(robocal.InputError, match="out of the robot's reach"):
+        robocal.plan_constraints(kr, features_file=bad, per_feature=4, candidates_per_feature=10)

@@ -38,7 +38,8 @@ def test_every_public_name_has_a_stub(stub):
     assert not missing, missing
 
 
-@pytest.mark.parametrize("name", ["calibrate", "calibrate_files", "evaluate", "compensate", "simulate", "plan",
+@pytest.mark.parametrize("name", ["calibrate", "calibrate_files", "calibrate_constraints", "plan_constraints",
+                                  "evaluate", "compensate", "simulate", "plan",
                                   "iso9283_plan", "iso9283_evaluate"])
 def test_function_signatures_match(stub, name):
     fn = stub_functions(stub)[name]

@@ -34,33 +34,7 @@ pub(super) fn run(a: &SimulateArgs, kind: &str) -> anyhow::Result<()> {
         ));
     }
     let nominal = super::common::robot(&a.robot)?;
-    let truth = TruthSource::from_arg(&a.truth, &nominal)
-        .with_context(|| format!("--truth {}", a.truth))?;
-    let random = matches!(truth, TruthSource::Random);
-    if !random
-        && (a.length_error_mm.is_some() || a.angle_error_deg.is_some() || a.tilt_parallel_axes)
-    {
-        return Err(exit::usage(
-            "--length-error-mm, --angle-error-deg and --tilt-parallel-axes apply only to --truth \
-             random",
-        ));
-    }
-    let (truth, errors) = match truth {
-        TruthSource::Random => {
-            let d = GeometricErrors::default();
-            let e = GeometricErrors {
-                length_sigma_mm: a.length_error_mm.unwrap_or(d.length_sigma_mm),
-                angle_sigma_deg: a.angle_error_deg.unwrap_or(d.angle_sigma_deg),
-                tilt_parallel_axes: a.tilt_parallel_axes,
-            };
-            let t = e.apply(&nominal, &mut stream_rng(a.seed, Stream::Truth))?;
-            (t, Some(e))
-        }
-        TruthSource::Robot(t) | TruthSource::File { robot: t, .. } => {
-            check_truth_matches(&nominal, &t)?;
-            (t, None)
-        }
-    };
+    let (truth, errors) = truth_of(a, &nominal)?;
     let spec = ConstraintSimulation {
         kind,
         features: a.features,
@@ -167,4 +141,156 @@ fn gravity(a: &SimulateArgs, dof: usize) -> anyhow::Result<Option<GravityModel>>
     g.validate(dof)
         .map_err(|e| exit::usage(format!("--compliance: {e}")))?;
     Ok(Some(g))
+}
+
+/// The true robot of `a.truth` (and the random errors' sizes, for a random truth).
+fn truth_of(
+    a: &SimulateArgs,
+    nominal: &robocal_core::Robot,
+) -> anyhow::Result<(robocal_core::Robot, Option<GeometricErrors>)> {
+    let truth =
+        TruthSource::from_arg(&a.truth, nominal).with_context(|| format!("--truth {}", a.truth))?;
+    let random = matches!(truth, TruthSource::Random);
+    if !random
+        && (a.length_error_mm.is_some() || a.angle_error_deg.is_some() || a.tilt_parallel_axes)
+    {
+        return Err(exit::usage(
+            "--length-error-mm, --angle-error-deg and --tilt-parallel-axes apply only to --truth \
+             random",
+        ));
+    }
+    Ok(match truth {
+        TruthSource::Random => {
+            let d = GeometricErrors::default();
+            let e = GeometricErrors {
+                length_sigma_mm: a.length_error_mm.unwrap_or(d.length_sigma_mm),
+                angle_sigma_deg: a.angle_error_deg.unwrap_or(d.angle_sigma_deg),
+                tilt_parallel_axes: a.tilt_parallel_axes,
+            };
+            let t = e.apply(nominal, &mut stream_rng(a.seed, Stream::Truth))?;
+            (t, Some(e))
+        }
+        TruthSource::Robot(t) | TruthSource::File { robot: t, .. } => {
+            check_truth_matches(nominal, &t)?;
+            (t, None)
+        }
+    })
+}
+
+/// Measures the constraint plan at `plan` (`--constraint-plan`): the true robot of `a.truth`
+/// touches every planned contact (`simulation::constraint::measure_plan`); writes the
+/// measurement CSV, the truth file and, with `--distances-out`, the true distances.
+pub(super) fn run_plan(a: &SimulateArgs, plan: &std::path::Path) -> anyhow::Result<()> {
+    use robocal_core::io::{read_measurements, Positions};
+    use robocal_core::observations::constraint::ConstraintData;
+    use robocal_core::simulation::constraint::measure_plan;
+    let nominal = super::common::robot(&a.robot)?;
+    let truth_out = super::truth_path(&a.out);
+    let mut io = super::super::io_plan::IoPlan::new();
+    io.robot("--robot", &a.robot);
+    if a.truth != "random" {
+        io.robot("--truth", &a.truth);
+    }
+    io.input("--constraint-plan", plan)
+        .output(
+            "--out",
+            &a.out,
+            "the truth file is written beside it (FILE.truth.json)",
+        )
+        .derived_output(
+            "--out",
+            &a.out,
+            &truth_out,
+            "the truth file written beside it",
+        );
+    if let Some(d) = &a.distances_out {
+        io.output("--distances-out", d, "calibrate reads it");
+    }
+    io.check()?;
+    let set = read_measurements(plan, nominal.joint_space(), Positions::Ignored)?;
+    let planned = ConstraintData::from_measurements(&set)?;
+    if a.distances_out.is_some()
+        && planned
+            .features
+            .iter()
+            .filter(|f| f.kind != ConstraintKind::Plane)
+            .count()
+            < 2
+    {
+        return Err(exit::usage(
+            "--distances-out: the plan has fewer than two points or spheres (distances are \
+             between points or sphere centres)",
+        ));
+    }
+    let (truth, errors) = truth_of(a, &nominal)?;
+    let (sim, missed) = measure_plan(
+        &truth,
+        &nominal,
+        &planned,
+        a.noise_mm,
+        a.seed,
+        a.distances_out.is_some(),
+    )?;
+    let csv = measurements_csv(&constraint_measurements(&nominal, &sim.data))?;
+    let dist = distances_csv(&sim.data).into_bytes();
+    let file_name = a
+        .out
+        .file_name()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let kind = planned.features[0].kind;
+    let spec = ConstraintSimulation {
+        kind,
+        features: planned.features.len(),
+        per_feature: 0,
+        noise_mm: a.noise_mm,
+        seed: a.seed,
+        distances: a.distances_out.is_some(),
+        ..ConstraintSimulation::default()
+    };
+    let truth_json = truth_json(
+        (&nominal, &truth),
+        (&a.truth, errors),
+        &spec,
+        &sim,
+        &file_name,
+    )?
+    .into_bytes();
+    let mut files: Vec<(&std::path::Path, &[u8])> = vec![(&a.out, &csv), (&truth_out, &truth_json)];
+    if let Some(d) = &a.distances_out {
+        files.push((d, &dist));
+    }
+    write_all_atomic(&files)?;
+    if !missed.is_empty() {
+        let lines: Vec<String> = missed
+            .iter()
+            .map(|&i| planned.rows[i].line.to_string())
+            .collect();
+        errln!(
+            "warning: the true robot does not reach {} planned contact(s) from the planned \
+             configuration within its joint limits (at a limit or a singularity); left out, as an \
+             operator would skip them: {} line(s) {}",
+            missed.len(),
+            plan.display(),
+            lines.join(", ")
+        )?;
+    }
+    outln!(
+        "{} constraint row(s) of the plan {} measured by the true robot, contact noise {} mm; \
+         written to {}{}",
+        sim.data.rows.len(),
+        plan.display(),
+        a.noise_mm,
+        a.out.display(),
+        a.distances_out.as_ref().map_or(String::new(), |d| format!(
+            ", {} distance(s) to {}",
+            sim.data.distances.len(),
+            d.display()
+        ))
+    )?;
+    outln!(
+        "truth (the true robot and the true features, base frame of the true robot): {}",
+        truth_out.display()
+    )?;
+    Ok(())
 }

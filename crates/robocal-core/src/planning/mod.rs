@@ -19,6 +19,8 @@
 //! candidates of `sigma sqrt(tr(J_i M^-1 J_i^T))`.
 
 mod builder;
+pub mod constraint;
+pub mod constraint_features;
 pub mod design;
 pub mod pooled;
 pub mod select;
@@ -168,7 +170,7 @@ fn jacobians(robot: &Robot, index: &[usize], qs: &[Vec<f64>]) -> Vec<f64> {
 }
 
 /// Scales every column of `j` (blocks of `ROWS x k`) by `1 / scale`.
-fn scale_columns(j: &mut [f64], k: usize, scale: &[f64]) {
+pub(crate) fn scale_columns(j: &mut [f64], k: usize, scale: &[f64]) {
     for row in j.chunks_exact_mut(k) {
         for (v, s) in row.iter_mut().zip(scale) {
             *v /= s;
@@ -192,7 +194,13 @@ fn weight_by_noise(j: &mut [f64], k: usize, robot: &Robot, qs: &[Vec<f64>], s: &
 }
 
 /// The quality of the information matrix `m` (scaled, no ridge) of `n` poses.
-fn quality(m: &DMatrix<f64>, n: usize, scale: &[f64], blocks: &Blocks, noise: f64) -> Quality {
+pub(crate) fn quality(
+    m: &DMatrix<f64>,
+    n: usize,
+    scale: &[f64],
+    blocks: &Blocks,
+    noise: f64,
+) -> Quality {
     let k = m.nrows();
     let ld = log_det(m);
     let (std, ws) = match m.clone().cholesky() {

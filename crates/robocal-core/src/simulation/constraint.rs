@@ -120,7 +120,7 @@ pub struct SimulatedConstraints {
 }
 
 /// Reference configurations tried per feature before giving up.
-const REFERENCE_TRIES: usize = 50;
+pub(crate) const REFERENCE_TRIES: usize = 50;
 
 /// Simulates `spec` on the true robot `truth`, reference configurations drawn by `sampler`.
 pub fn simulate_constraints(
@@ -230,6 +230,28 @@ fn feature_rows<R: Rng>(
         ConstraintKind::Sphere => (p0 - spec.radius_mm * z0, None),
         ConstraintKind::Plane => (p0, Some(z0)),
     };
+    let rows = contacts(truth, ik, q0, spec, rng)?;
+    Some((rows, position, normal))
+}
+
+/// The configurations of one feature touched from reference configuration `q0` (whose tool
+/// pose is the reference contact, its z axis the feature's normal): `spec.per_feature` of
+/// them, or `None` when the robot misses too many contacts.
+pub(crate) fn contacts<R: Rng>(
+    truth: &Robot,
+    ik: &Compensator<'_>,
+    q0: &[f64],
+    spec: &ConstraintSimulation,
+    rng: &mut R,
+) -> Option<Vec<Vec<f64>>> {
+    let t0 = truth.tool_pose(q0);
+    let r0 = t0.rotation;
+    let p0 = t0.translation.vector;
+    let z0 = r0.matrix().column(2).into_owned();
+    let position = match spec.kind {
+        ConstraintKind::Sphere => p0 - spec.radius_mm * z0,
+        _ => p0,
+    };
     let (t1, t2) = crate::identification::constraint::features::tangents(&z0);
     let cone = (spec.span_mm / spec.radius_mm).min(80f64.to_radians());
     let mut rows = Vec::with_capacity(spec.per_feature);
@@ -272,7 +294,138 @@ fn feature_rows<R: Rng>(
             }
         }
     }
-    Some((rows, position, normal))
+    Some(rows)
+}
+
+/// The rows of `planned` (configurations in which `nominal` touches the features) as the true
+/// robot `truth` measures them: each configuration moved by inverse kinematics on the truth,
+/// from the planned one, until the truth's tool frame is where the nominal's was (the operator
+/// jogs the probe into the socket or onto the surface), the contact with Gaussian noise
+/// `noise_mm` per axis (seed `seed`). Distances are kept. A contact the truth cannot reach from
+/// there within its joint limits (a planned configuration at a limit or a singularity) is left
+/// out, as an operator would skip it: its index (0-based, in `planned.rows`) is returned beside
+/// the data; a feature left with fewer rows than it needs is an error naming it.
+pub fn touch(
+    truth: &Robot,
+    nominal: &Robot,
+    planned: &ConstraintData,
+    noise_mm: f64,
+    seed: u64,
+) -> Result<(ConstraintData, Vec<usize>)> {
+    if !(0.0..=10.0).contains(&noise_mm) {
+        return Err(Error::invalid(
+            "noise_mm",
+            format!("{noise_mm} is not within 0..10 mm"),
+        ));
+    }
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let mut ik = Compensator::new(truth, truth, DampedLeastSquares::default())?;
+    ik.pose_solver.tolerance_mm = 1e-10;
+    ik.pose_solver.tolerance_deg = 1e-9;
+    let mut out = planned.clone();
+    let mut q = vec![0.0; truth.dof()];
+    let mut missed = Vec::new();
+    for (i, r) in out.rows.iter_mut().enumerate() {
+        let t = nominal.tool_pose(&r.q);
+        let noise = Vector3::from_fn(|_, _| {
+            let z: f64 = StandardNormal.sample(&mut rng);
+            noise_mm * z
+        });
+        let target =
+            Frame::from_parts(Translation3::from(t.translation.vector + noise), t.rotation);
+        let rep = ik.reach_pose(&target, Some(&r.q), &mut q);
+        if !rep.status.reaches_target() || !truth.joints_outside_limits(&q).is_empty() {
+            missed.push(i);
+            continue;
+        }
+        r.q.clone_from(&q);
+    }
+    let mut i = 0;
+    out.rows.retain(|_| {
+        i += 1;
+        !missed.contains(&(i - 1))
+    });
+    out.check_counts().map_err(|e| {
+        Error::Numerical(format!(
+            "the true robot does not reach {} of the planned contacts from their planned \
+             configurations: {e}",
+            missed.len()
+        ))
+    })?;
+    Ok((out, missed))
+}
+
+/// A plan's configurations (`planned`, where `nominal` touches its features) measured by the
+/// true robot `truth` ([`touch`]), with the features' true places: where the nominal's planned
+/// contacts put them (the truth reaches the same poses of the base frame), from the nominal
+/// tool points of each feature's rows (a point's mean, a sphere's centre, a plane's point and
+/// normal; exact for the noise-free plan). With `distances`, the true distances between every
+/// pair of points or sphere centres replace the plan's. The rows the truth missed are returned
+/// beside (see [`touch`]).
+pub fn measure_plan(
+    truth: &Robot,
+    nominal: &Robot,
+    planned: &ConstraintData,
+    noise_mm: f64,
+    seed: u64,
+    distances: bool,
+) -> Result<(SimulatedConstraints, Vec<usize>)> {
+    use crate::identification::constraint::FeatureEstimate;
+    let (mut data, missed) = touch(truth, nominal, planned, noise_mm, seed)?;
+    let mut true_positions = Vec::new();
+    let mut true_normals = Vec::new();
+    for (k, f) in planned.features.iter().enumerate() {
+        let pts: Vec<Vector3<f64>> = planned
+            .rows_of(k)
+            .map(|r| nominal.tool_position(&r.q))
+            .collect();
+        // A sphere of unknown radius: its centre and radius from the points.
+        let e = FeatureEstimate::start(f.kind, &f.name, f.radius_mm, &pts).map_err(|m| {
+            planned.parse_error(
+                f.first_line,
+                crate::observations::constraint::CONSTRAINT_COLUMN,
+                m,
+            )
+        })?;
+        match f.kind {
+            ConstraintKind::Plane => {
+                let n = e.normal.unwrap_or(Vector3::z());
+                true_positions.push(pts.iter().sum::<Vector3<f64>>() / pts.len().max(1) as f64);
+                true_normals.push(Some(n));
+            }
+            _ => {
+                true_positions.push(e.position);
+                true_normals.push(None);
+            }
+        }
+    }
+    data.distances.clear();
+    if distances {
+        let n = planned.features.len();
+        for a in 0..n {
+            for b in a + 1..n {
+                if planned.features[a].kind == ConstraintKind::Plane
+                    || planned.features[b].kind == ConstraintKind::Plane
+                {
+                    continue;
+                }
+                data.distances.push(KnownDistance {
+                    from: a,
+                    to: b,
+                    distance_mm: (true_positions[a] - true_positions[b]).norm(),
+                    line: 0,
+                });
+            }
+        }
+    }
+    Ok((
+        SimulatedConstraints {
+            data,
+            true_positions,
+            true_normals,
+        },
+        missed,
+    ))
 }
 
 /// The measurement file of simulated constraint data: joints, `constraint` and (for spheres)

@@ -57,6 +57,9 @@ __all__ = [
     "Parameter",
     "calibrate",
     "calibrate_files",
+    "calibrate_constraints",
+    "plan_constraints",
+    "ConstraintPlan",
     "evaluate",
     "compensate",
     "simulate",
@@ -526,3 +529,4 @@ def plan(
 from ._importing import Imported, import_measurements  # noqa: E402
 from ._simulating import PerJoint, simulate, simulate_constraints  # noqa: E402
 from ._iso9283 import iso9283_evaluate, iso9283_plan  # noqa: E402
+from ._constraints import ConstraintPlan, calibrate_constraints, plan_constraints  # noqa: E402

@@ -194,6 +194,58 @@ def calibrate_files(
     """The CLI's ``robocal calibrate --data DATA [--validate VALIDATE]``; a constraint file with
     ``[--distances DISTANCES] [--accept-unknown-scale]``."""
 
+def calibrate_constraints(
+    robot: Robot,
+    q: ArrayLike,
+    constraint: Sequence[str],
+    *,
+    radius_mm: Optional[ArrayLike] = None,
+    distances: Optional[Sequence[Tuple[str, str, float]]] = None,
+    accept_unknown_scale: bool = False,
+    accept_implausible: bool = False,
+    nominal_limits: bool = False,
+    rank_tol: Optional[float] = None,
+) -> Result:
+    """The array form of ``calibrate_files`` on constraint data: joints (n, dof) in degrees, one
+    ``constraint`` label per row, ``radius_mm`` per row (NaN: unknown), ``distances`` as
+    ``(from, to, mm)``."""
+
+class ConstraintPlan(NamedTuple):
+    """A constraint plan: ``robocal plan --constraint``'s file and figures."""
+
+    q: FloatArray
+    constraint: List[str]
+    radius_mm: Optional[FloatArray]
+    features: List[Dict[str, Any]]
+    parameters: List[str]
+    unseen: List[str]
+    scale_known: bool
+    planned: Dict[str, Any]
+    random: Dict[str, Any]
+    weakest: List[Dict[str, Any]]
+
+def plan_constraints(
+    robot: Robot,
+    constraint: str = "point",
+    *,
+    features: int = 4,
+    features_file: Optional[PathLike] = None,
+    per_feature: int = 20,
+    candidates_per_feature: int = 200,
+    radius_mm: float = 25.0,
+    unknown_radius: bool = False,
+    distances: bool = False,
+    tilt_deg: float = 60.0,
+    span_mm: float = 300.0,
+    noise_mm: float = 0.01,
+    seed: int = 1,
+    criterion: str = "workspace",
+    floor_mm: float = 0.0,
+    footprint_mm: Optional[float] = None,
+    out: Optional[PathLike] = None,
+) -> ConstraintPlan:
+    """The CLI's ``robocal plan --constraint KIND`` (or ``--features-file``)."""
+
 def simulate_constraints(
     robot: Robot,
     out: PathLike,
