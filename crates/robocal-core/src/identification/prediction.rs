@@ -678,8 +678,18 @@ pub(crate) fn predict_with(
 /// The poses of `n` a prediction averages over: every one, or an even spread of at most
 /// [`MAX_POSES`].
 fn averaged_poses(n: usize) -> Vec<usize> {
-    (0..n).step_by(n.div_ceil(MAX_POSES).max(1)).collect()
+    averaged_poses_up_to(n, MAX_POSES)
 }
+
+/// Every pose of `n`, or an even spread of at most `max`.
+fn averaged_poses_up_to(n: usize, max: usize) -> Vec<usize> {
+    (0..n).step_by(n.div_ceil(max).max(1)).collect()
+}
+
+#[path = "prediction_candidate.rs"]
+mod candidate;
+pub(crate) use candidate::predict_for_candidate;
+pub use candidate::CANDIDATE_POSES;
 
 #[cfg(test)]
 #[path = "prediction_tests.rs"]

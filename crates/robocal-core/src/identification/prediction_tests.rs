@@ -254,3 +254,49 @@ fn prediction_matches_a_direct_computation() {
     );
     assert_eq!(p.map.len(), MAP_POSES);
 }
+
+/// A candidate's lighter prediction (the noise by one degrees-of-freedom correction, the mean
+/// over at most [`CANDIDATE_POSES`] poses) is within 1% of the full one on calibrations of
+/// noisy simulated data, small and large, with noise growing with the distance as a tracker's.
+#[test]
+fn a_candidates_prediction_is_close_to_the_full_one() {
+    use crate::identification::pipeline::{calibrate_model, CalibrationData};
+    use rand_distr::{Distribution, Normal};
+    let truth = crate::model::presets::preset("kuka-kr480-r3330-table3").unwrap();
+    let nominal = crate::model::presets::preset("kuka-kr480-r3330").unwrap();
+    for (n, seed) in [(75, 1), (1500, 2)] {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let qs = random_poses(&truth, n, &PoseSampler::default(), &mut rng).unwrap();
+        let unit = Normal::new(0.0, 1.0).unwrap();
+        let mut obs = Observations::new(6);
+        for (i, q) in qs.iter().enumerate() {
+            let p = truth.tool_position(q);
+            let sigma = 0.01 + 0.01 * p.norm() / 1000.0;
+            let m = p.map(|v| v + sigma * unit.sample(&mut rng));
+            obs.push(q, m, i + 2).unwrap();
+        }
+        let data = CalibrationData {
+            calibration: &obs,
+            plane: None,
+            validation: None,
+        };
+        let cal = calibrate_model(&nominal, data, &Default::default(), &()).unwrap();
+        let full = cal.prediction.as_ref().expect("a prediction");
+        let threshold = cal.robust_scale_mm;
+        let light = predict_for_candidate(
+            &cal.calibrated,
+            &cal.covariance,
+            &obs,
+            &cal.calibration.after,
+            threshold,
+        )
+        .expect("a candidate's prediction");
+        for (what, a, b) in [
+            ("mean", light.mean_mm, full.mean_mm),
+            ("noise", light.noise_sigma_mm, full.noise_sigma_mm),
+        ] {
+            assert!((a / b - 1.0).abs() < 0.01, "{n} poses, {what}: {a} vs {b}");
+        }
+        assert!(light.map.is_empty());
+    }
+}

@@ -12,7 +12,7 @@ use crate::error::Result;
 use crate::identification::covariance::Covariance;
 use crate::identification::objective::{robust_sigma, ROBUST_SCALE_SIGMAS};
 use crate::identification::plausibility::{self, Plausibility};
-use crate::identification::prediction::{predict_with, Prediction};
+use crate::identification::prediction::{predict, predict_for_candidate, Prediction};
 use crate::identification::set_errors::{DownWeighted, SetErrors};
 use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
@@ -69,14 +69,13 @@ pub(super) fn assemble(
     let threshold = solved.robust_scale.unwrap_or_else(|| {
         ROBUST_SCALE_SIGMAS * robust_sigma(&calibration.after, problem.kind().rows())
     });
-    let prediction = predict_with(
-        robot,
-        &covariance,
-        cal,
-        &calibration.after,
-        Some(threshold),
-        purpose == Purpose::Result,
-    );
+    let prediction = match purpose {
+        Purpose::Result => predict(robot, &covariance, cal, &calibration.after, Some(threshold)),
+        // Only the candidate's gate reads it (see `predict_for_candidate`).
+        Purpose::Candidate => {
+            predict_for_candidate(robot, &covariance, cal, &calibration.after, Some(threshold))
+        }
+    };
     let (validation, validation_frame) = validation_errors(nominal, data, settings, &start, robot)?;
     let downweighted = solved.robust_scale.map_or_else(Vec::new, |c| {
         let norms = match &solved.final_norms {
