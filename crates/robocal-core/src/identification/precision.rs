@@ -18,7 +18,7 @@
 //! (wrong units, another robot): the bound then means nothing and the gate names the cause.
 
 use crate::identification::objective::Loss;
-use crate::identification::system::{Level, Problem};
+use crate::identification::system::{Accumulated, Level, Problem};
 use crate::model::family::plausible;
 use crate::model::{Param, Robot};
 use nalgebra::DMatrix;
@@ -51,12 +51,35 @@ pub fn undetermined(
     sigma0_mm: f64,
     keep_always: &[Param],
 ) -> Vec<Undetermined> {
+    undetermined_keeping(start, problem, sigma0_mm, keep_always).0
+}
+
+/// [`undetermined`], also returning its pass: the full pass ([`Level::Full`]) of `problem` at
+/// `start` with the squared loss, which a least-squares solve from `start` starts with.
+pub(crate) fn undetermined_keeping(
+    start: &Robot,
+    problem: &Problem,
+    sigma0_mm: f64,
+    keep_always: &[Param],
+) -> (Vec<Undetermined>, Option<Accumulated>) {
     let params = problem.params();
     if !(sigma0_mm > 0.0 && sigma0_mm.is_finite()) || params.is_empty() {
-        return Vec::new();
+        return (Vec::new(), None);
     }
     let acc = problem.accumulate(start, &Loss::Squared, Level::Full);
-    let Some(s) = acc.s else { return Vec::new() };
+    let out = undetermined_from(start, params, &acc, sigma0_mm, keep_always);
+    (out, Some(acc))
+}
+
+/// [`undetermined`] from the pass `acc` over `params`.
+fn undetermined_from(
+    start: &Robot,
+    params: &[Param],
+    acc: &Accumulated,
+    sigma0_mm: f64,
+    keep_always: &[Param],
+) -> Vec<Undetermined> {
+    let Some(s) = &acc.s else { return Vec::new() };
     let mut keep: Vec<usize> = (0..params.len()).collect();
     let mut out = Vec::new();
     while !keep.is_empty() {

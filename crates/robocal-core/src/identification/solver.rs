@@ -140,20 +140,23 @@ pub fn solve(
     opts: &SolverOptions,
     observer: &dyn Observer,
 ) -> SolverReport {
-    solve_keeping(problem, robot, loss, opts, observer).0
+    solve_keeping(problem, robot, loss, opts, observer, None).0
 }
 
 /// [`solve`], also returning the full pass ([`Level::Full`]) at the final `robot` when the solve
 /// ended on one (a solve that stops at its start, as the last stage of a reweighted fit usually
-/// does): the covariance needs exactly that pass, which is then not repeated.
+/// does): the covariance needs exactly that pass, which is then not repeated. `first`, when
+/// given, is the full pass at the starting `robot` with `loss` (computed before, by the
+/// identifiability's precision analysis), not repeated either.
 pub(crate) fn solve_keeping(
     problem: &Problem,
     robot: &mut Robot,
     loss: &Loss,
     opts: &SolverOptions,
     observer: &dyn Observer,
+    first: Option<Accumulated>,
 ) -> (SolverReport, Option<Accumulated>) {
-    let (report, acc, current) = solve_inner(problem, robot, loss, opts, observer);
+    let (report, acc, current) = solve_inner(problem, robot, loss, opts, observer, first);
     let full = current && acc.h.is_some() && acc.s.is_some();
     (report, full.then_some(acc))
 }
@@ -165,6 +168,7 @@ fn solve_inner(
     loss: &Loss,
     opts: &SolverOptions,
     observer: &dyn Observer,
+    first: Option<Accumulated>,
 ) -> (SolverReport, Accumulated, bool) {
     let k = problem.params().len();
     let n = problem.len().max(1) as f64;
@@ -175,7 +179,9 @@ fn solve_inner(
     } else {
         Level::Newton
     };
-    let first = problem.accumulate(robot, loss, Level::Full);
+    let first = first
+        .filter(|f| f.s.is_some() && f.h.is_some() && f.a.nrows() == k)
+        .unwrap_or_else(|| problem.accumulate(robot, loss, Level::Full));
     // RMS tool displacement per unit change of each parameter, for the step test.
     let s = first.s.as_ref().expect("full pass");
     let col_rms: Vec<f64> = (0..k).map(|j| (s[(j, j)] / n).sqrt()).collect();

@@ -121,6 +121,25 @@ pub struct Accumulated {
     pub rows: usize,
 }
 
+impl Accumulated {
+    /// This pass as it would have been over the parameters at positions `cols` of its own
+    /// (ascending or not): the sums of each pair of columns do not depend on the others.
+    pub(crate) fn restricted(&self, cols: &[usize]) -> Accumulated {
+        let m = cols.len();
+        let sub = |x: &DMatrix<f64>| DMatrix::from_fn(m, m, |r, c| x[(cols[r], cols[c])]);
+        Accumulated {
+            objective: self.objective,
+            weighted_sq: self.weighted_sq,
+            a: sub(&self.a),
+            b: DVector::from_fn(m, |r, _| self.b[cols[r]]),
+            s: self.s.as_ref().map(sub),
+            h: self.h.as_ref().map(sub),
+            psi_sq: self.psi_sq,
+            rows: self.rows,
+        }
+    }
+}
+
 #[path = "system_acc.rs"]
 mod acc;
 pub(crate) use acc::add_gram;

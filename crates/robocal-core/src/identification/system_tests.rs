@@ -196,7 +196,7 @@ fn the_kept_pass_is_the_full_pass_at_the_solution() {
         assert_eq!(kept.s, fresh.s);
     };
     let mut robot = nominal.clone();
-    let (moved, kept) = solve_keeping(&p, &mut robot, &loss, &opts, &());
+    let (moved, kept) = solve_keeping(&p, &mut robot, &loss, &opts, &(), None);
     assert!(
         moved.termination.converged() && moved.iterations > 1,
         "{moved:?}"
@@ -205,9 +205,56 @@ fn the_kept_pass_is_the_full_pass_at_the_solution() {
         same(k, &robot);
     }
     let at_minimum = robot.clone();
-    let (again, kept) = solve_keeping(&p, &mut robot, &loss, &opts, &());
+    let (again, kept) = solve_keeping(&p, &mut robot, &loss, &opts, &(), None);
     assert!(again.termination.converged(), "{again:?}");
     let kept = kept.expect("a solve that stops at its start keeps its full pass");
     same(&kept, &robot);
     assert_eq!(p.values(&robot), p.values(&at_minimum));
+}
+
+/// A pass restricted to some of its parameters equals the pass over those parameters alone; a
+/// solve given the pass at its start (as the precision analysis hands it over) ends where the
+/// solve computing it ends, bit for bit.
+#[test]
+fn a_restricted_start_pass_is_the_subsets_own_and_the_solve_from_it_the_same() {
+    let (nominal, obs) = kr480_problem_data(40, 0.02);
+    let all: Vec<Param> = nominal
+        .params()
+        .into_iter()
+        .filter(|p| {
+            ["a2", "a3", "d4", "phi2", "phi3", "alpha2", "alpha3"].contains(&p.name().as_str())
+        })
+        .collect();
+    let some: Vec<Param> = vec![all[4], all[0], all[2]];
+    let cols: Vec<usize> = some
+        .iter()
+        .map(|p| all.iter().position(|a| a == p).unwrap())
+        .collect();
+    let frame = TrackerFrame::identity();
+    let big = Problem::new(&nominal, &all, &obs, &frame);
+    let small = Problem::new(&nominal, &some, &obs, &frame);
+    let restricted = big
+        .accumulate(&nominal, &Loss::Squared, Level::Full)
+        .restricted(&cols);
+    let own = small.accumulate(&nominal, &Loss::Squared, Level::Full);
+    let close = |a: &DMatrix<f64>, b: &DMatrix<f64>| (a - b).amax() <= 1e-12 * b.amax();
+    assert!(close(&restricted.a, &own.a));
+    assert!(close(
+        restricted.s.as_ref().unwrap(),
+        own.s.as_ref().unwrap()
+    ));
+    assert!(close(
+        restricted.h.as_ref().unwrap(),
+        own.h.as_ref().unwrap()
+    ));
+    assert!((&restricted.b - &own.b).amax() <= 1e-12 * own.b.amax());
+    assert_eq!(restricted.objective.to_bits(), own.objective.to_bits());
+    use crate::identification::solver::{solve_keeping, SolverOptions};
+    let opts = SolverOptions::default();
+    let (mut r1, mut r2) = (nominal.clone(), nominal.clone());
+    let (a, _) = solve_keeping(&small, &mut r1, &Loss::Squared, &opts, &(), None);
+    let (b, _) = solve_keeping(&small, &mut r2, &Loss::Squared, &opts, &(), Some(own));
+    assert_eq!(a.iterations, b.iterations);
+    assert_eq!(a.evaluations, b.evaluations);
+    assert_eq!(small.values(&r1), small.values(&r2));
 }

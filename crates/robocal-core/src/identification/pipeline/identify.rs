@@ -20,6 +20,9 @@ pub(super) struct Identified {
     /// Set when the identified parameters are too nearly dependent for the covariance to have
     /// reliable digits (allowed only by `allow_ill_conditioned`).
     pub ill_conditioned: Option<String>,
+    /// The full pass at the start model with the squared loss over the identified parameters,
+    /// when the precision analysis computed it (a least-squares solve's first pass).
+    pub start_pass: Option<crate::identification::system::Accumulated>,
 }
 
 /// Analyzes identifiability at the start model: rank and conditioning of the scaled Jacobian,
@@ -42,9 +45,10 @@ pub(super) fn identifiable(
     } else {
         0.0
     };
-    let undetermined = precision::undetermined(
+    let analyzed = ident.identified.clone();
+    let (undetermined, pass) = precision::undetermined_keeping(
         &start.robot,
-        &Problem::new(&start.robot, &ident.identified, cal, &start.frame),
+        &Problem::new(&start.robot, &analyzed, cal, &start.frame),
         sigma0,
         &opts.free,
     );
@@ -84,9 +88,17 @@ pub(super) fn identifiable(
             cal.len()
         )));
     }
+    // The pass over the parameters finally identified, when they are among those analyzed.
+    let cols: Option<Vec<usize>> = ident
+        .identified
+        .iter()
+        .map(|p| analyzed.iter().position(|a| a == p))
+        .collect();
+    let start_pass = pass.zip(cols).map(|(pass, cols)| pass.restricted(&cols));
     Ok(Identified {
         identifiability: ident,
         ill_conditioned,
+        start_pass,
     })
 }
 

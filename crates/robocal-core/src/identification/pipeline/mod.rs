@@ -270,7 +270,8 @@ fn calibrate_once(
     registered: &start::Registered,
 ) -> Result<Calibration> {
     let start = start::prepare(nominal, &data, settings, registered)?;
-    let identified = identify::identifiable(nominal, &start, &settings.identifiability, observer)?;
+    let mut identified =
+        identify::identifiable(nominal, &start, &settings.identifiability, observer)?;
     let solved = {
         let problem = Problem::new(
             &start.robot,
@@ -284,6 +285,7 @@ fn calibrate_once(
             start.tool_fit.applied,
             settings,
             observer,
+            identified.start_pass.take(),
         )?
     };
     let job = Job {
@@ -330,6 +332,7 @@ pub(crate) fn complete(
     let identified = identify::Identified {
         ill_conditioned: identify::ill_conditioned(&cal.identifiability),
         identifiability: cal.identifiability,
+        start_pass: None,
     };
     let solved = stages::Solved {
         robot: cal.calibrated,

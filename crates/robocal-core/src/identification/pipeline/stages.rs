@@ -55,6 +55,8 @@ struct Runs<'p, 'a> {
     stages: Vec<Stage>,
     /// The last run's full pass at `robot`, when it ended on one.
     final_pass: Option<Accumulated>,
+    /// The full pass at the start with the squared loss, for a first run of least squares.
+    first_pass: Option<Accumulated>,
 }
 
 impl Runs<'_, '_> {
@@ -66,8 +68,18 @@ impl Runs<'_, '_> {
             max_iterations: self.settings.solver.max_iterations.saturating_sub(used),
             ..self.settings.solver
         };
-        let (report, pass) =
-            solve_keeping(self.problem, &mut self.robot, &loss, &opts, self.observer);
+        let first = self
+            .first_pass
+            .take()
+            .filter(|_| self.stages.is_empty() && loss == Loss::Squared);
+        let (report, pass) = solve_keeping(
+            self.problem,
+            &mut self.robot,
+            &loss,
+            &opts,
+            self.observer,
+            first,
+        );
         self.final_pass = pass;
         if let crate::identification::solver::Termination::Failed(m) = &report.termination {
             return Err(Error::Numerical(format!(
@@ -96,13 +108,15 @@ impl Runs<'_, '_> {
 
 /// Identifies the parameters of `problem` from `start` with the settings' objective. `tools_fit`:
 /// whether the start model fits the data (the tools fitted to the nominal geometry were applied).
-/// A large problem starts on a subsample (see the module docs).
+/// A large problem starts on a subsample (see the module docs). `start_pass`: the full pass at
+/// `start` with the squared loss, when computed before (the first least-squares run's).
 pub(super) fn solve_stages(
     problem: &Problem,
     start: &Robot,
     tools_fit: bool,
     settings: &CalibrationSettings,
     observer: &dyn Observer,
+    start_pass: Option<Accumulated>,
 ) -> Result<Solved> {
     let n = problem.len();
     if n >= settings.solver.warm_start_min_points {
@@ -113,7 +127,7 @@ pub(super) fn solve_stages(
                 i % step == 0
             })?;
         let sub = problem.restricted(&sub_obs, &kept);
-        let warm = solve_from(&sub, start, tools_fit, settings, observer, None)?;
+        let warm = solve_from(&sub, start, tools_fit, settings, observer, None, None)?;
         if warm
             .stages
             .last()
@@ -128,11 +142,14 @@ pub(super) fn solve_stages(
                 settings,
                 observer,
                 Some(stages),
+                None,
             );
         }
         // A subsample that does not converge says nothing of the whole: the whole way then.
     }
-    solve_from(problem, start, tools_fit, settings, observer, None)
+    solve_from(
+        problem, start, tools_fit, settings, observer, None, start_pass,
+    )
 }
 
 /// The runs of [`solve_stages`] from `start`; after a warm start (its runs `warm`), the
@@ -144,6 +161,7 @@ fn solve_from(
     settings: &CalibrationSettings,
     observer: &dyn Observer,
     warm: Option<Vec<Stage>>,
+    start_pass: Option<Accumulated>,
 ) -> Result<Solved> {
     let warm_started = warm.is_some();
     let mut runs = Runs {
@@ -153,6 +171,7 @@ fn solve_from(
         robot: start.clone(),
         stages: warm.unwrap_or_default(),
         final_pass: None,
+        first_pass: start_pass,
     };
     let son = Loss::SumOfNorms {
         delta: SUM_OF_NORMS_SMOOTHING_MM,
