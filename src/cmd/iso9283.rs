@@ -16,6 +16,8 @@ use robocal_core::programs::Format;
 use std::path::PathBuf;
 
 #[derive(Subcommand, Debug)]
+// Each command's arguments are built only when it runs (or for help, completions, man).
+#[command(defer = true)]
 pub enum Iso9283Cmd {
     /// The test plan: the largest cube (edges parallel to the base axes) the robot reaches at
     /// every test pose with the tool orientation, P1..P5 on its diagonal plane, the cycles P1,

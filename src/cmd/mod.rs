@@ -39,6 +39,8 @@ pub struct Cli {
 }
 
 #[derive(Subcommand, Debug)]
+// Each command's arguments are built only when it runs (or for help, completions, man).
+#[command(defer = true)]
 enum Command {
     /// Robot models: show a preset or a robot file.
     #[command(subcommand)]

@@ -5,6 +5,8 @@ use clap::{Args, Subcommand};
 use std::path::PathBuf;
 
 #[derive(Subcommand, Debug)]
+// Each command's arguments are built only when it runs (or for help, completions, man).
+#[command(defer = true)]
 pub enum RobotCmd {
     /// Print a robot's parameter table (the layout of the paper's Table I), tool and limits.
     Show(ShowArgs),

@@ -6,6 +6,8 @@
 
 use crate::error::{Error, Result};
 use crate::frame::TrackerFrame;
+use crate::io::result_checks::check_read;
+pub(crate) use crate::io::result_checks::{check_frame, check_parameters};
 use crate::io::result_sections::{
     sorted_opt, DownweightedEntry, Identifiability, PlausibilitySection, Points, Registration,
     Settings, Solver, Uncertainty,
@@ -249,31 +251,25 @@ impl CalibrationResult {
     ) -> Result<(CalibrationResult, Option<crate::model::Robot>)> {
         let r: CalibrationResult = crate::io::input::parse_json(text, path, "robocal result")?;
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        check_status(r.status.as_ref(), text, path)?;
-        check_parameters(&r.parameters, text, path)?;
-        check_frame(&r.tracker_frame, "tracker_frame", text, path)?;
-        let nominal = r.robot.nominal_robot(path, Some(text))?;
-        let e = &r.errors;
-        let tables = [
-            ("calibration", Some(&e.calibration)),
-            ("validation", e.validation.as_ref()),
-        ];
-        for (set, t) in tables {
-            let Some(t) = t else { continue };
-            for (when, s) in [("before", &t.before), ("after", &t.after)] {
-                for (name, v) in [
-                    ("mean_mm", s.mean_mm),
-                    ("std_mm", s.std_mm),
-                    ("max_mm", s.max_mm),
-                    ("rms_mm", s.rms_mm),
-                    ("p95_mm", s.p95_mm),
-                ] {
-                    let field = format!("errors.{set}.{when}.{name}");
-                    check_value(text, path, &field, v, &crate::ranges::ERROR)?;
-                }
+        check_read(r, text, path)
+    }
+
+    /// Reads back `text`, which [`CalibrationResult::to_text`] just made of `self`, with the
+    /// checks of [`CalibrationResult::parse`]. The text of a result without [`extra`] keys has
+    /// no key twice in one object: the struct's fields are distinct, its maps (`parameters`, the
+    /// sorted sections written through a `serde_json::Value`) hold each key once, and only the
+    /// flattened `extra` could repeat a field's name. Such text is parsed directly (the
+    /// duplicate-key pass and the key-path tracking add nothing to it); anything else, or text
+    /// that does not parse, takes the whole reading path, whose messages name the field.
+    ///
+    /// [`extra`]: CalibrationResult::extra
+    fn read_back(&self, text: &str, path: &Path) -> Result<(CalibrationResult, Option<Robot>)> {
+        if self.extra.is_empty() {
+            if let Ok(r) = serde_json::from_str::<CalibrationResult>(text) {
+                return check_read(r, text, path);
             }
         }
-        Ok((r, nominal))
+        Self::parse_with_nominal(text, path)
     }
 
     /// The result's text as robocal writes it: pretty JSON with each per-point entry on one
@@ -304,8 +300,9 @@ impl CalibrationResult {
     /// range) is not written: [`Error::Implausible`] names the field.
     pub fn write(&self, path: &Path) -> Result<()> {
         let s = self.to_text()?;
-        let readable =
-            Self::parse_with_nominal(&s, path).and_then(|(back, nominal)| match nominal {
+        let readable = self
+            .read_back(&s, path)
+            .and_then(|(back, nominal)| match nominal {
                 Some(nominal) => back.calibrated_robot(&nominal, path).map(|_| ()),
                 None => Ok(()),
             });
@@ -494,84 +491,6 @@ impl CalibrationResult {
             })
             .collect()
     }
-}
-
-/// Checks `v` against `range`; the error names the file, the field and its line in `text`.
-pub(crate) fn check_value(
-    text: &str,
-    path: &Path,
-    field: &str,
-    v: f64,
-    range: &crate::ranges::Range,
-) -> Result<()> {
-    range.check(v).map(|_| ()).map_err(|msg| {
-        let line = crate::io::json_keys::line_of_key(text, field);
-        Error::parse(path, line, Some(field), msg)
-    })
-}
-
-/// Checks the values of a `parameters` object (result or truth file) against the range of their
-/// unit: nominal and calibrated values, and standard deviations.
-pub(crate) fn check_parameters(
-    params: &IndexMap<String, ParamEntry>,
-    text: &str,
-    path: &Path,
-) -> Result<()> {
-    use crate::ranges::Range;
-    for (name, p) in params {
-        let range = Range::for_unit(p.unit);
-        let field = |k: &str| format!("parameters.{name}.{k}");
-        check_value(text, path, &field("nominal"), p.nominal, range)?;
-        check_value(text, path, &field("calibrated"), p.calibrated, range)?;
-        if let Some(sd) = p.std {
-            check_value(text, path, &field("std"), sd, Range::size_for_unit(p.unit))?;
-        }
-    }
-    Ok(())
-}
-
-/// Checks a frame vector (`field` names it, e.g. `tracker_frame`): x, y, z as lengths, A, B, C
-/// as angles.
-pub(crate) fn check_frame(f: &FrameVec, field: &str, text: &str, path: &Path) -> Result<()> {
-    use crate::ranges::{ANGLE, LENGTH};
-    for (k, v, range) in [
-        ("x", f.x, &LENGTH),
-        ("y", f.y, &LENGTH),
-        ("z", f.z, &LENGTH),
-        ("a", f.a, &ANGLE),
-        ("b", f.b, &ANGLE),
-        ("c", f.c, &ANGLE),
-    ] {
-        check_value(text, path, &format!("{field}.{k}"), v, range)?;
-    }
-    Ok(())
-}
-
-/// Checks a result's `status`: present, and one robocal writes.
-fn check_status(status: Option<&StatusValue>, text: &str, path: &Path) -> Result<()> {
-    let known = KNOWN_STATUSES.join(", ");
-    let msg = match status {
-        Some(StatusValue::Known(_)) => return Ok(()),
-        None => {
-            return Err(Error::parse(
-                path,
-                None,
-                Some("status"),
-                format!(
-                    "missing: every result robocal writes says whether it is a calibration \
-                     (one of {known}); without it the file cannot be trusted as one"
-                ),
-            ))
-        }
-        Some(StatusValue::Other(serde_json::Value::String(s))) => {
-            format!("`{s}` is not a status robocal writes ({known})")
-        }
-        Some(StatusValue::Other(other)) => {
-            format!("{other} is not a status robocal writes ({known})")
-        }
-    };
-    let line = crate::io::json_keys::line_of_key(text, "status");
-    Err(Error::parse(path, line, Some("status"), msg))
 }
 
 #[cfg(test)]

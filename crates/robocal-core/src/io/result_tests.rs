@@ -135,3 +135,81 @@ fn absurd_magnitudes_are_range_errors_naming_the_field() {
     v["parameters"]["a2"]["calibrated"] = json!(-999_999.0);
     parse(&v).unwrap();
 }
+
+/// A fresh directory for the writing tests.
+fn scratch(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("robocal-result-{tag}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn good_result() -> CalibrationResult {
+    serde_json::from_value(good()).unwrap()
+}
+
+/// The direct read-back of `write` is the reading path's: the same result and robot, and on text
+/// the reading path refuses, its message.
+#[test]
+fn read_back_of_own_text_is_the_reading_path() {
+    let r = good_result();
+    let text = r.to_text().unwrap();
+    let path = Path::new("r.json");
+    assert!(crate::io::json_keys::find_duplicate_key(&text)
+        .unwrap()
+        .is_none());
+    let (fast, fast_nominal) = r.read_back(&text, path).unwrap();
+    let (slow, slow_nominal) = CalibrationResult::parse_with_nominal(&text, path).unwrap();
+    assert_eq!(fast, slow);
+    assert_eq!(fast, r);
+    assert_eq!(fast_nominal.is_some(), slow_nominal.is_some());
+    let mut bad = r.clone();
+    bad.parameters["a2"].calibrated = f64::NAN;
+    let text = bad.to_text().unwrap();
+    let fast = bad.read_back(&text, path).unwrap_err().to_string();
+    let slow = CalibrationResult::parse(&text, path)
+        .unwrap_err()
+        .to_string();
+    assert_eq!(fast, slow);
+    assert!(fast.contains("parameters.a2.calibrated"), "{fast}");
+}
+
+/// Only the flattened `extra` keys can repeat a key in the text robocal writes (see
+/// `read_back`): an extra key naming a field is caught, and the result is not written.
+#[test]
+fn an_extra_key_repeating_a_field_is_not_written() {
+    let mut r = good_result();
+    r.extra
+        .insert("status".to_owned(), serde_json::json!("calibrated"));
+    let text = r.to_text().unwrap();
+    let dup = crate::io::json_keys::find_duplicate_key(&text).unwrap();
+    assert_eq!(dup.map(|d| d.path), Some("status".to_owned()));
+    let dir = scratch("dup");
+    let out = dir.join("r.json");
+    let e = r.write(&out).unwrap_err().to_string();
+    assert!(e.contains("appears twice") && e.contains("status"), "{e}");
+    assert!(!out.exists());
+    // Extra keys of their own are kept and read back.
+    let mut r = good_result();
+    r.extra.insert("note".to_owned(), serde_json::json!("x"));
+    r.write(&out).unwrap();
+    assert_eq!(CalibrationResult::read(&out).unwrap(), r);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// What robocal writes, robocal reads: a value its readers refuse is not written.
+#[test]
+fn a_result_out_of_range_is_not_written() {
+    let dir = scratch("range");
+    let out = dir.join("r.json");
+    let mut r = good_result();
+    r.parameters["a2"].calibrated = 1e300;
+    let e = r.write(&out).unwrap_err();
+    assert!(matches!(e, Error::Implausible(_)), "{e}");
+    let e = e.to_string();
+    assert!(e.contains("field `parameters.a2.calibrated`"), "{e}");
+    assert!(!out.exists());
+    good_result().write(&out).unwrap();
+    assert_eq!(CalibrationResult::read(&out).unwrap(), good_result());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
