@@ -240,8 +240,20 @@ fn calibrate_data(
     mut warnings: Vec<String>,
 ) -> PyResult<(String, String, Vec<String>, f64)> {
     let started = std::time::Instant::now();
+    // The model as `calibrate_files` chooses it by default on constraint data (and the CLI):
+    // the families the data support, by cross-validation by configuration.
+    let model = robocal_core::identification::CalibrationSettings::default().model;
     let cal = py
-        .detach(|| calibrate_constraints(nominal, cdata, opts))
+        .detach(|| match model {
+            robocal_core::identification::ModelChoice::Auto(auto) => {
+                robocal_core::identification::constraint::calibrate_constraints_auto(
+                    nominal, cdata, opts, auto,
+                )
+            }
+            robocal_core::identification::ModelChoice::Given => {
+                calibrate_constraints(nominal, cdata, opts)
+            }
+        })
         .map_err(|e| {
             let hint = if cdata.has_known_length() {
                 ""
@@ -291,6 +303,9 @@ fn calibrate_data(
              (accept_unknown_scale=True): lengths may be off in proportion",
             held.name()
         ));
+    }
+    if let Some(remark) = cal.model_selection.as_ref().and_then(|s| s.remark.as_ref()) {
+        warnings.push(remark.clone());
     }
     let mut res = cal.to_result(nominal, cdata).py_err()?;
     res.inputs = inputs;

@@ -39,7 +39,10 @@ def calibrate_constraints(
     file form's reader, so every refusal is the file's (:class:`InputError` naming the row, the
     arrays' rows numbered from 1, the distances' entries from line 2); without a known distance
     or radius the scale is undetermined and :class:`NumericalError` is raised unless
-    ``accept_unknown_scale``. The result is up to the base pose (its ``constraint`` section).
+    ``accept_unknown_scale``. The model is chosen as :func:`calibrate_files` chooses it by default
+    on a constraint file (``model="auto"``: the families the rows support, by cross-validation by
+    configuration; the result's ``model_selection``). The result is up to the base pose (its
+    ``constraint`` section).
     """
     from . import _finish
 

@@ -251,3 +251,32 @@ fn on_a_sagging_robot_the_choice_takes_compliance_and_the_model_error_drops() {
         );
     }
 }
+
+/// Few rows for many unknowns (3 spheres of unknown radius x 12 configurations, the scale held):
+/// a candidate with a family more could follow the rows' noise exactly, and its cross-validation
+/// from the full fit would then read about zero; it is rejected for its unknowns instead, and no
+/// family is chosen.
+#[test]
+fn a_candidate_with_more_unknowns_than_the_rows_bear_is_rejected() {
+    let s = ConstraintSimulation {
+        features: 3,
+        per_feature: 12,
+        radius_known: false,
+        radius_mm: 150.0,
+        distances: false,
+        ..spec(ConstraintKind::Sphere, 0.01, 1)
+    };
+    let data = simulate(&truth(1), &s).data;
+    let opts = ConstraintOptions {
+        accept_unknown_scale: true,
+        ..ConstraintOptions::default()
+    };
+    let cal =
+        calibrate_constraints_auto(&nominal(), &data, &opts, AutoFamilies::default()).unwrap();
+    let sel = cal.model_selection.as_ref().unwrap();
+    assert!(sel.chosen().families.is_empty(), "{:?}", sel.chosen());
+    for c in sel.candidates.iter().filter(|c| !c.families.is_empty()) {
+        let why = c.rejected.as_deref().unwrap_or_default();
+        assert!(why.contains("unknowns for"), "{}: {why:?}", c.name());
+    }
+}

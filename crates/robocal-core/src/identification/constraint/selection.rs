@@ -112,6 +112,18 @@ fn assess(
         ));
         return (c, None);
     }
+    // The folds' refits start from the full fit, which already follows every row: they mean
+    // something only where each refit (on four folds of five) stays overdetermined.
+    let rows = fit::row_count(data, &cal.features);
+    let unknowns = cal.identified.len()
+        + cal.features.iter().map(|f| f.param_count()).sum::<usize>()
+        + if cal.frame.is_some() { 6 } else { 0 };
+    if 4 * unknowns > 3 * rows {
+        c.rejected = Some(format!(
+            "{unknowns} unknowns for {rows} residual rows: more than three quarters of them, so              a fit can follow the rows' noise and its cross-validation (refits on four folds of              five, from the full fit) says nothing; measure more configurations"
+        ));
+        return (c, None);
+    }
     match cross_validate_constraints(&cal, data, FOLDS) {
         Ok(cv) => {
             c.cv_mean_mm = Some(cv.mean_mm);
