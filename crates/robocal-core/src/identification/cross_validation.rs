@@ -61,12 +61,7 @@ pub fn pose_folds(obs: &Observations, folds: usize) -> Vec<usize> {
 
 /// The observations `i` of `obs` for which `keep(i)`, with their extras and weights.
 pub fn subset(obs: &Observations, keep: impl Fn(usize) -> bool) -> Result<Observations> {
-    let mut out = Observations::new(obs.dof());
-    out.set_mm_per_deg(obs.mm_per_rad().to_radians())?;
-    for i in (0..obs.len()).filter(|&i| keep(i)) {
-        out.push_with(obs.q(i), *obs.m(i), obs.extras(i), obs.line(i))?;
-    }
-    Ok(out)
+    obs.rows_where(keep)
 }
 
 /// Cross-validates `cal` (fitted to `calibration`, the points as given to the calibration) over

@@ -44,6 +44,14 @@ pub struct SolverOptions {
     pub warm_start_points: usize,
 }
 
+/// From this many points, the solve starts on an even subsample (see [`crate::identification::pipeline`]'s stages).
+pub const WARM_START_MIN_POINTS: usize = 100_000;
+
+/// About this many points make the subsample of a warm start: enough that its minimum is within
+/// a fraction of the noise of the whole set's, few enough that its runs cost a few passes over
+/// the whole set.
+pub const WARM_START_POINTS: usize = 25_000;
+
 /// The smallest warm-start subsample accepted: fewer points would leave its minimum too far
 /// from the whole set's for the last runs to be short.
 pub const MIN_WARM_START_POINTS: usize = 1_000;
@@ -56,8 +64,8 @@ impl Default for SolverOptions {
             gradient_tolerance: 1e-10,
             objective_tolerance: 1e-9,
             initial_lambda: 1e-3,
-            warm_start_min_points: crate::identification::pipeline::WARM_START_MIN_POINTS,
-            warm_start_points: crate::identification::pipeline::WARM_START_POINTS,
+            warm_start_min_points: WARM_START_MIN_POINTS,
+            warm_start_points: WARM_START_POINTS,
         }
     }
 }

@@ -13,7 +13,6 @@ pub mod json_keys;
 pub mod measurements;
 pub mod result;
 pub mod result_cell;
-mod result_checks;
 pub mod result_constraint;
 mod result_format;
 pub mod result_payload;

@@ -6,14 +6,16 @@
 
 use crate::error::{Error, Result};
 use crate::frame::TrackerFrame;
-use crate::io::result_checks::check_read;
-pub(crate) use crate::io::result_checks::{check_frame, check_parameters};
+#[path = "result_checks.rs"]
+mod checks;
 use crate::io::result_sections::{
     sorted_opt, DownweightedEntry, Identifiability, PlausibilitySection, Points, Registration,
     Settings, Solver, Uncertainty,
 };
 use crate::model::{Param, Robot, Unit};
 use crate::stats::ErrorStats;
+use checks::check_read;
+pub(crate) use checks::{check_frame, check_parameters};
 use indexmap::IndexMap;
 use serde::{Deserialize, Serialize};
 use std::path::Path;

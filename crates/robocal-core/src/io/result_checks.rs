@@ -1,9 +1,9 @@
 //! The checks a result file passes on reading beyond its JSON shape ([`CalibrationResult::parse`]):
 //! a `status` robocal writes, and every number within its plausible range ([`crate::ranges`]).
 
+use super::ParamEntry;
+use super::{CalibrationResult, FrameVec, StatusValue, KNOWN_STATUSES};
 use crate::error::{Error, Result};
-use crate::io::result::ParamEntry;
-use crate::io::result::{CalibrationResult, FrameVec, StatusValue, KNOWN_STATUSES};
 use crate::model::Robot;
 use indexmap::IndexMap;
 use std::path::Path;

@@ -235,6 +235,16 @@ impl Observations {
         Ok(())
     }
 
+    /// The observations `i` for which `keep(i)`, with their extras and weights.
+    pub fn rows_where(&self, keep: impl Fn(usize) -> bool) -> Result<Observations> {
+        let mut out = Observations::new(self.dof());
+        out.set_mm_per_deg(self.mm_per_rad().to_radians())?;
+        for i in (0..self.len()).filter(|&i| keep(i)) {
+            out.push_with(self.q(i), *self.m(i), self.extras(i), self.line(i))?;
+        }
+        Ok(out)
+    }
+
     /// Observation `i`'s conditions (temperature, approach directions; unknown when the rows
     /// carry none).
     #[inline]

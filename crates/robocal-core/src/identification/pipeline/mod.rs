@@ -85,7 +85,7 @@ pub struct Stage {
     pub points: Option<usize>,
 }
 
-pub use stages::{WARM_START_MIN_POINTS, WARM_START_POINTS};
+pub use crate::identification::solver::{WARM_START_MIN_POINTS, WARM_START_POINTS};
 
 /// The outcome of [`calibrate_model`].
 #[derive(Debug, Clone)]

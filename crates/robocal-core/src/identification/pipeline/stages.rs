@@ -2,8 +2,8 @@
 //! runs ([`Stage`]s): a robust or adaptive objective starts from a least-squares fit and
 //! re-estimates its scale from the residuals until it settles.
 //!
-//! A large set (from [`WARM_START_MIN_POINTS`] points, [`SolverOptions::warm_start_min_points`])
-//! starts on an even subsample of about [`WARM_START_POINTS`]: the same runs there reach a model within the subsample's noise of the
+//! A large set (from [`crate::identification::solver::WARM_START_MIN_POINTS`] points, [`SolverOptions::warm_start_min_points`])
+//! starts on an even subsample of about [`crate::identification::solver::WARM_START_POINTS`]: the same runs there reach a model within the subsample's noise of the
 //! minimum, from which the runs on every point need an iteration or two instead of the whole
 //! way (each iteration a pass over a million points). The minimum is the same: the last runs
 //! are on every point, to the solver's own tolerance.
@@ -37,14 +37,6 @@ pub(super) struct Solved {
     /// computed them there (the down-weighted points' list, not computed again then).
     pub final_norms: Option<Vec<f64>>,
 }
-
-/// From this many points, the solve starts on an even subsample (see the module docs).
-pub const WARM_START_MIN_POINTS: usize = 100_000;
-
-/// About this many points make the subsample of a warm start: enough that its minimum is within
-/// a fraction of the noise of the whole set's, few enough that its runs cost a few passes over
-/// the whole set.
-pub const WARM_START_POINTS: usize = 25_000;
 
 /// The solver runs of one identification, with the iteration limit shared by all.
 struct Runs<'p, 'a> {
@@ -122,10 +114,7 @@ pub(super) fn solve_stages(
     if n >= settings.solver.warm_start_min_points {
         let step = n.div_ceil(settings.solver.warm_start_points);
         let kept: Vec<usize> = (0..n).step_by(step).collect();
-        let sub_obs =
-            crate::identification::cross_validation::subset(problem.observations(), |i| {
-                i % step == 0
-            })?;
+        let sub_obs = problem.observations().rows_where(|i| i % step == 0)?;
         let sub = problem.restricted(&sub_obs, &kept);
         let warm = solve_from(&sub, start, tools_fit, settings, observer, None, None)?;
         if warm
