@@ -101,17 +101,24 @@ def test_ur5_files_are_the_cli(ur5, real_data, ur5_cli):
     assert res.data["settings"]["data"] == cli["settings"]["data"]
 
 
-def test_ur5_calibration_is_as_fast_as_the_cli(ur5, real_data, ur5_cli):
+def test_ur5_calibration_is_as_fast_as_the_cli(ur5, real_data, cli, tmp_path):
     q, xyz, _ = load_csv(real_data / "jacobi_ur5_grid.csv")
     vq, vxyz, _ = load_csv(real_data / "jacobi_ur5_random.csv")
     robocal.calibrate(ur5, q, xyz, validate=(vq, vxyz))
-    runs = []
+    # The CLI and the Python call in turn, the fastest of each compared: the other tests run
+    # beside this one, and one run of either can fall on a busy moment.
+    runs, clis = [], []
     for _ in range(3):
+        t = time.perf_counter()
+        cli("calibrate", "--robot", example("ur5.toml"), "--data",
+            str(real_data / "jacobi_ur5_grid.csv"), "--validate",
+            str(real_data / "jacobi_ur5_random.csv"), "--out", str(tmp_path / "cli.json"))
+        clis.append(time.perf_counter() - t)
         t = time.perf_counter()
         res = robocal.calibrate(ur5, q, xyz, validate=(vq, vxyz))
         runs.append((time.perf_counter() - t, res.library_seconds))
     py, lib = min(runs)
-    cli = ur5_cli[1]
+    cli = min(clis)
     print(f"\ncalibration of 1000 UR5 poses: Python call {py * 1e3:.0f} ms, of which the library "
           f"{lib * 1e3:.0f} ms; the whole CLI process {cli * 1e3:.0f} ms")
     # Within 1.5x of the library's own time, and no slower than the CLI.
