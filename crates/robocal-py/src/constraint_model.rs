@@ -7,14 +7,12 @@
 //! `robocal calibrate --data CONSTRAINTS.csv`. The CLI's refusals as
 //! [`crate::constraints::calibrate_constraint_file`]'s.
 
-use crate::errors::{input, raise, IntoPy};
+use crate::constraints::calibrate_data;
+use crate::errors::{input, IntoPy};
 use crate::robot::PyRobot;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use robocal_core::identification::constraint::{
-    calibrate_constraints, calibrate_constraints_auto, ConstraintOptions, Scale,
-};
-use robocal_core::identification::ModelChoice;
+use robocal_core::identification::constraint::ConstraintOptions;
 use robocal_core::io::inputs::{InputFile, Inputs};
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::{read_measurements, Positions};
@@ -65,76 +63,20 @@ pub fn calibrate_constraint_file_model(
         rank_tolerance: opts.settings.identifiability.rank_tolerance,
         ..ConstraintOptions::default()
     };
-    let started = std::time::Instant::now();
-    let cal = py
-        .detach(|| match opts.settings.model {
-            ModelChoice::Auto(auto) => calibrate_constraints_auto(&nominal, &cdata, &copts, auto),
-            ModelChoice::Given => calibrate_constraints(&nominal, &cdata, &copts),
-        })
-        .map_err(|e| {
-            let hint = if cdata.has_known_length() {
-                ""
-            } else {
-                " (distances=FILE with from,to,distance_mm; or radius_mm on a sphere's rows; or \
-                 accept_unknown_scale=True)"
-            };
-            raise(
-                crate::errors::exit_code(&e),
-                format!(
-                    "calibrating from {}: {}{hint}",
-                    data.display(),
-                    crate::errors::message(&e)
-                ),
-            )
-        })?;
-    let seconds = started.elapsed().as_secs_f64();
-    if !cal.fit.converged {
-        return Err(raise(
-            5,
-            format!(
-                "the constraint fit did not converge in {} iterations: not a calibration",
-                cal.fit.iterations
-            ),
-        ));
-    }
-    if !cal.implausible.is_empty() {
-        let summary = cal.implausible.join("\n");
-        if !opts.accept_implausible {
-            return Err(raise(
-                6,
-                format!(
-                    "implausible fit: the constraint fit converged, but the result cannot be a \
-                     calibration. Failed checks:\n{summary}\n(fix the data or the robot; \
-                     accept_implausible=True returns it anyway, marked \"status\": \
-                     \"implausible\")"
-                ),
-            ));
-        }
-        warnings.push(format!(
-            "IMPLAUSIBLE FIT (accept_implausible=True): the fit failed the plausibility gate and \
-             is NOT a calibration:\n{summary}"
-        ));
-    }
-    if let Scale::Assumed { held } = &cal.scale {
-        warnings.push(format!(
-            "the robot's scale is not determined by these data; {} is held at its nominal value \
-             (accept_unknown_scale=True): lengths may be off in proportion",
-            held.name()
-        ));
-    }
-    if let Some(remark) = cal.model_selection.as_ref().and_then(|s| s.remark.as_ref()) {
-        warnings.push(remark.clone());
-    }
-    let mut res = cal.to_result(&nominal, &cdata).py_err()?;
     let mut inputs = Inputs::new();
     inputs.insert("data".into(), InputFile::of(&data).py_err()?);
     if let Some(d) = &distances {
         inputs.insert("distances".into(), InputFile::of(d).py_err()?);
     }
-    res.inputs = Some(inputs);
-    let status = res.status().map_or("calibrated", |s| s.as_str()).to_owned();
-    let text = res
-        .to_text()
-        .map_err(|e| raise(1, format!("cannot serialize the result: {e}")))?;
-    Ok((text, status, warnings, seconds))
+    calibrate_data(
+        py,
+        &nominal,
+        &cdata,
+        &copts,
+        Some(opts.settings.model),
+        opts.accept_implausible,
+        &data.display().to_string(),
+        Some(inputs),
+        warnings,
+    )
 }

@@ -69,6 +69,7 @@ pub fn calibrate_constraint_file(
         nominal,
         &cdata,
         &opts,
+        None,
         accept_implausible,
         &what,
         Some(inputs),
@@ -181,6 +182,7 @@ pub fn calibrate_constraint_arrays(
         nominal,
         &cdata,
         &opts,
+        None,
         accept_implausible,
         "constraint arrays",
         None,
@@ -227,22 +229,24 @@ fn options(accept_unknown_scale: bool, rank_tol: Option<f64>) -> ConstraintOptio
 }
 
 /// Calibrates from `cdata` (read from a file or from arrays, `what` in messages) with the CLI's
-/// refusals; returns what `calibrate_constraint_file` returns.
+/// refusals, the model chosen as `model` says (`None`: as `calibrate_files` chooses it by default
+/// on constraint data, and the CLI: the families the data support, by cross-validation by
+/// configuration); returns what `calibrate_constraint_file` returns.
 #[allow(clippy::too_many_arguments)]
-fn calibrate_data(
+pub(crate) fn calibrate_data(
     py: Python<'_>,
     nominal: &robocal_core::Robot,
     cdata: &ConstraintData,
     opts: &ConstraintOptions,
+    model: Option<robocal_core::identification::ModelChoice>,
     accept_implausible: bool,
     what: &str,
     inputs: Option<Inputs>,
     mut warnings: Vec<String>,
 ) -> PyResult<(String, String, Vec<String>, f64)> {
     let started = std::time::Instant::now();
-    // The model as `calibrate_files` chooses it by default on constraint data (and the CLI):
-    // the families the data support, by cross-validation by configuration.
-    let model = robocal_core::identification::CalibrationSettings::default().model;
+    let model =
+        model.unwrap_or_else(|| robocal_core::identification::CalibrationSettings::default().model);
     let cal = py
         .detach(|| match model {
             robocal_core::identification::ModelChoice::Auto(auto) => {
