@@ -14,14 +14,13 @@
 use crate::error::Result;
 use crate::identification::pipeline::Calibration;
 use crate::identification::solver::{solve, undamped_step, SolverOptions};
-use crate::identification::system::{Accumulated, Level, Problem};
+use crate::identification::system::{Level, Problem};
 use crate::model::Robot;
 use crate::observations::{Observations, Weighting};
 use nalgebra::{DMatrix, DVector};
-use rand::seq::SliceRandom;
-use rand::SeedableRng;
 use rayon::prelude::*;
-use std::collections::HashMap;
+
+pub use super::folds::pose_folds;
 
 /// Iteration limit of a fold's refit. It starts at the full fit's minimum, a few Gauss-Newton
 /// steps from its own; a refit still moving after this many (a model whose fit creeps) is taken
@@ -38,25 +37,6 @@ pub struct CrossValidation {
     pub std_error_mm: f64,
     /// Whether every fold's refit converged.
     pub converged: bool,
-}
-
-/// The fold (0..folds) of each observation: the distinct poses (joint values) in a seeded
-/// random order, dealt out in turn, so that the rows of one pose share a fold.
-pub fn pose_folds(obs: &Observations, folds: usize) -> Vec<usize> {
-    let mut pose_of = Vec::with_capacity(obs.len());
-    let mut index: HashMap<Vec<u64>, usize> = HashMap::new();
-    for i in 0..obs.len() {
-        let key: Vec<u64> = obs.q(i).iter().map(|v| v.to_bits()).collect();
-        let n = index.len();
-        pose_of.push(*index.entry(key).or_insert(n));
-    }
-    let mut order: Vec<usize> = (0..index.len()).collect();
-    order.shuffle(&mut rand_chacha::ChaCha8Rng::seed_from_u64(0x5eed));
-    let mut fold_of_pose = vec![0; order.len()];
-    for (k, &p) in order.iter().enumerate() {
-        fold_of_pose[p] = k % folds.max(1);
-    }
-    pose_of.into_iter().map(|p| fold_of_pose[p]).collect()
 }
 
 /// The observations `i` of `obs` for which `keep(i)`, with their extras and weights.
@@ -121,7 +101,9 @@ fn refit_fold(
 
 /// Cross-validates `cal` (fitted to `calibration`, the points as given to the calibration) over
 /// `folds` folds by pose: each fold's refit is one Newton step from the full fit on the normal
-/// equations of the other folds (see the module docs), the folds' accumulations in parallel.
+/// equations of the other folds (see the module docs). Each fold's share of the normal equations
+/// comes from the fit's last pass when it summed them ([`Calibration::fold_passes`]), else from a
+/// pass of its own, the folds in parallel.
 pub fn cross_validate(
     cal: &Calibration,
     calibration: &Observations,
@@ -132,6 +114,10 @@ pub fn cross_validate(
     let loss = cal.stages.last().expect("at least one stage").loss;
     let params = &cal.identifiability.identified;
     let robot = &cal.calibrated;
+    let stored = cal
+        .fold_passes
+        .as_ref()
+        .filter(|p| p.len() == folds && p.iter().all(|(h, _)| h.nrows() == params.len()));
     // Each fold's points and their share of the normal equations at the full fit's minimum.
     let parts: Vec<Result<Option<Part>>> = (0..folds)
         .into_par_iter()
@@ -140,12 +126,18 @@ pub fn cross_validate(
             if test.is_empty() {
                 return Ok(None);
             }
-            let acc = Problem::new(robot, params, &test, &cal.frame).accumulate(
-                robot,
-                &loss,
-                Level::Newton,
-            );
-            Ok(Some((f, test, acc)))
+            let share = match stored {
+                Some(p) => p[f].clone(),
+                None => {
+                    let acc = Problem::new(robot, params, &test, &cal.frame).accumulate(
+                        robot,
+                        &loss,
+                        Level::Newton,
+                    );
+                    (acc.h.expect("Newton level"), acc.b)
+                }
+            };
+            Ok(Some((f, test, share)))
         })
         .collect();
     let parts: Vec<Part> = parts
@@ -157,16 +149,16 @@ pub fn cross_validate(
     let k = params.len();
     let mut h = DMatrix::zeros(k, k);
     let mut b = DVector::zeros(k);
-    for (_, _, acc) in &parts {
-        h += acc.h.as_ref().expect("Newton level");
-        b += &acc.b;
+    for (_, _, (hf, bf)) in &parts {
+        h += hf;
+        b += bf;
     }
     let runs: Vec<Result<(Vec<f64>, bool)>> = (0..parts.len())
         .into_par_iter()
         .map(|p| {
-            let (f, test, acc) = &parts[p];
-            let h_train = &h - acc.h.as_ref().expect("Newton level");
-            let b_train = &b - &acc.b;
+            let (f, test, (hf, bf)) = &parts[p];
+            let h_train = &h - hf;
+            let b_train = &b - bf;
             match undamped_step(&h_train, &b_train) {
                 Some(step) => {
                     let problem = Problem::new(robot, params, test, &cal.frame);
@@ -185,8 +177,8 @@ pub fn cross_validate(
     summarize(runs)
 }
 
-/// A fold: its index, its points and their share of the normal equations.
-type Part = (usize, Observations, Accumulated);
+/// A fold: its index, its points and their share of the objective's Hessian and gradient.
+type Part = (usize, Observations, (DMatrix<f64>, DVector<f64>));
 
 /// The cross-validated mean and its standard error from each fold's left-out errors (and
 /// whether its refit converged).

@@ -233,6 +233,21 @@ pub struct Reduced {
     pub angular: Vec<f64>,
 }
 
+impl Reduced {
+    /// The reduced Jacobian of the parameters at positions `cols` of this one's: that of a model
+    /// whose Jacobian columns are these columns at the same poses (a model with a subset of the
+    /// parameters, the others at values with no effect on its columns). Its R factor is that of
+    /// `R[:, cols]` (`Q R = J` gives `J[:, cols] = Q R[:, cols]`), so column norms and angles,
+    /// all that [`analyze_reduced`] reads, are those of the columns themselves.
+    pub fn columns(&self, cols: &[usize]) -> Reduced {
+        let sub = self.r.select_columns(cols);
+        Reduced {
+            r: sub.qr().r(),
+            angular: cols.iter().map(|&c| self.angular[c]).collect(),
+        }
+    }
+}
+
 /// The R factor (n x n, n = all parameters) of the stacked identification Jacobian over the
 /// observations of `obs` (the rows their measurement kind gives), computed blockwise (and in
 /// parallel for large sets); see [`Reduced`].

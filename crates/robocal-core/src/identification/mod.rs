@@ -28,6 +28,7 @@ pub mod bounds;
 pub mod constraint;
 pub mod covariance;
 pub mod cross_validation;
+pub mod folds;
 pub(crate) mod householder;
 pub mod identifiability;
 pub mod model_choice;

@@ -72,7 +72,7 @@ pub(crate) fn undetermined_keeping(
 }
 
 /// [`undetermined`] from the pass `acc` over `params`.
-fn undetermined_from(
+pub(crate) fn undetermined_from(
     start: &Robot,
     params: &[Param],
     acc: &Accumulated,

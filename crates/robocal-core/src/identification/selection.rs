@@ -35,16 +35,15 @@ pub use crate::identification::model_choice::{
 };
 use crate::identification::pipeline::start::same_tool_points;
 use crate::identification::pipeline::{
-    calibrate_model, calibrate_model_for, complete, register_for, Calibration, CalibrationData,
-    CalibrationSettings, Purpose,
+    calibrate_model, calibrate_model_for, complete, Calibration, CalibrationData,
+    CalibrationSettings, Purpose, Shared,
 };
 use crate::model::family::{backlash, compliance, thermal, transmission};
 use crate::model::Robot;
 use crate::progress::{self, Observer};
 use rayon::prelude::*;
 
-/// Folds of the cross-validation.
-pub const FOLDS: usize = 5;
+pub use crate::identification::folds::FOLDS;
 
 /// Harmonics per joint the selection tries (besides none).
 pub const HARMONICS: [usize; 2] = [1, 2];
@@ -156,6 +155,17 @@ impl Families {
         out
     }
 
+    /// Every family `auto` selects, the highest harmonic order: the widest candidate, whose
+    /// parameters every candidate's are among.
+    fn widest(auto: AutoFamilies, compliant: bool) -> Families {
+        Families {
+            compliance: auto.compliance && compliant,
+            harmonics: if auto.harmonics { HARMONICS[HARMONICS.len() - 1] } else { 0 },
+            backlash: auto.backlash,
+            thermal: auto.thermal,
+        }
+    }
+
     /// `nominal` with these families (their parameters at zero); thermal expansion referred to
     /// `reference_c`.
     fn robot(self, nominal: &Robot, reference_c: Option<f64>) -> Result<Robot> {
@@ -216,10 +226,13 @@ fn select_fitted(
     };
     let given = Families::default().robot(nominal, reference_c)?;
     // The candidates are the robot as given with families at zero: the same tool points, so
-    // the same frame and tools, registered once (checked point by point, else their own).
-    let registered = register_for(&given, data, &fit_settings)?;
+    // the same frame and tools, registered once (checked point by point, else their own), and
+    // the same start passes, those of the widest candidate.
+    let widest = Families::widest(auto, !compliance::auto_joints(nominal).is_empty())
+        .robot(nominal, reference_c)?;
+    let shared = Shared::new(&given, &widest, data, &fit_settings)?;
     let fit = |robot: &Robot, reference: bool| -> (Candidate, Option<Calibration>) {
-        let shared = same_tool_points(robot, &given, data.calibration).then_some(&registered);
+        let shared = same_tool_points(robot, &given, data.calibration).then_some(&shared);
         match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &(), shared) {
             Err(e) => {
                 let mut cand = Candidate::new(robot, reference);
@@ -230,7 +243,7 @@ fn select_fitted(
         }
     };
     let given_fit = |robot: &Robot| -> Result<(Candidate, Option<Calibration>)> {
-        let shared = same_tool_points(robot, &given, data.calibration).then_some(&registered);
+        let shared = same_tool_points(robot, &given, data.calibration).then_some(&shared);
         let cal = calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &(), shared)?;
         Ok(assess(robot, false, cal, data))
     };

@@ -255,7 +255,8 @@ fn solve_inner(
             x_new.copy_from(&x);
             x_new += &delta;
             problem.apply(&mut trial, &x_new);
-            let f_new = problem.objective(&trial, loss);
+            let at_trial = problem.accumulate(&trial, loss, Level::Full);
+            let f_new = at_trial.objective;
             report.evaluations += 1;
             let gain = (acc.objective - f_new) / pred;
             if f_new.is_finite() && gain > UNDAMPED_MIN_GAIN {
@@ -267,7 +268,8 @@ fn solve_inner(
                 f_cur = f_new;
                 x.copy_from(&x_new);
                 problem.apply(robot, &x);
-                current = false;
+                acc = at_trial;
+                report.final_objective = acc.objective;
                 lambda = (lambda / 3.0).max(MIN_LAMBDA);
                 nu = 2.0;
                 if step <= opts.step_tolerance_mm {
@@ -278,10 +280,6 @@ fn solve_inner(
                     report.termination = Termination::ConvergedObjective;
                     break 'outer;
                 }
-                acc = problem.accumulate(robot, loss, level);
-                current = true;
-                report.evaluations += 1;
-                report.final_objective = acc.objective;
                 continue 'outer;
             }
             problem.apply(&mut trial, &x);
@@ -291,8 +289,7 @@ fn solve_inner(
             // Newton's model first (fast near the minimum), then the reweighted one (a
             // majorizer: reliable far from it and for exact fits).
             let mut best_step = f64::INFINITY;
-            let mut accepted = false;
-            let mut f_new_accepted = f64::NAN;
+            let mut accepted = None;
             let mut small_change = false;
             for use_newton in [true, false] {
                 let model = match (use_newton, &acc.h) {
@@ -320,37 +317,48 @@ fn solve_inner(
                 x_new.copy_from(&x);
                 x_new += &delta;
                 problem.apply(&mut trial, &x_new);
-                let f_new = problem.objective(&trial, loss);
+                // Where the model is trusted the step is likely taken: its pass then serves
+                // the next iteration.
+                let near = lambda <= opts.initial_lambda;
+                let (f_new, at_trial) = trial_pass(problem, &trial, loss, near);
                 report.evaluations += 1;
                 let gain = (acc.objective - f_new) / pred;
                 if f_new.is_finite() && pred > 0.0 && gain > 1e-4 {
                     let tol = opts.objective_tolerance * acc.objective.abs();
                     small_change = acc.objective - f_new <= tol && pred <= tol;
                     lambda *= (1.0 - (2.0 * gain - 1.0).powi(3)).max(1.0 / 3.0);
-                    accepted = true;
-                    f_new_accepted = f_new;
+                    accepted = Some((f_new, at_trial));
                     break;
                 }
                 problem.apply(&mut trial, &x);
             }
-            if accepted {
-                f_cur = f_new_accepted;
+            if let Some((f_new, at_trial)) = accepted {
+                f_cur = f_new;
                 x.copy_from(&x_new);
                 problem.apply(robot, &x);
-                current = false;
                 nu = 2.0;
-                if report.last_step_mm <= opts.step_tolerance_mm {
-                    report.termination = Termination::ConvergedStep;
+                let converged = if report.last_step_mm <= opts.step_tolerance_mm {
+                    Some(Termination::ConvergedStep)
+                } else if small_change {
+                    Some(Termination::ConvergedObjective)
+                } else {
+                    None
+                };
+                // The pass at the new point: the trial's when it made one, else its own
+                // (not needed to stop).
+                match at_trial {
+                    Some(pass) => acc = pass,
+                    None if converged.is_none() => {
+                        acc = problem.accumulate(robot, loss, level);
+                        report.evaluations += 1;
+                    }
+                    None => current = false,
+                }
+                report.final_objective = f_new;
+                if let Some(t) = converged {
+                    report.termination = t;
                     break 'outer;
                 }
-                if small_change {
-                    report.termination = Termination::ConvergedObjective;
-                    break 'outer;
-                }
-                acc = problem.accumulate(robot, loss, level);
-                current = true;
-                report.evaluations += 1;
-                report.final_objective = acc.objective;
                 continue 'outer;
             }
             // Rejected: the current point stays. A rejected step below the tolerance means the
@@ -373,6 +381,24 @@ fn solve_inner(
     }
     report.final_objective = f_cur;
     (report, acc, current)
+}
+
+/// The objective at a trial point `trial`, with the full pass ([`Level::Full`]) there when
+/// `pass`: for a step likely to be taken, whose pass is then the next iteration's (or, at the
+/// solution, the covariance's), at the cost of one Jacobian per point where the objective alone
+/// costs the forward kinematics.
+fn trial_pass(
+    problem: &Problem,
+    trial: &Robot,
+    loss: &Loss,
+    pass: bool,
+) -> (f64, Option<Accumulated>) {
+    if pass {
+        let acc = problem.accumulate(trial, loss, Level::Full);
+        (acc.objective, Some(acc))
+    } else {
+        (problem.objective(trial, loss), None)
+    }
 }
 
 /// The largest cosine between a weighted Jacobian column and the weighted residual vector:

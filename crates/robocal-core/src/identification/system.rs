@@ -76,6 +76,9 @@ pub struct Problem<'a> {
     targets: Vec<f64>,
     /// Whether the kind needs the tool frame's angular screws and rotation.
     angular: bool,
+    /// The group of each observation and the number of groups, when a pass also sums each
+    /// group's share of the objective's Hessian and gradient ([`Accumulated::groups`]).
+    groups: Option<(&'a [usize], usize)>,
 }
 
 impl std::fmt::Debug for Problem<'_> {
@@ -119,6 +122,9 @@ pub struct Accumulated {
     pub psi_sq: f64,
     /// The number of residual rows summed over (rows per observation times observations).
     pub rows: usize,
+    /// For a [`Problem::grouped`] problem at [`Level::Newton`] and above: each group's share of
+    /// the objective's Hessian `H` and of `b` (they sum to the whole's, up to rounding).
+    pub groups: Option<Vec<(DMatrix<f64>, DVector<f64>)>>,
 }
 
 impl Accumulated {
@@ -136,6 +142,7 @@ impl Accumulated {
             h: self.h.as_ref().map(sub),
             psi_sq: self.psi_sq,
             rows: self.rows,
+            groups: None,
         }
     }
 }
@@ -173,7 +180,18 @@ impl<'a> Problem<'a> {
             kind,
             targets,
             angular: kind.measurability().orientation,
+            groups: None,
         }
+    }
+
+    /// This problem with its observations in groups (`group[i]` of observation `i`, below
+    /// `count`): its passes at [`Level::Newton`] and above then also give each group's share
+    /// ([`Accumulated::groups`]), the cross-validation's folds for one pass over the data.
+    pub(crate) fn grouped(mut self, group: &'a [usize], count: usize) -> Self {
+        assert_eq!(group.len(), self.obs.len(), "a group per observation");
+        assert!(group.iter().all(|&g| g < count), "groups below their count");
+        self.groups = Some((group, count));
+        self
     }
 
     /// Observation `i`'s residual rows `e` (measured minus model) and the model's Jacobian rows
@@ -346,6 +364,7 @@ impl<'a> Problem<'a> {
             kind: self.kind,
             targets,
             angular: self.angular,
+            groups: None,
         }
     }
 
@@ -525,13 +544,37 @@ impl<'a> Problem<'a> {
         let np = robot.param_count();
         let rows = self.kind.rows();
         let angular = self.angular;
-        let acc = chunked(
-            self.len(),
-            || Acc::new(k, rows, np, angular, level),
-            #[inline(always)]
-            |acc, i| acc.add_observation(self, robot, loss, i),
-            Acc::merge,
-        );
+        let new = || Acc::new(k, rows, np, angular, level);
+        let (acc, groups) = match self.groups.filter(|_| level >= Level::Newton) {
+            None => (
+                chunked(
+                    self.len(),
+                    new,
+                    #[inline(always)]
+                    |acc, i| acc.add_observation(self, robot, loss, i),
+                    Acc::merge,
+                ),
+                None,
+            ),
+            Some((group, count)) => {
+                let parts = chunked(
+                    self.len(),
+                    || (0..count).map(|_| new()).collect::<Vec<Acc>>(),
+                    #[inline(always)]
+                    |accs, i| accs[group[i]].add_observation(self, robot, loss, i),
+                    |a, b| a.into_iter().zip(b).map(|(x, y)| x.merge(y)).collect(),
+                );
+                let shares = parts
+                    .iter()
+                    .map(|g| {
+                        let a = symmetric(k, &g.a);
+                        (&a + symmetric(k, &g.h), DVector::from_column_slice(&g.b))
+                    })
+                    .collect();
+                let whole = parts.into_iter().reduce(Acc::merge).unwrap_or_else(new);
+                (whole, Some(shares))
+            }
+        };
         let a = symmetric(k, &acc.a);
         let s = (level == Level::Full).then(|| &a + symmetric(k, &acc.s));
         let h = (level >= Level::Newton).then(|| &a + symmetric(k, &acc.h));
@@ -544,6 +587,7 @@ impl<'a> Problem<'a> {
             h,
             psi_sq: acc.psi_sq,
             rows: self.rows(),
+            groups,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The pipeline's third step: which parameters these poses identify (paper, section II.B),
 //! including those independent in principle that the data cannot pin.
 
+use super::shared::CandidateStart;
 use super::start::StartModel;
 use crate::error::{Error, Result};
 use crate::identification::identifiability::{
@@ -28,34 +29,48 @@ pub(super) struct Identified {
 /// Analyzes identifiability at the start model: rank and conditioning of the scaled Jacobian,
 /// then the precision each parameter would have ([`precision::undetermined`]), fixing those the
 /// data cannot determine. Fails when the problem is too ill-conditioned (unless allowed) or has
-/// fewer points than parameters.
+/// fewer points than parameters. `shared`: the reduced Jacobian and the precision pass taken
+/// from a model selection's shared start (see [`super::shared`]) instead of computed.
 pub(super) fn identifiable(
     nominal: &Robot,
     start: &StartModel,
     opts: &IdentifiabilityOptions,
     observer: &dyn Observer,
+    shared: Option<CandidateStart>,
 ) -> Result<Identified> {
     observer.progress(progress::Stage::Identifiability, 0, 1);
     let cal = &start.observations;
-    let reduced = jacobian_r(&start.robot, cal);
-    let mut ident = analyze_reduced(&start.robot, cal, opts, &reduced)?;
-    // Only with the tools fitted: otherwise the noise estimate, and the bound, mean nothing.
-    let sigma0 = if start.tool_fit.applied {
-        start.tool_fit.stats.rms_mm / 3f64.sqrt()
-    } else {
-        0.0
+    let own;
+    let reduced = match &shared {
+        Some(s) => &s.reduced,
+        None => {
+            own = jacobian_r(&start.robot, cal);
+            &own
+        }
     };
+    let mut ident = analyze_reduced(&start.robot, cal, opts, reduced)?;
+    let sigma0 = noise_bound(start);
     let analyzed = ident.identified.clone();
-    let (undetermined, pass) = precision::undetermined_keeping(
-        &start.robot,
-        &Problem::new(&start.robot, &analyzed, cal, &start.frame),
-        sigma0,
-        &opts.free,
-    );
+    let shared_pass = shared
+        .as_ref()
+        .filter(|_| sigma0 > 0.0 && sigma0.is_finite() && !analyzed.is_empty())
+        .and_then(|s| s.pass(&analyzed));
+    let (undetermined, pass) = match shared_pass {
+        Some(acc) => (
+            precision::undetermined_from(&start.robot, &analyzed, &acc, sigma0, &opts.free),
+            Some(acc),
+        ),
+        None => precision::undetermined_keeping(
+            &start.robot,
+            &Problem::new(&start.robot, &analyzed, cal, &start.frame),
+            sigma0,
+            &opts.free,
+        ),
+    };
     if !undetermined.is_empty() {
         let mut opts = opts.clone();
         opts.fix.extend(undetermined.iter().map(|u| u.param));
-        ident = analyze_reduced(&start.robot, cal, &opts, &reduced)?;
+        ident = analyze_reduced(&start.robot, cal, &opts, reduced)?;
         for f in &mut ident.fixed {
             if let Some(u) = undetermined.iter().find(|u| u.param == f.param) {
                 f.reason = FixReason::Undetermined {
@@ -100,6 +115,17 @@ pub(super) fn identifiable(
         ill_conditioned,
         start_pass,
     })
+}
+
+/// The per-axis noise bound of the precision analysis ([`precision`]): the nominal geometry's
+/// per-axis RMS error with the fitted tools; zero when the tools were not applied (the estimate,
+/// and the bound, then mean nothing).
+pub(super) fn noise_bound(start: &StartModel) -> f64 {
+    if start.tool_fit.applied {
+        start.tool_fit.stats.rms_mm / 3f64.sqrt()
+    } else {
+        0.0
+    }
 }
 
 /// Why the identified parameters are too nearly dependent for double precision, if they are.

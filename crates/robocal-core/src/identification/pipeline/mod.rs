@@ -16,12 +16,16 @@
 mod identify;
 mod inputs;
 mod outcome;
+mod shared;
 mod stages;
 pub(crate) mod start;
+
+pub(crate) use shared::Shared;
 
 use crate::error::{Error, Result};
 use crate::identification::bounds;
 use crate::identification::covariance::Covariance;
+use crate::identification::folds::{pose_folds, FOLDS};
 use crate::identification::identifiability::{FixReason, Identifiability, IdentifiabilityOptions};
 use crate::identification::model_choice::{ModelChoice, ModelSelection};
 use crate::identification::objective::{Loss, Objective};
@@ -134,6 +138,10 @@ pub struct Calibration {
     pub weighting: AppliedWeighting,
     /// The automatic model choice, when the settings asked for it.
     pub model_selection: Option<ModelSelection>,
+    /// A model selection's candidate: each cross-validation fold's share of the objective's
+    /// Hessian and gradient at the calibrated model ([`crate::identification::folds`]), from the
+    /// solver's last pass, when it ended on one (the cross-validation's, not repeated then).
+    pub(crate) fold_passes: Option<Vec<(nalgebra::DMatrix<f64>, nalgebra::DVector<f64>)>>,
 }
 
 impl Calibration {
@@ -200,7 +208,7 @@ pub(super) struct Job<'a> {
 }
 
 /// The frame and tools registered to `nominal` for a calibration of `data` (the inputs checked
-/// first), to share among models with its tool points ([`calibrate_model_for`]).
+/// first), to share among models with its tool points ([`calibrate_model_for`], [`Shared`]).
 pub(crate) fn register_for(
     nominal: &Robot,
     data: CalibrationData,
@@ -210,27 +218,27 @@ pub(crate) fn register_for(
     start::register_nominal(nominal, &data, settings, &())
 }
 
-/// [`calibrate_model`] for a `purpose`; `shared`: the frame and tools registered to a model
-/// with the same tool points as `nominal` at the start (see [`start::same_tool_points`]), not
-/// registered again.
+/// [`calibrate_model`] for a `purpose`; `shared`: the frame, tools and start passes shared by
+/// the candidates of a model selection, for a model with the same tool points at the start as
+/// the robot they were registered to (see [`start::same_tool_points`]), not computed again.
 pub(crate) fn calibrate_model_for(
     nominal: &Robot,
     data: CalibrationData,
     settings: &CalibrationSettings,
     purpose: Purpose,
     observer: &dyn Observer,
-    shared: Option<&start::Registered>,
+    shared: Option<&Shared>,
 ) -> Result<Calibration> {
     inputs::check(nominal, &data, settings)?;
     let own;
     let registered = match shared {
-        Some(r) => r,
+        Some(s) => &s.registered,
         None => {
             own = start::register_nominal(nominal, &data, settings, observer)?;
             &own
         }
     };
-    let first = calibrate_once(nominal, data, settings, purpose, observer, registered)?;
+    let first = calibrate_once(nominal, data, settings, purpose, observer, registered, shared)?;
     let start = if first.tool_fit.applied {
         first.tool_fit.apply(nominal)
     } else {
@@ -245,7 +253,7 @@ pub(crate) fn calibrate_model_for(
         .identifiability
         .fix
         .extend(held.iter().map(|h| h.param));
-    let mut c = calibrate_once(nominal, data, &again, purpose, observer, registered)?;
+    let mut c = calibrate_once(nominal, data, &again, purpose, observer, registered, shared)?;
     for f in &mut c.identifiability.fixed {
         if let Some(h) = held.iter().find(|h| h.param == f.param) {
             f.reason = FixReason::AtBound {
@@ -259,8 +267,8 @@ pub(crate) fn calibrate_model_for(
     Ok(c)
 }
 
-/// One calibration of the model as given, from the frame and tools `registered`: its steps,
-/// each a function of its own.
+/// One calibration of the model as given, from the frame and tools `registered` (and the start
+/// passes `shared`, when given): its steps, each a function of its own.
 fn calibrate_once(
     nominal: &Robot,
     data: CalibrationData,
@@ -268,10 +276,16 @@ fn calibrate_once(
     purpose: Purpose,
     observer: &dyn Observer,
     registered: &start::Registered,
+    shared: Option<&Shared>,
 ) -> Result<Calibration> {
     let start = start::prepare(nominal, &data, settings, registered)?;
-    let mut identified =
-        identify::identifiable(nominal, &start, &settings.identifiability, observer)?;
+    let mut identified = identify::identifiable(
+        nominal,
+        &start,
+        &settings.identifiability,
+        observer,
+        shared.and_then(|s| s.candidate(&start.robot)),
+    )?;
     let solved = {
         let problem = Problem::new(
             &start.robot,
@@ -279,6 +293,12 @@ fn calibrate_once(
             &start.observations,
             &start.frame,
         );
+        // A candidate's passes also sum each cross-validation fold's share.
+        let folds = (purpose == Purpose::Candidate).then(|| pose_folds(&start.observations, FOLDS));
+        let problem = match &folds {
+            Some(f) => problem.grouped(f, FOLDS),
+            None => problem,
+        };
         stages::solve_stages(
             &problem,
             &start.robot,

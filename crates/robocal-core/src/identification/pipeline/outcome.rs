@@ -36,7 +36,7 @@ pub(super) fn assemble(
     job: &Job,
     start: StartModel,
     identified: Identified,
-    solved: Solved,
+    mut solved: Solved,
 ) -> Result<Calibration> {
     let Job {
         nominal,
@@ -54,6 +54,7 @@ pub(super) fn assemble(
     );
     let robot = &solved.robot;
     observer.progress(progress::Stage::Uncertainty, 0, 1);
+    let fold_passes = solved.final_pass.as_mut().and_then(|p| p.groups.take());
     // The solver's last pass when it is at the solution, else a pass of its own.
     let acc = match &solved.final_pass {
         Some(pass) => std::borrow::Cow::Borrowed(pass),
@@ -119,6 +120,7 @@ pub(super) fn assemble(
         settings: settings.clone(),
         weighting: start.weighting,
         model_selection: None,
+        fold_passes,
     })
 }
 

@@ -327,7 +327,7 @@ fn urdf_sniffing() {
 }
 
 /// Reading is linear in the file's size: a chain of 100,000 fixed joints after one revolute joint
-/// is read and imported in under 2 s (release build; it took minutes while each joint's line was
+/// is read and imported in seconds (release build; it took minutes while each joint's line was
 /// searched in the text).
 #[test]
 fn a_long_fixed_chain_reads_in_linear_time() {
@@ -358,6 +358,8 @@ fn a_long_fixed_chain_reads_in_linear_time() {
     // It was quadratic (11 minutes for this file), then took 5.7-7.3 s through urdf-rs's two DOM
     // passes (`robot show`, whole process, under a load of about 7); read in one streaming pass,
     // 1.1-1.3 s for the whole process on the same machine.
-    let bound = if cfg!(debug_assertions) { 20.0 } else { 2.0 };
+    // The bound only tells linear from quadratic (minutes): it took 2.9 s under the load of
+    // parallel builds on two cores, so it leaves room for a loaded machine.
+    let bound = if cfg!(debug_assertions) { 60.0 } else { 15.0 };
     assert!(took.as_secs_f64() < bound, "took {took:?}");
 }
