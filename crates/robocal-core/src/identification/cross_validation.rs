@@ -6,7 +6,9 @@
 //! other folds (the whole minus its own) at the full fit's minimum, which is a step of the
 //! order of the noise away from the fold's own minimum, so that the step lands on it to second
 //! order. The left-out points are then evaluated exactly (forward kinematics) under the stepped
-//! model. The whole costs one pass over the data where refits cost several per fold.
+//! model. The whole costs one pass over the data where refits cost several per fold, and none
+//! when the fit's own last pass summed the folds' shares (a model selection's candidates,
+//! [`Calibration::fold_passes`]).
 //! [`cross_validate_refit`] iterates each fold's refit to convergence (warm-started from the full
 //! fit: same identified parameters, tracker frame and final loss); the tests hold the two
 //! together, and a fold whose step cannot be solved is refitted that way.
@@ -114,30 +116,28 @@ pub fn cross_validate(
     let loss = cal.stages.last().expect("at least one stage").loss;
     let params = &cal.identifiability.identified;
     let robot = &cal.calibrated;
-    let stored = cal
+    // Each fold's share of the objective's Hessian and gradient at the full fit's minimum,
+    // weighted as the fit weighted its points: from the fit's last pass when it summed them,
+    // else from one pass of its own (a pass over a fold's points alone would weigh them by
+    // their own mean uncertainty, not the whole set's).
+    let shares = match cal
         .fold_passes
         .as_ref()
-        .filter(|p| p.len() == folds && p.iter().all(|(h, _)| h.nrows() == params.len()));
-    // Each fold's points and their share of the normal equations at the full fit's minimum.
-    let parts: Vec<Result<Option<Part>>> = (0..folds)
+        .filter(|p| p.len() == folds && p.iter().all(|(h, _)| h.nrows() == params.len()))
+    {
+        Some(p) => p.clone(),
+        None => Problem::new(robot, params, &weighted, &cal.frame)
+            .grouped(&fold, folds)
+            .accumulate(robot, &loss, Level::Newton)
+            .groups
+            .expect("a grouped Newton pass"),
+    };
+    let parts: Vec<Result<Option<Part>>> = shares
         .into_par_iter()
-        .map(|f| {
+        .enumerate()
+        .map(|(f, share)| {
             let test = subset(&weighted, |i| fold[i] == f)?;
-            if test.is_empty() {
-                return Ok(None);
-            }
-            let share = match stored {
-                Some(p) => p[f].clone(),
-                None => {
-                    let acc = Problem::new(robot, params, &test, &cal.frame).accumulate(
-                        robot,
-                        &loss,
-                        Level::Newton,
-                    );
-                    (acc.h.expect("Newton level"), acc.b)
-                }
-            };
-            Ok(Some((f, test, share)))
+            Ok((!test.is_empty()).then_some((f, test, share)))
         })
         .collect();
     let parts: Vec<Part> = parts

@@ -160,7 +160,11 @@ impl Families {
     fn widest(auto: AutoFamilies, compliant: bool) -> Families {
         Families {
             compliance: auto.compliance && compliant,
-            harmonics: if auto.harmonics { HARMONICS[HARMONICS.len() - 1] } else { 0 },
+            harmonics: if auto.harmonics {
+                HARMONICS[HARMONICS.len() - 1]
+            } else {
+                0
+            },
             backlash: auto.backlash,
             thermal: auto.thermal,
         }

@@ -217,3 +217,101 @@ fn the_one_step_cross_validation_matches_the_refits() {
         }
     }
 }
+
+/// What the candidates share (see `pipeline::shared`) gives each candidate the fit it would
+/// have of its own: the widest candidate's reduced Jacobian and start pass, restricted, give the
+/// same identifiability and the same minimum; the folds' shares of the fit's last pass give the
+/// cross-validation of passes of its own.
+#[test]
+fn shared_start_passes_and_fold_shares_give_the_candidates_own_fits() {
+    use crate::identification::cross_validation::cross_validate;
+    use crate::identification::folds::FOLDS;
+    use crate::identification::pipeline::{calibrate_model_for, Purpose, Shared};
+    use crate::model::family::compliance;
+    let truth = preset("kuka-kr480-r3330-table3").unwrap();
+    let sag = GravityModel::new(
+        vec![0.0, 2e-8, 2e-8, 0.0, 0.0, 0.0],
+        PAPER_LINK_MASSES_KG.to_vec(),
+        PAPER_PAYLOAD_KG,
+    );
+    let nominal = preset("kuka-kr480-r3330").unwrap();
+    let mut widest = nominal.clone();
+    compliance::enable(&mut widest, &compliance::auto_joints(&nominal), None).unwrap();
+    transmission::enable(&mut widest, &(0..6).collect::<Vec<_>>(), 2).unwrap();
+    let mut harmonic = nominal.clone();
+    transmission::enable(&mut harmonic, &(0..6).collect::<Vec<_>>(), 1).unwrap();
+    let mut compliant = nominal.clone();
+    compliance::enable(&mut compliant, &compliance::auto_joints(&nominal), None).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(8);
+    let obs = measure(&truth, Some(&sag), 75, &mut rng);
+    let data = CalibrationData {
+        calibration: &obs,
+        plane: None,
+        validation: None,
+    };
+    let settings = CalibrationSettings::default();
+    let shared = Shared::new(&nominal, &widest, data, &settings).unwrap();
+    for (name, model) in [
+        ("geometric", &nominal),
+        ("harmonics 1", &harmonic),
+        ("compliance", &compliant),
+    ] {
+        let fit = |s| calibrate_model_for(model, data, &settings, Purpose::Candidate, &(), s);
+        let (with, own) = (fit(Some(&shared)).unwrap(), fit(None).unwrap());
+        let (a, b) = (&with.identifiability, &own.identifiability);
+        assert_eq!(a.identified, b.identified, "{name}");
+        assert_eq!(
+            a.fixed.iter().map(|f| f.param).collect::<Vec<_>>(),
+            b.fixed.iter().map(|f| f.param).collect::<Vec<_>>(),
+            "{name}"
+        );
+        assert!(
+            (a.condition_number - b.condition_number).abs() <= 1e-9 * b.condition_number,
+            "{name}: {} against {}",
+            a.condition_number,
+            b.condition_number
+        );
+        for (p, q) in a.independence.iter().zip(&b.independence) {
+            assert!((p - q).abs() <= 1e-9, "{name}: {p} against {q}");
+        }
+        let mean = |c: &Calibration| c.calibration.after_stats().mean_mm;
+        assert!(
+            (mean(&with) - mean(&own)).abs() <= 1e-9,
+            "{name}: {} against {}",
+            mean(&with),
+            mean(&own)
+        );
+        // The fit's last pass summed the folds' shares, and they give the same figures as
+        // passes of the cross-validation's own.
+        let shares = with.fold_passes.as_ref().expect("the folds' shares");
+        // Weighted as the fit weighs the points (each by the whole set's mean uncertainty):
+        // at the fit's minimum the folds' gradients cancel.
+        let total = shares
+            .iter()
+            .fold(nalgebra::DVector::zeros(shares[0].1.len()), |t, s| t + &s.1);
+        let largest = shares.iter().map(|s| s.1.amax()).fold(0.0, f64::max);
+        eprintln!(
+            "{name}: total gradient {:e}, largest fold's {:e}",
+            total.amax(),
+            largest
+        );
+        assert!(
+            total.amax() <= 1e-3 * largest,
+            "{name}: {} of {largest}",
+            total.amax()
+        );
+        let mut without = with.clone();
+        without.fold_passes = None;
+        let (x, y) = (
+            cross_validate(&with, &obs, FOLDS).unwrap(),
+            cross_validate(&without, &obs, FOLDS).unwrap(),
+        );
+        assert!(
+            (x.mean_mm - y.mean_mm).abs() <= 1e-9 * y.mean_mm,
+            "{name}: {} against {}",
+            x.mean_mm,
+            y.mean_mm
+        );
+        assert!((x.std_error_mm - y.std_error_mm).abs() <= 1e-9 * y.std_error_mm);
+    }
+}

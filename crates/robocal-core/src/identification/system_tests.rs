@@ -258,3 +258,63 @@ fn a_restricted_start_pass_is_the_subsets_own_and_the_solve_from_it_the_same() {
     assert_eq!(a.evaluations, b.evaluations);
     assert_eq!(small.values(&r1), small.values(&r2));
 }
+
+/// A grouped pass gives each group's share of the Hessian and gradient: the pass over that
+/// group's observations alone (unweighted points here: a subset's own pass weighs its points by
+/// its own mean uncertainty), the shares summing to the whole, which is the ungrouped pass's
+/// (to rounding: the sums are taken in another order). Over enough points for parallel chunks.
+#[test]
+fn a_grouped_pass_gives_each_groups_share() {
+    let (nominal, obs) = kr480_problem_data(700, 0.02);
+    let group: Vec<usize> = (0..obs.len()).map(|i| (i * 7) % 3).collect();
+    for loss in [
+        Loss::Huber { k: 0.03 },
+        Loss::Adaptive { k: 0.04 },
+        Loss::Squared,
+    ] {
+        grouped_pass_case(&nominal, &obs, &group, &loss);
+    }
+}
+
+fn grouped_pass_case(nominal: &Robot, obs: &Observations, group: &[usize], loss: &Loss) {
+    let (nominal, loss) = (nominal.clone(), *loss);
+    let params = nominal.params();
+    let frame = TrackerFrame::identity();
+    let plain =
+        Problem::new(&nominal, &params, obs, &frame).accumulate(&nominal, &loss, Level::Full);
+    let grouped_problem = Problem::new(&nominal, &params, obs, &frame).grouped(group, 3);
+    let grouped = grouped_problem.accumulate(&nominal, &loss, Level::Full);
+    let close = |a: &DMatrix<f64>, b: &DMatrix<f64>| (a - b).amax() <= 1e-12 * b.amax();
+    assert!(close(&grouped.a, &plain.a));
+    assert!(close(
+        grouped.s.as_ref().unwrap(),
+        plain.s.as_ref().unwrap()
+    ));
+    assert!(close(
+        grouped.h.as_ref().unwrap(),
+        plain.h.as_ref().unwrap()
+    ));
+    assert!((&grouped.b - &plain.b).amax() <= 1e-12 * plain.b.amax());
+    assert!((grouped.objective - plain.objective).abs() <= 1e-12 * plain.objective);
+    assert!(plain.groups.is_none());
+    let shares = grouped.groups.expect("the groups' shares");
+    assert_eq!(shares.len(), 3);
+    let mut sum = DMatrix::zeros(params.len(), params.len());
+    for (g, (h, b)) in shares.iter().enumerate() {
+        let sub = obs.rows_where(|i| group[i] == g).unwrap();
+        let own = Problem::new(&nominal, &params, &sub, &frame).accumulate(
+            &nominal,
+            &loss,
+            Level::Newton,
+        );
+        assert!(close(h, own.h.as_ref().unwrap()), "group {g}");
+        assert!((b - &own.b).amax() <= 1e-12 * own.b.amax(), "group {g}");
+        sum += h;
+    }
+    assert!(close(&sum, plain.h.as_ref().unwrap()));
+    // Below the Newton level there is no Hessian to share.
+    assert!(grouped_problem
+        .accumulate(&nominal, &loss, Level::Normal)
+        .groups
+        .is_none());
+}

@@ -238,7 +238,9 @@ pub(crate) fn calibrate_model_for(
             &own
         }
     };
-    let first = calibrate_once(nominal, data, settings, purpose, observer, registered, shared)?;
+    let first = calibrate_once(
+        nominal, data, settings, purpose, observer, registered, shared,
+    )?;
     let start = if first.tool_fit.applied {
         first.tool_fit.apply(nominal)
     } else {

@@ -74,13 +74,11 @@ impl Shared {
             let params = start.robot.param_list().to_vec();
             let reduced = jacobian_r(&start.robot, &start.observations);
             let sigma0 = super::identify::noise_bound(&start);
-            let pass = (sigma0 > 0.0 && sigma0.is_finite()).then(|| {
-                Problem::new(&start.robot, &params, &start.observations, &start.frame).accumulate(
-                    &start.robot,
-                    &Loss::Squared,
-                    Level::Full,
-                )
-            });
+            let pass =
+                (sigma0 > 0.0 && sigma0.is_finite()).then(|| {
+                    Problem::new(&start.robot, &params, &start.observations, &start.frame)
+                        .accumulate(&start.robot, &Loss::Squared, Level::Full)
+                });
             Some(StartPasses {
                 params,
                 reduced,
