@@ -13,6 +13,7 @@
 
 pub mod conditions;
 pub mod poe;
+pub mod trig;
 
 pub use conditions::Conditions;
 
@@ -356,10 +357,10 @@ fn joint_motion<const MIXED: bool>(
     qi: f64,
 ) -> (f64, f64, f64) {
     if MIXED && types[i] == JointType::Prismatic {
-        let (s, c) = l.phi.sin_cos();
+        let (s, c) = trig::sin_cos(l.phi);
         (s, c, l.d + qi)
     } else {
-        let (s, c) = (qi + l.phi).sin_cos();
+        let (s, c) = trig::sin_cos(qi + l.phi);
         (s, c, l.d)
     }
 }
