@@ -105,10 +105,22 @@ fn near_miss(h: &str, dof: usize) -> Option<String> {
 /// A CSV reader with robocal's settings: a header row, fields trimmed, equal row lengths, the
 /// delimiter of the header line (`,`, `;` or tab), true line numbers ([`LineCounted`]).
 pub(crate) fn csv_reader<R: Read>(reader: R) -> csv::Reader<LineCounted<R>> {
+    reader_trimming(reader, csv::Trim::All)
+}
+
+/// [`csv_reader`] that trims only the header: the cells of each row are left as written, for a
+/// reader that reads them through [`ColumnLayout::number`], [`ColumnLayout::extra_values_into`]
+/// and [`next_record`], which trim each cell they read (`csv` trims a row by building a new
+/// record, an allocation per row).
+pub(crate) fn csv_reader_header_trimmed<R: Read>(reader: R) -> csv::Reader<LineCounted<R>> {
+    reader_trimming(reader, csv::Trim::Headers)
+}
+
+fn reader_trimming<R: Read>(reader: R, trim: csv::Trim) -> csv::Reader<LineCounted<R>> {
     let counted = LineCounted::new(reader);
     csv::ReaderBuilder::new()
         .has_headers(true)
-        .trim(csv::Trim::All)
+        .trim(trim)
         .flexible(false)
         .delimiter(counted.delimiter())
         .from_reader(counted)
@@ -232,8 +244,9 @@ impl ColumnLayout {
         )
     }
 
-    /// The number in column `k` of `record` (at `line`): rejects empty cells, text and
-    /// non-finite values, naming the file, line and column.
+    /// The number in column `k` of `record` (at `line`; the cell trimmed): rejects empty cells,
+    /// text and non-finite values, naming the file, line and column.
+    #[inline]
     pub fn number(
         &self,
         record: &csv::StringRecord,
@@ -241,7 +254,7 @@ impl ColumnLayout {
         path: &Path,
         line: usize,
     ) -> Result<f64> {
-        let s = &record[k];
+        let s = record[k].trim();
         let perr = |msg: String| Error::parse(path, Some(line), Some(&self.headers[k]), msg);
         if s.is_empty() {
             return Err(perr("empty cell".into()));
@@ -265,6 +278,7 @@ impl ColumnLayout {
     /// [`ColumnLayout::number`] within `range` ([`crate::ranges`]); a value outside is an error
     /// naming the file, line and column, its message starting with `what` (e.g. `not a plausible
     /// tracker reading`).
+    #[inline]
     pub fn number_in(
         &self,
         record: &csv::StringRecord,
@@ -329,19 +343,39 @@ impl ColumnLayout {
         path: &Path,
         line: usize,
     ) -> Result<(Vec<f64>, f64)> {
+        let mut q = Vec::with_capacity(joints.dof());
+        let largest = self.joint_values_into(record, cols, joints, path, line, &mut q)?;
+        Ok((q, largest))
+    }
+
+    /// [`ColumnLayout::joint_values`] written to `q` (its old values replaced; no allocation
+    /// once `q` has room for the joints, for files of `q1..qn` columns); returns the largest
+    /// magnitude of a revolute joint's cell.
+    pub fn joint_values_into(
+        &self,
+        record: &csv::StringRecord,
+        cols: &JointColumns,
+        joints: &JointSpace,
+        path: &Path,
+        line: usize,
+        q: &mut Vec<f64>,
+    ) -> Result<f64> {
         // Joint j's cell within its plausible range: an angle (deg, multi-turn axes allowed) or,
         // for a prismatic joint, a length (mm).
+        let read_into = |c: &[usize], v: &mut [f64]| -> Result<()> {
+            for ((&k, t), v) in c.iter().zip(joints.types()).zip(v.iter_mut()) {
+                let range = match t {
+                    JointType::Revolute => &crate::ranges::JOINT,
+                    JointType::Prismatic => &crate::ranges::LENGTH,
+                };
+                *v = self.number_in(record, k, path, line, range, "not a plausible joint value")?;
+            }
+            Ok(())
+        };
         let read = |c: &[usize]| -> Result<Vec<f64>> {
-            c.iter()
-                .zip(joints.types())
-                .map(|(&k, t)| {
-                    let range = match t {
-                        JointType::Revolute => &crate::ranges::JOINT,
-                        JointType::Prismatic => &crate::ranges::LENGTH,
-                    };
-                    self.number_in(record, k, path, line, range, "not a plausible joint value")
-                })
-                .collect()
+            let mut v = vec![0.0; c.len()];
+            read_into(c, &mut v)?;
+            Ok(v)
         };
         let largest_angle = |v: &[f64]| {
             v.iter()
@@ -349,20 +383,25 @@ impl ColumnLayout {
                 .filter(|(_, t)| **t == JointType::Revolute)
                 .fold(0.0f64, |m, (x, _)| m.max(x.abs()))
         };
+        q.clear();
         match cols {
             JointColumns::Model(c) => {
-                let v = read(c)?;
-                Ok((joints.joints_from_display(&v), largest_angle(&v)))
+                let mut buf = [0.0; crate::model::MAX_JOINTS];
+                let v = &mut buf[..c.len()];
+                read_into(c, v)?;
+                q.extend(v.iter().enumerate().map(|(i, x)| joints.to_internal(i, *x)));
+                Ok(largest_angle(v))
             }
             JointColumns::Axes(c) => {
                 let v = read(c)?;
-                Ok((joints.joints_from_axes(&v), largest_angle(&v)))
+                q.extend(joints.joints_from_axes(&v));
+                Ok(largest_angle(&v))
             }
             JointColumns::Both(qc, ac) => {
                 let v = read(qc)?;
                 let a = read(ac)?;
-                let q = joints.joints_from_display(&v);
-                let expected = joints.axes_from_joints(&q);
+                q.extend(joints.joints_from_display(&v));
+                let expected = joints.axes_from_joints(q);
                 for (j, (x, e)) in a.iter().zip(&expected).enumerate() {
                     if (x - e).abs() > AXIS_AGREEMENT {
                         return Err(Error::parse(
@@ -378,14 +417,26 @@ impl ColumnLayout {
                         ));
                     }
                 }
-                Ok((q, largest_angle(&v)))
+                Ok(largest_angle(&v))
             }
         }
     }
 
-    /// The values of the extra columns of `record`.
+    /// The values of the extra columns of `record` (trimmed).
     pub fn extra_values(&self, record: &csv::StringRecord) -> Vec<String> {
-        self.extra.iter().map(|&k| record[k].to_owned()).collect()
+        self.extra
+            .iter()
+            .map(|&k| record[k].trim().to_owned())
+            .collect()
+    }
+
+    /// [`ColumnLayout::extra_values`] written to `out`, reusing its strings.
+    pub fn extra_values_into(&self, record: &csv::StringRecord, out: &mut Vec<String>) {
+        out.resize_with(self.extra.len(), String::new);
+        for (o, &k) in out.iter_mut().zip(&self.extra) {
+            o.clear();
+            o.push_str(record[k].trim());
+        }
     }
 }
 
@@ -400,7 +451,7 @@ pub(crate) fn next_record<R: Read>(
         if !read.map_err(|e| csv_error(path, e, Some(rdr.get_ref())))? {
             return Ok(None);
         }
-        if !record.iter().all(|f| f.is_empty()) {
+        if !record.iter().all(|f| f.trim().is_empty()) {
             let byte = record.position().map_or(0, csv::Position::byte);
             return Ok(Some(rdr.get_ref().line_at(byte)));
         }
