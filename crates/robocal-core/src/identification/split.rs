@@ -46,7 +46,13 @@ pub fn read_split<R: Read>(
     let header = reader.header();
     let mut split = Splitter::new(&header)?;
     let mut labeler = Labeler::new(&header.extra_columns);
-    while let Some(r) = reader.next_row()? {
+    let mut r = Measurement {
+        line: 0,
+        q: Vec::new(),
+        p: None,
+        extra: Vec::new(),
+    };
+    while reader.next_row_into(&mut r)? {
         each_row(&r);
         if let Some(label) = labeler.label(r.line, &r.extra) {
             split.push(&header, &r, label)?;

@@ -105,10 +105,22 @@ fn near_miss(h: &str, dof: usize) -> Option<String> {
 /// A CSV reader with robocal's settings: a header row, fields trimmed, equal row lengths, the
 /// delimiter of the header line (`,`, `;` or tab), true line numbers ([`LineCounted`]).
 pub(crate) fn csv_reader<R: Read>(reader: R) -> csv::Reader<LineCounted<R>> {
+    reader_trimming(reader, csv::Trim::All)
+}
+
+/// [`csv_reader`] that trims only the header: the cells of each row are left as written, for a
+/// reader that reads them through [`ColumnLayout::number`], [`ColumnLayout::extra_values_into`]
+/// and [`next_record`], which trim each cell they read (`csv` trims a row by building a new
+/// record, an allocation per row).
+pub(crate) fn csv_reader_header_trimmed<R: Read>(reader: R) -> csv::Reader<LineCounted<R>> {
+    reader_trimming(reader, csv::Trim::Headers)
+}
+
+fn reader_trimming<R: Read>(reader: R, trim: csv::Trim) -> csv::Reader<LineCounted<R>> {
     let counted = LineCounted::new(reader);
     csv::ReaderBuilder::new()
         .has_headers(true)
-        .trim(csv::Trim::All)
+        .trim(trim)
         .flexible(false)
         .delimiter(counted.delimiter())
         .from_reader(counted)
@@ -232,8 +244,9 @@ impl ColumnLayout {
         )
     }
 
-    /// The number in column `k` of `record` (at `line`): rejects empty cells, text and
-    /// non-finite values, naming the file, line and column.
+    /// The number in column `k` of `record` (at `line`; the cell trimmed): rejects empty cells,
+    /// text and non-finite values, naming the file, line and column.
+    #[inline]
     pub fn number(
         &self,
         record: &csv::StringRecord,
@@ -241,13 +254,13 @@ impl ColumnLayout {
         path: &Path,
         line: usize,
     ) -> Result<f64> {
-        let s = &record[k];
+        let s = record[k].trim();
         let perr = |msg: String| Error::parse(path, Some(line), Some(&self.headers[k]), msg);
         if s.is_empty() {
             return Err(perr("empty cell".into()));
         }
         // A decimal comma, where commas do not separate the columns (`;` or tab): `12,5`.
-        let v: f64 = match s.parse() {
+        let v: f64 = match plain_decimal(s).map_or_else(|| s.parse(), Ok) {
             Ok(v) => v,
             Err(_) if self.delimiter != b',' && s.matches(',').count() == 1 && !s.contains('.') => {
                 s.replace(',', ".")
@@ -265,6 +278,7 @@ impl ColumnLayout {
     /// [`ColumnLayout::number`] within `range` ([`crate::ranges`]); a value outside is an error
     /// naming the file, line and column, its message starting with `what` (e.g. `not a plausible
     /// tracker reading`).
+    #[inline]
     pub fn number_in(
         &self,
         record: &csv::StringRecord,
@@ -329,19 +343,39 @@ impl ColumnLayout {
         path: &Path,
         line: usize,
     ) -> Result<(Vec<f64>, f64)> {
+        let mut q = Vec::with_capacity(joints.dof());
+        let largest = self.joint_values_into(record, cols, joints, path, line, &mut q)?;
+        Ok((q, largest))
+    }
+
+    /// [`ColumnLayout::joint_values`] written to `q` (its old values replaced; no allocation
+    /// once `q` has room for the joints, for files of `q1..qn` columns); returns the largest
+    /// magnitude of a revolute joint's cell.
+    pub fn joint_values_into(
+        &self,
+        record: &csv::StringRecord,
+        cols: &JointColumns,
+        joints: &JointSpace,
+        path: &Path,
+        line: usize,
+        q: &mut Vec<f64>,
+    ) -> Result<f64> {
         // Joint j's cell within its plausible range: an angle (deg, multi-turn axes allowed) or,
         // for a prismatic joint, a length (mm).
+        let read_into = |c: &[usize], v: &mut [f64]| -> Result<()> {
+            for ((&k, t), v) in c.iter().zip(joints.types()).zip(v.iter_mut()) {
+                let range = match t {
+                    JointType::Revolute => &crate::ranges::JOINT,
+                    JointType::Prismatic => &crate::ranges::LENGTH,
+                };
+                *v = self.number_in(record, k, path, line, range, "not a plausible joint value")?;
+            }
+            Ok(())
+        };
         let read = |c: &[usize]| -> Result<Vec<f64>> {
-            c.iter()
-                .zip(joints.types())
-                .map(|(&k, t)| {
-                    let range = match t {
-                        JointType::Revolute => &crate::ranges::JOINT,
-                        JointType::Prismatic => &crate::ranges::LENGTH,
-                    };
-                    self.number_in(record, k, path, line, range, "not a plausible joint value")
-                })
-                .collect()
+            let mut v = vec![0.0; c.len()];
+            read_into(c, &mut v)?;
+            Ok(v)
         };
         let largest_angle = |v: &[f64]| {
             v.iter()
@@ -349,20 +383,25 @@ impl ColumnLayout {
                 .filter(|(_, t)| **t == JointType::Revolute)
                 .fold(0.0f64, |m, (x, _)| m.max(x.abs()))
         };
+        q.clear();
         match cols {
             JointColumns::Model(c) => {
-                let v = read(c)?;
-                Ok((joints.joints_from_display(&v), largest_angle(&v)))
+                let mut buf = [0.0; crate::model::MAX_JOINTS];
+                let v = &mut buf[..c.len()];
+                read_into(c, v)?;
+                q.extend(v.iter().enumerate().map(|(i, x)| joints.to_internal(i, *x)));
+                Ok(largest_angle(v))
             }
             JointColumns::Axes(c) => {
                 let v = read(c)?;
-                Ok((joints.joints_from_axes(&v), largest_angle(&v)))
+                q.extend(joints.joints_from_axes(&v));
+                Ok(largest_angle(&v))
             }
             JointColumns::Both(qc, ac) => {
                 let v = read(qc)?;
                 let a = read(ac)?;
-                let q = joints.joints_from_display(&v);
-                let expected = joints.axes_from_joints(&q);
+                q.extend(joints.joints_from_display(&v));
+                let expected = joints.axes_from_joints(q);
                 for (j, (x, e)) in a.iter().zip(&expected).enumerate() {
                     if (x - e).abs() > AXIS_AGREEMENT {
                         return Err(Error::parse(
@@ -378,15 +417,65 @@ impl ColumnLayout {
                         ));
                     }
                 }
-                Ok((q, largest_angle(&v)))
+                Ok(largest_angle(&v))
             }
         }
     }
 
-    /// The values of the extra columns of `record`.
+    /// The values of the extra columns of `record` (trimmed).
     pub fn extra_values(&self, record: &csv::StringRecord) -> Vec<String> {
-        self.extra.iter().map(|&k| record[k].to_owned()).collect()
+        self.extra
+            .iter()
+            .map(|&k| record[k].trim().to_owned())
+            .collect()
     }
+
+    /// [`ColumnLayout::extra_values`] written to `out`, reusing its strings.
+    pub fn extra_values_into(&self, record: &csv::StringRecord, out: &mut Vec<String>) {
+        out.resize_with(self.extra.len(), String::new);
+        for (o, &k) in out.iter_mut().zip(&self.extra) {
+            o.clear();
+            o.push_str(record[k].trim());
+        }
+    }
+}
+
+/// The exact powers of ten of a double, 1e0..=1e22.
+const POWERS_OF_TEN: [f64; 23] = [
+    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+];
+
+/// A plain decimal (`-12.345`: an optional sign, digits, at most one point, at most 15 digits in
+/// all) the quick way, `None` for anything else: its digits as an integer and ten to the number
+/// of decimals are both exact doubles, so their quotient is the correctly rounded value, the
+/// same bits as `str::parse` gives (Clinger's fast path); the standard parser (a few hundred
+/// instructions a cell) then reads only what this does not.
+#[inline]
+fn plain_decimal(s: &str) -> Option<f64> {
+    let b = s.as_bytes();
+    let (neg, digits) = match b.first()? {
+        b'-' => (true, &b[1..]),
+        b'+' => (false, &b[1..]),
+        _ => (false, b),
+    };
+    let (mut mantissa, mut count, mut decimals, mut point) = (0u64, 0usize, 0usize, false);
+    for &c in digits {
+        match c {
+            b'0'..=b'9' => {
+                mantissa = mantissa * 10 + u64::from(c - b'0');
+                count += 1;
+                decimals += usize::from(point);
+            }
+            b'.' if !point => point = true,
+            _ => return None,
+        }
+    }
+    if count == 0 || count > 15 {
+        return None;
+    }
+    let v = mantissa as f64 / POWERS_OF_TEN[decimals];
+    Some(if neg { -v } else { v })
 }
 
 /// Reads the next row that is not blank into `record`; its 1-based line, or `None` at the end.
@@ -400,7 +489,7 @@ pub(crate) fn next_record<R: Read>(
         if !read.map_err(|e| csv_error(path, e, Some(rdr.get_ref())))? {
             return Ok(None);
         }
-        if !record.iter().all(|f| f.is_empty()) {
+        if !record.iter().all(|f| f.trim().is_empty()) {
             let byte = record.position().map_or(0, csv::Position::byte);
             return Ok(Some(rdr.get_ref().line_at(byte)));
         }
@@ -436,4 +525,63 @@ pub(crate) fn csv_error<R: Read>(
         _ => e.to_string(),
     };
     Error::parse(path, line, None, msg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::plain_decimal;
+
+    /// The quick parse gives the standard parser's bits wherever it answers, and answers for the
+    /// decimals files hold.
+    #[test]
+    fn plain_decimals_are_the_standard_parse() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..100_000 {
+            let (r, decimals) = (next(), (next() % 16) as usize);
+            let v = (r % 10_000_000_000) as f64 / 1000.0 - 5e6;
+            let s = format!("{v:.decimals$}");
+            let want: f64 = s.parse().unwrap();
+            match plain_decimal(&s) {
+                Some(got) => assert_eq!(got.to_bits(), want.to_bits(), "{s}"),
+                None => assert!(s.trim_start_matches('-').len() > 16, "{s}"),
+            }
+        }
+        for s in [
+            "0",
+            "-0",
+            "-0.0",
+            "+5",
+            "5.",
+            ".5",
+            "-37.953953735",
+            "123456789012345",
+        ] {
+            let want: f64 = s.parse().unwrap();
+            assert_eq!(
+                plain_decimal(s).map(f64::to_bits),
+                Some(want.to_bits()),
+                "{s}"
+            );
+        }
+        for s in [
+            "",
+            "-",
+            ".",
+            "1e5",
+            "1.2.3",
+            "inf",
+            "NaN",
+            "1,5",
+            "1234567890123456",
+            " 1",
+        ] {
+            assert_eq!(plain_decimal(s), None, "{s}");
+        }
+    }
 }

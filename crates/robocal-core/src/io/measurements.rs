@@ -9,7 +9,9 @@
 //! positions must be within their plausible ranges ([`crate::ranges`]).
 
 use crate::error::{Error, Result};
-use crate::io::columns::{csv_reader, joint_column, next_record, ColumnLayout, JointColumns};
+use crate::io::columns::{
+    csv_reader_header_trimmed, joint_column, next_record, ColumnLayout, JointColumns,
+};
 use crate::model::JointSpace;
 use crate::ranges;
 use nalgebra::Vector3;
@@ -143,7 +145,7 @@ impl<R: Read> MeasurementReader<R> {
             Error::parse(path, line, field, msg)
         };
         let dof = joints.dof();
-        let mut rdr = csv_reader(reader);
+        let mut rdr = csv_reader_header_trimmed(reader);
         let layout = ColumnLayout::read(
             &mut rdr,
             path,
@@ -217,12 +219,25 @@ impl<R: Read> MeasurementReader<R> {
     /// The next data row (blank rows are skipped), `None` at the end of the file. Fails naming
     /// the line and the column of a malformed cell.
     pub fn next_row(&mut self) -> Result<Option<Measurement>> {
+        let mut row = Measurement {
+            line: 0,
+            q: Vec::with_capacity(self.joints.dof()),
+            p: None,
+            extra: Vec::new(),
+        };
+        Ok(self.next_row_into(&mut row)?.then_some(row))
+    }
+
+    /// [`MeasurementReader::next_row`] written to `row` (every field replaced), reusing its
+    /// buffers: a file of any length is read without an allocation per row. `false` at the end
+    /// of the file (`row` then unchanged).
+    pub fn next_row_into(&mut self, row: &mut Measurement) -> Result<bool> {
         let Some(line) = next_record(&mut self.rdr, &mut self.record, &self.path)? else {
-            return Ok(None);
+            return Ok(false);
         };
         let (layout, record, path) = (&self.layout, &self.record, &self.path);
-        let (q, largest_angle) =
-            layout.joint_values(record, &self.q_col, &self.joints, path, line)?;
+        let largest_angle =
+            layout.joint_values_into(record, &self.q_col, &self.joints, path, line, &mut row.q)?;
         self.max_abs_deg = self.max_abs_deg.max(largest_angle);
         let pos = |k| {
             layout.number_in(
@@ -239,12 +254,10 @@ impl<R: Read> MeasurementReader<R> {
             None => None,
         };
         self.rows += 1;
-        Ok(Some(Measurement {
-            line,
-            q,
-            p,
-            extra: self.layout.extra_values(&self.record),
-        }))
+        row.line = line;
+        row.p = p;
+        layout.extra_values_into(record, &mut row.extra);
+        Ok(true)
     }
 
     /// Ends the reading: fails if the file had no data rows; returns the warnings (e.g. joint

@@ -13,12 +13,13 @@
 
 pub mod conditions;
 pub mod poe;
+pub mod trig;
 
 pub use conditions::Conditions;
 
 use crate::frame::Frame;
 use crate::model::family::{self, PoseFrames, RigidPose};
-use crate::model::{mul_rot_z, Convention, JointType, Link, Robot, MAX_JOINTS};
+use crate::model::{mul_rot_z, Convention, JointType, Robot, MAX_JOINTS};
 use nalgebra::{Matrix3, Vector3};
 
 impl Robot {
@@ -38,10 +39,9 @@ impl Robot {
     fn flange_pose_with<const MIXED: bool>(&self, q: &[f64]) -> Frame {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut f = *self.base_frame();
-        let types = self.joint_types();
-        for (i, &qi) in q.iter().enumerate() {
-            let l = &self.links()[i];
-            let (s, co, d) = joint_motion::<MIXED>(types, i, l, qi);
+        let motion = self.joint_motions::<MIXED>(q);
+        for i in 0..q.len() {
+            let (s, co, d) = motion.of(i);
             match self.convention() {
                 Convention::Mdh => {
                     self.apply_link_constant(i, &mut f);
@@ -166,16 +166,14 @@ impl Robot {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut out = RigidPose::default();
         out.commanded[..q.len()].copy_from_slice(q);
-        let mixed = self.joint_space().any_prismatic();
+        let motion = if self.joint_space().any_prismatic() {
+            self.joint_motions::<true>(q)
+        } else {
+            self.joint_motions::<false>(q)
+        };
         let mut f = *self.base_frame();
-        let types = self.joint_types();
-        for (i, &qi) in q.iter().enumerate() {
-            let l = &self.links()[i];
-            let (s, co, d) = if mixed {
-                joint_motion::<true>(types, i, l, qi)
-            } else {
-                joint_motion::<false>(types, i, l, qi)
-            };
+        for i in 0..q.len() {
+            let (s, co, d) = motion.of(i);
             if self.convention() == Convention::Mdh {
                 self.apply_link_constant(i, &mut f);
             }
@@ -201,10 +199,9 @@ impl Robot {
             rigid: RigidPose::default(),
         };
         let mut f = *self.base_frame();
-        let types = self.joint_types();
-        for (i, &qi) in q.iter().enumerate() {
-            let l = &self.links()[i];
-            let (s, co, d) = joint_motion::<MIXED>(types, i, l, qi);
+        let motion = self.joint_motions::<MIXED>(q);
+        for i in 0..q.len() {
+            let (s, co, d) = motion.of(i);
             match self.convention() {
                 Convention::Mdh => {
                     ch.link[i] = f;
@@ -345,22 +342,43 @@ impl Robot {
     }
 }
 
-/// Joint `i`'s rotation (sin, cos) and translation along its axis at joint value `qi`:
-/// `Rz(qi + phi) Tz(d)` for a revolute joint, `Rz(phi) Tz(d + qi)` for a prismatic one. Without
-/// `MIXED` every joint is revolute (the caller knows) and `types` is not read.
-#[inline(always)]
-fn joint_motion<const MIXED: bool>(
-    types: &[JointType],
-    i: usize,
-    l: &Link,
-    qi: f64,
-) -> (f64, f64, f64) {
-    if MIXED && types[i] == JointType::Prismatic {
-        let (s, c) = l.phi.sin_cos();
-        (s, c, l.d + qi)
-    } else {
-        let (s, c) = (qi + l.phi).sin_cos();
-        (s, c, l.d)
+/// Every joint's rotation (sin, cos) and translation along its axis at the joint values of one
+/// pass: `Rz(q + phi) Tz(d)` for a revolute joint, `Rz(phi) Tz(d + q)` for a prismatic one.
+struct JointMotions {
+    sin: [f64; MAX_JOINTS],
+    cos: [f64; MAX_JOINTS],
+    d: [f64; MAX_JOINTS],
+}
+
+impl JointMotions {
+    /// Joint `i`'s `(sin, cos, d)`.
+    #[inline(always)]
+    fn of(&self, i: usize) -> (f64, f64, f64) {
+        (self.sin[i], self.cos[i], self.d[i])
+    }
+}
+
+impl Robot {
+    /// The [`JointMotions`] at `q`: every angle first, then their sines and cosines in one loop
+    /// ([`trig::sin_cos_all`]) whose iterations do not wait on each other, nor on the frames
+    /// the pass then chains. Without `MIXED` every joint is revolute (the caller knows).
+    #[inline(always)]
+    fn joint_motions<const MIXED: bool>(&self, q: &[f64]) -> JointMotions {
+        let n = q.len();
+        let types = self.joint_types();
+        let mut angle = [0.0; MAX_JOINTS];
+        let mut m = JointMotions {
+            sin: [0.0; MAX_JOINTS],
+            cos: [0.0; MAX_JOINTS],
+            d: [0.0; MAX_JOINTS],
+        };
+        for (i, (l, &qi)) in self.links().iter().zip(q).enumerate() {
+            let prismatic = MIXED && types[i] == JointType::Prismatic;
+            angle[i] = if prismatic { l.phi } else { qi + l.phi };
+            m.d[i] = if prismatic { l.d + qi } else { l.d };
+        }
+        trig::sin_cos_all(&angle[..n], &mut m.sin[..n], &mut m.cos[..n]);
+        m
     }
 }
 

@@ -100,15 +100,18 @@ pub fn fit_procrustes(
         ));
     }
     let w = |i: usize| weights.map_or(1.0, |w| w[i]);
-    let wsum: f64 = (0..n).map(w).sum();
-    if !(wsum > 0.0 && wsum.is_finite()) {
-        return Err(Error::Numerical("registration: weights sum to zero".into()));
-    }
+    // The weights' sum and the weighted sums of the points in one pass (each sum in point
+    // order, as in separate passes).
+    let mut wsum = 0.0;
     let mut cm = Vector3::zeros();
     let mut cp = Vector3::zeros();
     for i in 0..n {
+        wsum += w(i);
         cm += from[i] * w(i);
         cp += to[i] * w(i);
+    }
+    if !(wsum > 0.0 && wsum.is_finite()) {
+        return Err(Error::Numerical("registration: weights sum to zero".into()));
     }
     cm /= wsum;
     cp /= wsum;

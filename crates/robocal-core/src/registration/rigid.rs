@@ -86,14 +86,17 @@ pub fn fit_rigid_sum_of_norms(
     let mut f = *init;
     let mut w = vec![0.0; measured.len()];
     for it in 1..=opts.max_iterations {
-        let e = residual_norms(&f, measured, target);
-        for (wi, ei) in w.iter_mut().zip(&e) {
-            *wi = 1.0 / ei.max(opts.floor_mm);
+        for ((wi, m), p) in w.iter_mut().zip(measured).zip(target) {
+            *wi = 1.0 / (f.to_base(m) - p).norm().max(opts.floor_mm);
         }
         let g = fit_rigid(measured, target, Some(&w))?;
+        // How far each point moved, `(R_g - R_f) m + (t_g - t_f)`: one product a point.
+        let (pg, pf) = (g.pose(), f.pose());
+        let dr = pg.rotation.matrix() - pf.rotation.matrix();
+        let dt = pg.translation.vector - pf.translation.vector;
         let moved = measured
             .iter()
-            .map(|m| (g.to_base(m) - f.to_base(m)).norm())
+            .map(|m| (dr * m + dt).norm())
             .fold(0.0, f64::max);
         f = g;
         if moved <= opts.tolerance_mm {
