@@ -1,13 +1,16 @@
 //! Sine and cosine of every joint angle of a chain in one branch-free pass: the forward
 //! kinematics of a million points spent a fifth of a calibration in the C library's `sincos`,
 //! one call per joint and pass. Here each angle is reduced by the nearest multiple of pi/2 (a
-//! three-part Cody-Waite reduction, exact in its first step for the angles robocal accepts) and evaluated by the minimax polynomials of fdlibm's
-//! `__kernel_sin` / `__kernel_cos` on [-pi/4, pi/4], then rotated into its quadrant without a
-//! branch, so the loop over the joints vectorises. The result is within about one unit in the
-//! last place of `f64::sin_cos` (a test holds it to 2 ulp over many turns).
+//! three-part Cody-Waite reduction, exact in its first step for the angles robocal accepts) and
+//! the sine and cosine of the remainder in [-pi/4, pi/4] are their Taylor series, to the
+//! terms below a unit in the last place there (x^17/17! and x^16/16!), summed so that the large
+//! terms come last; then rotated into the angle's quadrant without a branch, so the loop over
+//! the joints vectorises. Written here rather than taken from a crate because the point is
+//! that loop: the libm ports evaluate one angle at a time, with branches. The result is within
+//! about one unit in the last place of `f64::sin_cos` (a test holds it to 2 ulp over many turns).
 
-/// pi/2 in three parts (fdlibm's `pio2_1`, `pio2_2`, `pio2_2t`): the first two of 33 bits, so
-/// that their products with a quadrant count below 2^20 are exact.
+/// pi/2 in three parts: the first two with 33 significant bits, so that their products with a
+/// quadrant count below 2^20 are exact, the third the rest (pi/2 = sum to about 1e-37).
 const PIO2_1: f64 = 1.5707963267341256;
 const PIO2_2: f64 = 6.077100506303966e-11;
 const PIO2_2T: f64 = 2.0222662487959506e-21;
@@ -17,21 +20,35 @@ const PIO2_2T: f64 = 2.0222662487959506e-21;
 /// rounding instruction).
 const ROUNDER: f64 = 6_755_399_441_055_744.0;
 
-/// fdlibm `__kernel_sin` coefficients.
-const S1: f64 = -0.16666666666666632;
-const S2: f64 = 0.00833333333332249;
-const S3: f64 = -0.0001984126982985795;
-const S4: f64 = 2.7557313707070068e-06;
-const S5: f64 = -2.5050760253406863e-08;
-const S6: f64 = 1.58969099521155e-10;
+/// `1 / n!`.
+const fn inv_factorial(n: u32) -> f64 {
+    let mut f = 1.0;
+    let mut k = 2;
+    while k <= n {
+        f *= k as f64;
+        k += 1;
+    }
+    1.0 / f
+}
 
-/// fdlibm `__kernel_cos` coefficients.
-const C1: f64 = 0.0416666666666666;
-const C2: f64 = -0.001388888888887411;
-const C3: f64 = 2.480158728947673e-05;
-const C4: f64 = -2.7557314351390663e-07;
-const C5: f64 = 2.087572321298175e-09;
-const C6: f64 = -1.1359647557788195e-11;
+/// The sine's Taylor coefficients: `(-1)^k / (2k+1)!`, k = 1..8.
+const S1: f64 = -inv_factorial(3);
+const S2: f64 = inv_factorial(5);
+const S3: f64 = -inv_factorial(7);
+const S4: f64 = inv_factorial(9);
+const S5: f64 = -inv_factorial(11);
+const S6: f64 = inv_factorial(13);
+const S7: f64 = -inv_factorial(15);
+const S8: f64 = inv_factorial(17);
+
+/// The cosine's Taylor coefficients beyond `1 - x^2/2`: `(-1)^k / (2k)!`, k = 2..8.
+const C1: f64 = inv_factorial(4);
+const C2: f64 = -inv_factorial(6);
+const C3: f64 = inv_factorial(8);
+const C4: f64 = -inv_factorial(10);
+const C5: f64 = inv_factorial(12);
+const C6: f64 = -inv_factorial(14);
+const C7: f64 = inv_factorial(16);
 
 /// Beyond this magnitude (rad) the reduction is no longer accurate and the standard library's
 /// `sin_cos` is used instead (joint angles are far smaller: see [`crate::ranges::JOINT`]).
@@ -56,9 +73,11 @@ fn reduced_sin_cos(x: f64) -> (f64, f64) {
     let r = (x - k * PIO2_1) - k * PIO2_2 - k * PIO2_2T;
     let z = r * r;
     let w = z * z;
-    let sr = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6);
+    // sin r = r + r z (S1 + z (S2 + ...)), cos r = 1 - z/2 + z^2 (C1 + z (C2 + ...)), z = r^2:
+    // the small terms summed first, then added to the large ones.
+    let sr = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6) + w * w * z * (S7 + z * S8);
     let s = r + z * r * (S1 + z * sr);
-    let cr = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
+    let cr = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * (C6 + z * C7)));
     let hz = 0.5 * z;
     let one_minus = 1.0 - hz;
     let c = one_minus + (((1.0 - one_minus) - hz) + z * cr);
