@@ -1,6 +1,7 @@
 //! The folds of a model selection's cross-validation: by pose, so that the rows of one pose
 //! (several reflectors, 6-DoF rows) stay together.
 
+use crate::model::MAX_JOINTS;
 use crate::observations::Observations;
 use rand::seq::SliceRandom;
 use rand::SeedableRng;
@@ -13,9 +14,12 @@ pub const FOLDS: usize = 5;
 /// random order, dealt out in turn, so that the rows of one pose share a fold.
 pub fn pose_folds(obs: &Observations, folds: usize) -> Vec<usize> {
     let mut pose_of = Vec::with_capacity(obs.len());
-    let mut index: HashMap<Vec<u64>, usize> = HashMap::new();
+    let mut index: HashMap<[u64; MAX_JOINTS], usize> = HashMap::with_capacity(obs.len());
     for i in 0..obs.len() {
-        let key: Vec<u64> = obs.q(i).iter().map(|v| v.to_bits()).collect();
+        let mut key = [0u64; MAX_JOINTS];
+        for (k, v) in key.iter_mut().zip(obs.q(i)) {
+            *k = v.to_bits();
+        }
         let n = index.len();
         pose_of.push(*index.entry(key).or_insert(n));
     }

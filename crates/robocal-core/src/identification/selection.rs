@@ -33,7 +33,6 @@ use crate::identification::cross_validation::{cross_validate, CrossValidation};
 pub use crate::identification::model_choice::{
     AutoFamilies, Candidate, ModelChoice, ModelSelection,
 };
-use crate::identification::pipeline::start::same_tool_points;
 use crate::identification::pipeline::{
     calibrate_model, calibrate_model_for, complete, Calibration, CalibrationData,
     CalibrationSettings, Purpose, Shared,
@@ -236,7 +235,9 @@ fn select_fitted(
         .robot(nominal, reference_c)?;
     let shared = Shared::new(&given, &widest, data, &fit_settings)?;
     let fit = |robot: &Robot, reference: bool| -> (Candidate, Option<Calibration>) {
-        let shared = same_tool_points(robot, &given, data.calibration).then_some(&shared);
+        let shared = shared
+            .same_tool_points(robot, data.calibration)
+            .then_some(&shared);
         match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &(), shared) {
             Err(e) => {
                 let mut cand = Candidate::new(robot, reference);
@@ -247,7 +248,9 @@ fn select_fitted(
         }
     };
     let given_fit = |robot: &Robot| -> Result<(Candidate, Option<Calibration>)> {
-        let shared = same_tool_points(robot, &given, data.calibration).then_some(&shared);
+        let shared = shared
+            .same_tool_points(robot, data.calibration)
+            .then_some(&shared);
         let cal = calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &(), shared)?;
         Ok(assess(robot, false, cal, data))
     };

@@ -220,7 +220,7 @@ pub(crate) fn register_for(
 
 /// [`calibrate_model`] for a `purpose`; `shared`: the frame, tools and start passes shared by
 /// the candidates of a model selection, for a model with the same tool points at the start as
-/// the robot they were registered to (see [`start::same_tool_points`]), not computed again.
+/// the robot they were registered to (see [`Shared::same_tool_points`]), not computed again.
 pub(crate) fn calibrate_model_for(
     nominal: &Robot,
     data: CalibrationData,

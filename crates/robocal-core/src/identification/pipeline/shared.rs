@@ -18,11 +18,15 @@ use crate::identification::identifiability::{jacobian_r, Reduced};
 use crate::identification::objective::Loss;
 use crate::identification::system::{Accumulated, Level, Problem};
 use crate::model::{Param, Robot};
+use crate::observations::Observations;
+use nalgebra::Vector3;
 
 /// What the candidates of a model selection share (see the module docs).
 pub(crate) struct Shared {
     /// The frame and tools registered to the robot as given.
     pub registered: Registered,
+    /// The robot as given's targets, and its tool point at each calibration point.
+    given_points: (usize, Vec<Vector3<f64>>),
     /// The widest model's start passes, when it has the robot as given's tool points.
     passes: Option<StartPasses>,
 }
@@ -69,8 +73,20 @@ impl Shared {
         settings: &CalibrationSettings,
     ) -> Result<Shared> {
         let registered = super::register_for(given, data, settings)?;
-        let passes = if start::same_tool_points(widest, given, data.calibration) {
-            let start = start::prepare(widest, &data, settings, &registered)?;
+        let obs = data.calibration;
+        let given_points = (
+            given.target_count(),
+            (0..obs.len())
+                .map(|i| given.target_position_in(obs.q(i), obs.target(i), &obs.conditions(i)))
+                .collect(),
+        );
+        let mut shared = Shared {
+            registered,
+            given_points,
+            passes: None,
+        };
+        if shared.same_tool_points(widest, obs) {
+            let start = start::prepare(widest, &data, settings, &shared.registered)?;
             let params = start.robot.param_list().to_vec();
             let reduced = jacobian_r(&start.robot, &start.observations);
             let sigma0 = super::identify::noise_bound(&start);
@@ -79,15 +95,24 @@ impl Shared {
                     Problem::new(&start.robot, &params, &start.observations, &start.frame)
                         .accumulate(&start.robot, &Loss::Squared, Level::Full)
                 });
-            Some(StartPasses {
+            shared.passes = Some(StartPasses {
                 params,
                 reduced,
                 pass,
+            });
+        }
+        Ok(shared)
+    }
+
+    /// Whether `robot` puts the tool points of `obs` (the calibration points) where the robot
+    /// as given does, bit for bit: then it shares the start.
+    pub fn same_tool_points(&self, robot: &Robot, obs: &Observations) -> bool {
+        let (targets, points) = &self.given_points;
+        robot.target_count() == *targets
+            && obs.len() == points.len()
+            && (0..obs.len()).all(|i| {
+                robot.target_position_in(obs.q(i), obs.target(i), &obs.conditions(i)) == points[i]
             })
-        } else {
-            None
-        };
-        Ok(Shared { registered, passes })
     }
 
     /// The share of a candidate starting from `start` (the robot as given's tool points, its

@@ -73,17 +73,6 @@ pub(crate) fn register_nominal(
     })
 }
 
-/// Whether `a` and `b` put the tool points of `obs` at the same places (bit for bit): then
-/// they share a [`Registered`].
-pub(crate) fn same_tool_points(a: &Robot, b: &Robot, obs: &Observations) -> bool {
-    a.target_count() == b.target_count()
-        && (0..obs.len()).all(|i| {
-            let c = obs.conditions(i);
-            let (q, t) = (obs.q(i), obs.target(i));
-            a.target_position_in(q, t, &c) == b.target_position_in(q, t, &c)
-        })
-}
-
 /// The model the identification starts from: `registered` (the frame and tools fitted to
 /// `nominal`, or to a model with the same tool points), the weights resolved.
 pub(super) fn prepare(
