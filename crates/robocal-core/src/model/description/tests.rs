@@ -119,7 +119,8 @@ fn to_robot_is_the_robot_of_its_toml_text() {
             .find(|r| r.name() == "kr480-track")
             .unwrap(),
     );
-    let bad: Vec<(RobotDescription, fn(&mut RobotDescription))> = vec![
+    type Spoil = fn(&mut RobotDescription);
+    let bad: Vec<(RobotDescription, Spoil)> = vec![
         (kr.clone(), |d| d.joints[1].alpha = 1e300),
         (kr.clone(), |d| d.joints[2].d = f64::NAN),
         (kr.clone(), |d| d.joints[0].limits = [10.0, -10.0]),
