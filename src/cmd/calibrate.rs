@@ -17,7 +17,8 @@ mod real_cell;
 mod settings;
 pub(crate) use print::print_selection;
 use print::{print_plausibility, print_report};
-use settings::{read, Settings};
+use robocal_core::io::{MeasurementReader, Positions};
+use settings::{read, read_from, Settings};
 
 #[derive(Args, Debug)]
 pub struct CalibrateArgs {
@@ -185,7 +186,15 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let s = Settings::try_from(&a)?;
     let Settings { robot, betas, .. } = &s;
     let rank_tolerance = s.calibration.identifiability.rank_tolerance;
-    if constraints::is_constraint_file(&s.data, robot)? {
+    // The data file is opened once as measurements; only a header those refuse is read again
+    // to tell whether it holds constraint rows (whose header needs no x,y,z), in the order of
+    // checks of a file sniffed first: its header's errors, constraint data, then measurements.
+    let opened = MeasurementReader::open(&s.data, robot.joint_space(), Positions::Required);
+    let constraint = match &opened {
+        Ok(r) => constraints::has_constraint_column(r.extra_columns()),
+        Err(_) => constraints::is_constraint_file(&s.data, robot)?,
+    };
+    if constraint {
         return constraints::run(&s, a.distances.as_deref(), a.accept_unknown_scale);
     }
     if a.distances.is_some() || a.accept_unknown_scale {
@@ -196,7 +205,7 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         )));
     }
     let mut outside = Vec::new();
-    let mut data = read(&s.data, robot, s.nominal_limits, &mut outside)?;
+    let mut data = read_from(opened?, &s.data, robot, s.nominal_limits, &mut outside)?;
     let robot = &real_cell::fit_to_data(robot, &mut data, &s.data)?;
     let mut validation = data.validation.clone();
     if let Some(v) = &s.validate {

@@ -107,7 +107,15 @@ const PHRASES: &[(&str, &str)] = &[
 /// `text` with every setting named in backticks (`` `noise_mm` ``) replaced by its flag.
 pub fn with_flags(text: &str) -> String {
     let mut out = text.to_owned();
+    // Only text with a quoted word can name a setting; each is looked for, unquoted first (no
+    // allocation), then quoted where the bare name occurs.
+    if !out.contains('`') {
+        return out;
+    }
     for (setting, flag) in FLAGS {
+        if !out.contains(setting) {
+            continue;
+        }
         let quoted = format!("`{setting}`");
         if out.contains(&quoted) {
             out = out.replace(&quoted, flag);

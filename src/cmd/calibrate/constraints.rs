@@ -28,9 +28,15 @@ use std::path::Path;
 /// `constraint` column).
 pub(crate) fn is_constraint_file(path: &Path, robot: &Robot) -> anyhow::Result<bool> {
     let r = MeasurementReader::open(path, robot.joint_space(), Positions::Ignored)?;
-    Ok(r.extra_columns()
+    Ok(has_constraint_column(r.extra_columns()))
+}
+
+/// Whether a measurement file's extra columns (its header beyond the joint columns) hold the
+/// `constraint` column.
+pub(super) fn has_constraint_column(extra_columns: &[String]) -> bool {
+    extra_columns
         .iter()
-        .any(|c| c.eq_ignore_ascii_case(CONSTRAINT_COLUMN)))
+        .any(|c| c.eq_ignore_ascii_case(CONSTRAINT_COLUMN))
 }
 
 /// Reads, calibrates, prints and writes a constraint calibration.

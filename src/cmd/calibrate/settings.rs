@@ -165,6 +165,17 @@ pub(super) fn read(
 ) -> anyhow::Result<robocal_core::identification::SplitData> {
     // Row by row: a million rows are never held as text rows beside their observations.
     let reader = MeasurementReader::open(path, robot.joint_space(), Positions::Required)?;
+    read_from(reader, path, robot, nominal_limits, outside)
+}
+
+/// [`read`] from the file at `path` opened already (its header checked).
+pub(super) fn read_from<R: std::io::Read>(
+    reader: MeasurementReader<R>,
+    path: &Path,
+    robot: &Robot,
+    nominal_limits: bool,
+    outside: &mut Vec<OutsideLimits>,
+) -> anyhow::Result<robocal_core::identification::SplitData> {
     let mut o = OutsideLimits::new(robot, path);
     let (split, warnings) = read_split(reader, |r| o.check(r.line, &r.q))?;
     for w in &warnings {

@@ -15,6 +15,7 @@ pub mod result;
 pub mod result_cell;
 pub mod result_constraint;
 mod result_format;
+mod result_key_order;
 pub mod result_payload;
 pub mod result_prediction;
 pub mod result_robot;

@@ -34,7 +34,7 @@ pub(super) fn check_read(
                 ("rms_mm", s.rms_mm),
                 ("p95_mm", s.p95_mm),
             ] {
-                let field = format!("errors.{set}.{when}.{name}");
+                let field = || format!("errors.{set}.{when}.{name}");
                 check_value(text, path, &field, v, &crate::ranges::ERROR)?;
             }
         }
@@ -42,17 +42,19 @@ pub(super) fn check_read(
     Ok((r, nominal))
 }
 
-/// Checks `v` against `range`; the error names the file, the field and its line in `text`.
-pub(crate) fn check_value(
+/// Checks `v` against `range`; the error names the file, the field (its name made only then)
+/// and its line in `text`.
+fn check_value(
     text: &str,
     path: &Path,
-    field: &str,
+    field: &dyn Fn() -> String,
     v: f64,
     range: &crate::ranges::Range,
 ) -> Result<()> {
     range.check(v).map(|_| ()).map_err(|msg| {
-        let line = crate::io::json_keys::line_of_key(text, field);
-        Error::parse(path, line, Some(field), msg)
+        let field = field();
+        let line = crate::io::json_keys::line_of_key(text, &field);
+        Error::parse(path, line, Some(&field), msg)
     })
 }
 
@@ -66,7 +68,7 @@ pub(crate) fn check_parameters(
     use crate::ranges::Range;
     for (name, p) in params {
         let range = Range::for_unit(p.unit);
-        let field = |k: &str| format!("parameters.{name}.{k}");
+        let field = |k: &'static str| move || format!("parameters.{name}.{k}");
         check_value(text, path, &field("nominal"), p.nominal, range)?;
         check_value(text, path, &field("calibrated"), p.calibrated, range)?;
         if let Some(sd) = p.std {
@@ -88,7 +90,7 @@ pub(crate) fn check_frame(f: &FrameVec, field: &str, text: &str, path: &Path) ->
         ("b", f.b, &ANGLE),
         ("c", f.c, &ANGLE),
     ] {
-        check_value(text, path, &format!("{field}.{k}"), v, range)?;
+        check_value(text, path, &|| format!("{field}.{k}"), v, range)?;
     }
     Ok(())
 }

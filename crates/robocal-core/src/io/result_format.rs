@@ -12,18 +12,44 @@ use serde_json::ser::{Formatter, PrettyFormatter};
 use std::io::{self, Write};
 
 /// The arrays whose object entries take one line each: (parent key, key).
-const ONE_LINE_ENTRIES: [(&str, &str); 2] = [("points", "calibration"), ("points", "validation")];
+const ONE_LINE_ENTRIES: [(Key, Key); 2] = [
+    (Key::Points, Key::Calibration),
+    (Key::Points, Key::Validation),
+];
+
+/// A key as far as the layout cares: one of the keys of [`ONE_LINE_ENTRIES`], or another (so
+/// that no key is kept as text beyond the one being written).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Key {
+    Points,
+    Calibration,
+    Validation,
+    Other,
+}
+
+impl Key {
+    fn of(text: &str) -> Key {
+        match text {
+            "points" => Key::Points,
+            "calibration" => Key::Calibration,
+            "validation" => Key::Validation,
+            _ => Key::Other,
+        }
+    }
+}
 
 /// serde_json's pretty formatter, with the entries of [`ONE_LINE_ENTRIES`] on one line each.
 pub(crate) struct ResultFormatter {
     pretty: PrettyFormatter<'static>,
     /// For each open object or array, the key it is the value of (`None` at the root and in
     /// arrays).
-    open: Vec<Option<String>>,
-    /// The key being written, while it is.
-    key: Option<String>,
+    open: Vec<Option<Key>>,
+    /// The text of the key being written, while `in_key` (reused from key to key).
+    key: String,
+    /// Whether a key is being written.
+    in_key: bool,
     /// The last key written in the innermost open object.
-    last_key: Option<String>,
+    last_key: Option<Key>,
     /// The depth (`open.len()`) of the one-line entry being written, while one is.
     one_line: Option<usize>,
 }
@@ -34,7 +60,8 @@ impl ResultFormatter {
         ResultFormatter {
             pretty: PrettyFormatter::new(),
             open: Vec::new(),
-            key: None,
+            key: String::new(),
+            in_key: false,
             last_key: None,
             one_line: None,
         }
@@ -52,12 +79,10 @@ impl ResultFormatter {
         if n < 2 || self.last_key.is_some() {
             return false;
         }
-        let (Some(array), Some(parent)) = (&self.open[n - 1], &self.open[n - 2]) else {
+        let (Some(array), Some(parent)) = (self.open[n - 1], self.open[n - 2]) else {
             return false;
         };
-        ONE_LINE_ENTRIES
-            .iter()
-            .any(|(p, k)| p == parent && k == array)
+        ONE_LINE_ENTRIES.contains(&(parent, array))
     }
 
     fn in_one_line(&self) -> bool {
@@ -123,7 +148,8 @@ impl Formatter for ResultFormatter {
     }
 
     fn begin_object_key<W: ?Sized + Write>(&mut self, w: &mut W, first: bool) -> io::Result<()> {
-        self.key = Some(String::new());
+        self.key.clear();
+        self.in_key = true;
         if self.in_one_line() {
             return if first { Ok(()) } else { w.write_all(b", ") };
         }
@@ -131,7 +157,8 @@ impl Formatter for ResultFormatter {
     }
 
     fn end_object_key<W: ?Sized + Write>(&mut self, _w: &mut W) -> io::Result<()> {
-        self.last_key = self.key.take();
+        self.in_key = false;
+        self.last_key = Some(Key::of(&self.key));
         Ok(())
     }
 
@@ -155,8 +182,8 @@ impl Formatter for ResultFormatter {
         w: &mut W,
         fragment: &str,
     ) -> io::Result<()> {
-        if let Some(k) = &mut self.key {
-            k.push_str(fragment);
+        if self.in_key {
+            self.key.push_str(fragment);
         }
         w.write_all(fragment.as_bytes())
     }

@@ -9,41 +9,41 @@ use serde::{Deserialize, Serialize};
 /// `prediction` (DESIGN.md "Result JSON additions").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PredictionSection {
-    /// Expected mean error norm at new poses spread like the calibration poses (mm).
-    #[serde(deserialize_with = "nullable::f64")]
-    pub mean_mm: f64,
-    /// Spread (standard deviation) of the error norm over such poses (mm).
-    #[serde(deserialize_with = "nullable::f64")]
-    pub std_mm: f64,
-    /// Expected RMS error norm (mm).
-    #[serde(deserialize_with = "nullable::f64")]
-    pub rms_mm: f64,
-    /// Per-axis measurement noise the prediction assumes (mm), from the calibration residuals.
-    #[serde(deserialize_with = "nullable::f64")]
-    pub noise_sigma_mm: f64,
-    /// RMS error the parameters' uncertainty alone leaves at those poses (mm).
-    #[serde(deserialize_with = "nullable::f64")]
-    pub model_rms_mm: f64,
     /// The predicted error at random poses of the workspace.
     #[serde(default)]
     pub map: Vec<MapEntry>,
+    /// Expected mean error norm at new poses spread like the calibration poses (mm).
+    #[serde(deserialize_with = "nullable::f64")]
+    pub mean_mm: f64,
+    /// RMS error the parameters' uncertainty alone leaves at those poses (mm).
+    #[serde(deserialize_with = "nullable::f64")]
+    pub model_rms_mm: f64,
+    /// Per-axis measurement noise the prediction assumes (mm), from the calibration residuals.
+    #[serde(deserialize_with = "nullable::f64")]
+    pub noise_sigma_mm: f64,
+    /// Expected RMS error norm (mm).
+    #[serde(deserialize_with = "nullable::f64")]
+    pub rms_mm: f64,
+    /// Spread (standard deviation) of the error norm over such poses (mm).
+    #[serde(deserialize_with = "nullable::f64")]
+    pub std_mm: f64,
 }
 
 /// One point of `prediction.map`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MapEntry {
-    /// Tool position, base frame (mm).
-    pub x: f64,
-    /// Tool position, base frame (mm).
-    pub y: f64,
-    /// Tool position, base frame (mm).
-    pub z: f64,
     /// Expected error norm of a measurement there (mm).
     #[serde(deserialize_with = "nullable::f64")]
     pub mean_mm: f64,
     /// RMS error of the model alone there (mm).
     #[serde(deserialize_with = "nullable::f64")]
     pub model_mm: f64,
+    /// Tool position, base frame (mm).
+    pub x: f64,
+    /// Tool position, base frame (mm).
+    pub y: f64,
+    /// Tool position, base frame (mm).
+    pub z: f64,
 }
 
 impl From<&Prediction> for PredictionSection {

@@ -3,7 +3,9 @@
 //! CLI, the report) reads. Readers see exactly the schema the writer uses.
 //!
 //! The result writes each section through `sorted`, which orders the keys of every object
-//! alphabetically, as results have always been written. A non-finite number is written as `null`
+//! alphabetically, as results have always been written. The sections' structs declare their
+//! fields in that order where they can (a tagged or flattened entry cannot), so that they are
+//! written directly; the order of a declaration never changes the text, only the speed. A non-finite number is written as `null`
 //! (JSON has no NaN) and read back as NaN ([`nullable`]).
 
 use crate::frame::TrackerFrame;
@@ -12,9 +14,14 @@ use crate::unit::Unit;
 use serde::{Deserialize, Serialize, Serializer};
 use std::collections::BTreeMap;
 
-/// Writes `v` with the keys of every object in alphabetical order.
+/// Writes `v` with the keys of every object in alphabetical order: directly when its keys
+/// already come so ([`crate::io::result_key_order`]: the types declare their fields in that
+/// order), else through a `serde_json::Value`, whose maps sort them. The text is the same.
 pub(crate) fn sorted<T: Serialize, S: Serializer>(v: &T, s: S) -> Result<S::Ok, S::Error> {
     use serde::ser::Error;
+    if crate::io::result_key_order::keys_sorted(v) {
+        return v.serialize(s);
+    }
     serde_json::to_value(v)
         .map_err(S::Error::custom)?
         .serialize(s)
@@ -262,11 +269,11 @@ pub struct Registration {
 /// An identified parameter (`identifiability.identified`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct IdentifiedEntry {
-    /// Its name.
-    pub name: String,
     /// How independent of the others its effect is (0..1).
     #[serde(deserialize_with = "nullable::f64")]
     pub independence: f64,
+    /// Its name.
+    pub name: String,
     /// RMS effect of one unit on the points (mm per mm or deg).
     #[serde(deserialize_with = "nullable::f64")]
     pub rms_effect_mm_per_unit: f64,
@@ -294,22 +301,19 @@ pub enum FixKind {
 /// A parameter whose effect another one duplicates, with the coefficient.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DuplicateEntry {
-    /// The parameter.
-    pub name: String,
     /// Its coefficient (unit of the fixed parameter per unit of this one).
     #[serde(deserialize_with = "nullable::f64")]
     pub coefficient: f64,
+    /// The parameter.
+    pub name: String,
 }
 
 /// A fixed parameter (`identifiability.fixed`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FixedEntry {
-    /// Its name.
-    pub name: String,
-    /// Why, in words.
-    pub reason: String,
-    /// Why, as a kind.
-    pub kind: FixKind,
+    /// For a duplicate: the parameters whose combination it is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub duplicates: Option<Vec<DuplicateEntry>>,
     /// For a duplicate: how independent its effect is.
     #[serde(
         default,
@@ -317,9 +321,12 @@ pub struct FixedEntry {
         deserialize_with = "nullable_opt"
     )]
     pub independence: Option<f64>,
-    /// For a duplicate: the parameters whose combination it is.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub duplicates: Option<Vec<DuplicateEntry>>,
+    /// Why, as a kind.
+    pub kind: FixKind,
+    /// Its name.
+    pub name: String,
+    /// Why, in words.
+    pub reason: String,
 }
 
 fn nullable_opt<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D::Error> {
@@ -329,23 +336,23 @@ fn nullable_opt<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<f64>, D
 /// `identifiability`: which parameters the data identify.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Identifiability {
-    /// The relative rank threshold.
-    pub rank_tolerance: f64,
+    /// The limit above which it is ill-conditioned.
+    pub condition_limit: f64,
     /// Condition number of the scaled identification Jacobian.
     #[serde(deserialize_with = "nullable::f64")]
     pub condition_number: f64,
-    /// The limit above which it is ill-conditioned.
-    pub condition_limit: f64,
-    /// Whether it is.
-    pub ill_conditioned: bool,
-    /// How many identified.
-    pub n_identified: usize,
-    /// How many fixed.
-    pub n_fixed: usize,
-    /// The identified parameters.
-    pub identified: Vec<IdentifiedEntry>,
     /// The fixed parameters.
     pub fixed: Vec<FixedEntry>,
+    /// The identified parameters.
+    pub identified: Vec<IdentifiedEntry>,
+    /// Whether it is.
+    pub ill_conditioned: bool,
+    /// How many fixed.
+    pub n_fixed: usize,
+    /// How many identified.
+    pub n_identified: usize,
+    /// The relative rank threshold.
+    pub rank_tolerance: f64,
 }
 
 /// A solver stage's loss (`solver.stages[].loss` and its scale).
@@ -441,13 +448,13 @@ pub struct CorrelationEntry {
 /// `uncertainty`: the estimates' covariance.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Uncertainty {
+    /// The most correlated pairs.
+    pub most_correlated: Vec<CorrelationEntry>,
     /// The fit's sigma (mm).
     #[serde(deserialize_with = "nullable::f64")]
     pub sigma_mm: f64,
     /// Each identified parameter's standard deviation (its unit); `None` where unavailable.
     pub std: BTreeMap<String, Option<f64>>,
-    /// The most correlated pairs.
-    pub most_correlated: Vec<CorrelationEntry>,
     /// Why standard deviations are unavailable, if they are.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub std_unavailable: Option<String>,
@@ -496,23 +503,23 @@ pub struct Points {
 /// One check of the plausibility gate.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CheckEntry {
-    /// Its name.
-    pub name: String,
-    /// The measured value (`null` when not finite).
-    #[serde(deserialize_with = "nullable::f64")]
-    pub measured: f64,
-    /// Its limit.
-    #[serde(deserialize_with = "nullable::f64")]
-    pub limit: f64,
-    /// Their unit.
-    pub unit: String,
-    /// Whether it passed.
-    pub passed: bool,
-    /// In words.
-    pub detail: String,
     /// The likely cause of a failure.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cause: Option<String>,
+    /// In words.
+    pub detail: String,
+    /// Its limit.
+    #[serde(deserialize_with = "nullable::f64")]
+    pub limit: f64,
+    /// The measured value (`null` when not finite).
+    #[serde(deserialize_with = "nullable::f64")]
+    pub measured: f64,
+    /// Its name.
+    pub name: String,
+    /// Whether it passed.
+    pub passed: bool,
+    /// Their unit.
+    pub unit: String,
 }
 
 /// A likely cause of an implausible fit.
@@ -523,29 +530,29 @@ pub struct CauseEntry {
     /// RMS of the nominal model's fit under this explanation (mm).
     #[serde(deserialize_with = "nullable::f64")]
     pub fit_rms_mm: f64,
+    /// A joint mistake that explains the fit.
+    pub joints: Option<String>,
+    /// Whether the points are mirrored.
+    pub mirrored: bool,
     /// Scale of the points to the model.
     #[serde(deserialize_with = "nullable::f64")]
     pub scale: f64,
-    /// Whether the points are mirrored.
-    pub mirrored: bool,
     /// A length unit that explains the scale.
     pub unit: Option<String>,
-    /// A joint mistake that explains the fit.
-    pub joints: Option<String>,
 }
 
 /// `plausibility`: the gate's checks.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PlausibilitySection {
-    /// Whether every check passed.
-    pub passed: bool,
-    /// The robot's reach (mm).
-    pub reach_mm: f64,
     /// The checks.
     pub checks: Vec<CheckEntry>,
     /// Likely causes of a failure.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub likely_causes: Option<Vec<CauseEntry>>,
+    /// Whether every check passed.
+    pub passed: bool,
+    /// The robot's reach (mm).
+    pub reach_mm: f64,
 }
 
 /// A tracker frame's vector in mm and degrees, as a JSON object (the form of a

@@ -184,8 +184,7 @@ impl RobotDescription {
     /// limits ordered, prismatic joints with limits, an invertible controller map). Errors name
     /// `path` and the field as the robot file would (`joints[2].alpha`, `controller.sign`).
     pub fn to_robot(&self, path: &Path) -> Result<Robot> {
-        let text = self.to_toml()?;
-        super::robot_file::parse_robot_toml(&text, path).map_err(|e| match e {
+        super::robot_file::from_description(self, path).map_err(|e| match e {
             Error::Parse {
                 path,
                 field,

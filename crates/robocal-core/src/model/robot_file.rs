@@ -112,6 +112,67 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
             message: e.message().trim().to_owned(),
         }
     })?;
+    build(file, text, path)
+}
+
+/// The robot of a description ([`super::description::RobotDescription::to_robot`]), checked as
+/// its robot file would be: the description is handed to the file's checks directly, as the
+/// parsed file it would read back as (every value at an empty span; the caller drops the
+/// lines).
+pub(super) fn from_description(
+    d: &super::description::RobotDescription,
+    path: &Path,
+) -> Result<Robot> {
+    let at = |v: f64| Spanned::new(0..0, v);
+    let list = |v: &[f64]| Spanned::new(0..0, v.iter().map(|x| at(*x)).collect());
+    let file = RobotFile {
+        name: Some(d.name.clone()),
+        convention: Spanned::new(0..0, d.convention.as_str().to_owned()),
+        base: Some(list(&d.base)),
+        tool: Some(list(&d.tool)),
+        tool_correction: d.tool_correction.as_ref().map(|v| list(v)),
+        tools: d
+            .tools
+            .as_ref()
+            .map(|t| Spanned::new(0..0, t.iter().map(|v| list(v)).collect())),
+        gravity: d.gravity.as_ref().map(|v| list(v)),
+        joints: d
+            .joints
+            .iter()
+            .map(|j| JointEntry {
+                kind: Some(Spanned::new(0..0, j.kind.as_str().to_owned())),
+                alpha: at(j.alpha),
+                d: at(j.d),
+                a: at(j.a),
+                phi: Some(at(j.phi)),
+                beta: j.beta.map(at),
+                limits: Some(list(&j.limits)),
+            })
+            .collect(),
+        controller: d.controller.as_ref().map(|c| {
+            Spanned::new(
+                0..0,
+                ControllerEntry {
+                    sign: Some(list(&c.sign)),
+                    offset: Some(list(&c.offset)),
+                    coupling: (!c.coupling.is_empty()).then(|| {
+                        Spanned::new(
+                            0..0,
+                            c.coupling
+                                .iter()
+                                .map(|(i, j, k)| list(&[*i as f64, *j as f64, *k]))
+                                .collect(),
+                        )
+                    }),
+                },
+            )
+        }),
+    };
+    build(file, "", path)
+}
+
+/// Checks a parsed robot file (`text` is its text, for the lines in errors) and builds the robot.
+fn build(file: RobotFile, text: &str, path: &Path) -> Result<Robot> {
     let err = |span: std::ops::Range<usize>, field: String, msg: String| Error::Parse {
         path: path.to_owned(),
         line: Some(line_of(text, span.start)),

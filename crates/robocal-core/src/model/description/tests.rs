@@ -77,6 +77,83 @@ fn every_robot_round_trips_exactly_through_json_and_toml() {
     }
 }
 
+/// `to_robot` hands the description to the robot file's checks without writing and parsing its
+/// TOML text: the robot, and the refusal of a bad description, are those of the text.
+#[test]
+fn to_robot_is_the_robot_of_its_toml_text() {
+    let path = Path::new("r.json");
+    let via_text = |d: &RobotDescription| {
+        crate::model::robot_file::parse_robot_toml(&d.to_toml().unwrap(), path).map_err(|e| {
+            match e {
+                Error::Parse {
+                    path,
+                    field,
+                    message,
+                    ..
+                } => Error::Parse {
+                    path,
+                    line: None,
+                    field,
+                    message,
+                },
+                other => other,
+            }
+            .to_string()
+        })
+    };
+    let direct = |d: &RobotDescription| d.to_robot(path).map_err(|e| e.to_string());
+    for r in &all_robots() {
+        let d = RobotDescription::of(r);
+        assert_same(&direct(&d).unwrap(), &via_text(&d).unwrap());
+    }
+    let kr = RobotDescription::of(&presets::preset("kuka-kr480-r3330").unwrap());
+    let fanuc = RobotDescription::of(
+        &examples()
+            .into_iter()
+            .find(|r| r.name() == "fanuc-like")
+            .unwrap(),
+    );
+    let track = RobotDescription::of(
+        &examples()
+            .into_iter()
+            .find(|r| r.name() == "kr480-track")
+            .unwrap(),
+    );
+    type Spoil = fn(&mut RobotDescription);
+    let bad: Vec<(RobotDescription, Spoil)> = vec![
+        (kr.clone(), |d| d.joints[1].alpha = 1e300),
+        (kr.clone(), |d| d.joints[2].d = f64::NAN),
+        (kr.clone(), |d| d.joints[0].limits = [10.0, -10.0]),
+        (kr.clone(), |d| d.base[4] = f64::INFINITY),
+        (kr.clone(), |d| {
+            d.tool_correction = Some([0.0, 0.0, 0.0, 0.0, 1e9, 0.0])
+        }),
+        (kr.clone(), |d| d.gravity = Some([0.0, 0.0, 0.0])),
+        (kr.clone(), |d| d.tools = Some(vec![[1.0; 6], [2.0; 6]])),
+        (kr.clone(), |d| d.tools = Some(Vec::new())),
+        (kr.clone(), |d| d.joints.clear()),
+        (kr.clone(), |d| d.joints[3].beta = Some(-1e200)),
+        (fanuc.clone(), |d| {
+            d.controller.as_mut().unwrap().sign[0] = 0.5
+        }),
+        (fanuc.clone(), |d| {
+            d.controller.as_mut().unwrap().offset.pop();
+        }),
+        (fanuc.clone(), |d| {
+            d.controller.as_mut().unwrap().coupling = vec![(2, 2, 1.0)]
+        }),
+        (fanuc.clone(), |d| {
+            d.controller.as_mut().unwrap().coupling = vec![(9, 1, 1.0)]
+        }),
+        (track.clone(), |d| d.joints[0].limits = [0.0, -1.0]),
+    ];
+    for (mut d, spoil) in bad {
+        spoil(&mut d);
+        let e = direct(&d).unwrap_err();
+        assert_eq!(e, via_text(&d).unwrap_err());
+    }
+}
+
 #[test]
 fn the_description_carries_what_the_robot_file_says() {
     let track = examples()
