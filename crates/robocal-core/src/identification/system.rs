@@ -79,6 +79,8 @@ pub struct Problem<'a> {
     /// The group of each observation and the number of groups, when a pass also sums each
     /// group's share of the objective's Hessian and gradient ([`Accumulated::groups`]).
     groups: Option<(&'a [usize], usize)>,
+    /// Whether a pass also keeps each observation's residual norm ([`Accumulated::norms`]).
+    keep_norms: bool,
 }
 
 impl std::fmt::Debug for Problem<'_> {
@@ -125,6 +127,9 @@ pub struct Accumulated {
     /// For a [`Problem::grouped`] problem at [`Level::Newton`] and above: each group's share of
     /// the objective's Hessian `H` and of `b` (they sum to the whole's, up to rounding).
     pub groups: Option<Vec<(DMatrix<f64>, DVector<f64>)>>,
+    /// For a problem [`Problem::keeping_norms`]: each observation's weighted residual norm at
+    /// the pass's model (its [`Problem::fit_norms`], to rounding).
+    pub norms: Option<Vec<f64>>,
 }
 
 impl Accumulated {
@@ -143,6 +148,7 @@ impl Accumulated {
             psi_sq: self.psi_sq,
             rows: self.rows,
             groups: None,
+            norms: None,
         }
     }
 }
@@ -181,7 +187,15 @@ impl<'a> Problem<'a> {
             targets,
             angular: kind.measurability().orientation,
             groups: None,
+            keep_norms: false,
         }
+    }
+
+    /// This problem with its passes also keeping each observation's residual norm
+    /// ([`Accumulated::norms`]: the pass's [`Problem::fit_norms`], not computed again).
+    pub(crate) fn keeping_norms(mut self) -> Self {
+        self.keep_norms = true;
+        self
     }
 
     /// This problem with its observations in groups (`group[i]` of observation `i`, below
@@ -365,6 +379,7 @@ impl<'a> Problem<'a> {
             targets,
             angular: self.angular,
             groups: None,
+            keep_norms: self.keep_norms,
         }
     }
 
@@ -545,24 +560,43 @@ impl<'a> Problem<'a> {
         let rows = self.kind.rows();
         let angular = self.angular;
         let new = || Acc::new(k, rows, np, angular, level);
-        let (acc, groups) = match self.groups.filter(|_| level >= Level::Newton) {
-            None => (
-                chunked(
+        let keep = self.keep_norms;
+        // Each chunk's norms in order, the chunks' in order.
+        let join = |mut a: Vec<f64>, b: Vec<f64>| {
+            a.extend(b);
+            a
+        };
+        let (acc, groups, norms) = match self.groups.filter(|_| level >= Level::Newton) {
+            None => {
+                let (acc, norms) = chunked(
                     self.len(),
-                    new,
+                    || (new(), Vec::new()),
                     #[inline(always)]
-                    |acc, i| acc.add_observation(self, robot, loss, i),
-                    Acc::merge,
-                ),
-                None,
-            ),
+                    |(acc, norms), i| {
+                        let r = acc.add_observation(self, robot, loss, i);
+                        if keep {
+                            norms.push(r);
+                        }
+                    },
+                    |(a, na), (b, nb)| (a.merge(b), join(na, nb)),
+                );
+                (acc, None, norms)
+            }
             Some((group, count)) => {
-                let parts = chunked(
+                let (parts, norms) = chunked(
                     self.len(),
-                    || (0..count).map(|_| new()).collect::<Vec<Acc>>(),
+                    || ((0..count).map(|_| new()).collect::<Vec<Acc>>(), Vec::new()),
                     #[inline(always)]
-                    |accs, i| accs[group[i]].add_observation(self, robot, loss, i),
-                    |a, b| a.into_iter().zip(b).map(|(x, y)| x.merge(y)).collect(),
+                    |(accs, norms), i| {
+                        let r = accs[group[i]].add_observation(self, robot, loss, i);
+                        if keep {
+                            norms.push(r);
+                        }
+                    },
+                    |(a, na), (b, nb)| {
+                        let merged = a.into_iter().zip(b).map(|(x, y)| x.merge(y)).collect();
+                        (merged, join(na, nb))
+                    },
                 );
                 let shares = parts
                     .iter()
@@ -572,7 +606,7 @@ impl<'a> Problem<'a> {
                     })
                     .collect();
                 let whole = parts.into_iter().reduce(Acc::merge).unwrap_or_else(new);
-                (whole, Some(shares))
+                (whole, Some(shares), norms)
             }
         };
         let a = symmetric(k, &acc.a);
@@ -588,6 +622,7 @@ impl<'a> Problem<'a> {
             psi_sq: acc.psi_sq,
             rows: self.rows(),
             groups,
+            norms: keep.then_some(norms),
         }
     }
 }

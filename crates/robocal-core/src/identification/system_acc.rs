@@ -77,7 +77,14 @@ impl Acc {
     /// ([`Problem::observation_rows`]), then `w J^T J`, `w J^T e` (upper triangles) and what the
     /// level adds.
     #[inline(always)]
-    pub(super) fn add_observation(&mut self, p: &Problem, robot: &Robot, loss: &Loss, i: usize) {
+    /// Returns the observation's weighted residual norm (its [`Problem::fit_norms`] entry).
+    pub(super) fn add_observation(
+        &mut self,
+        p: &Problem,
+        robot: &Robot,
+        loss: &Loss,
+        i: usize,
+    ) -> f64 {
         let rows = p.kind.rows();
         let mut e = [0.0; kinds::MAX_ROWS];
         let angular = !self.jw.is_empty();
@@ -92,15 +99,16 @@ impl Acc {
         );
         // Point measurements (3 rows) take a copy of the loop the compiler unrolls.
         if rows == 3 {
-            self.accumulate(3, &e[..3], loss);
+            self.accumulate(3, &e[..3], loss)
         } else {
-            self.accumulate(rows, &e[..rows], loss);
+            self.accumulate(rows, &e[..rows], loss)
         }
     }
 
-    /// The accumulation of one observation's rows (`self.jr`, `rows x k`) and residual `e`.
+    /// The accumulation of one observation's rows (`self.jr`, `rows x k`) and residual `e`;
+    /// returns the residual's norm.
     #[inline(always)]
-    pub(super) fn accumulate(&mut self, rows: usize, e: &[f64], loss: &Loss) {
+    pub(super) fn accumulate(&mut self, rows: usize, e: &[f64], loss: &Loss) -> f64 {
         let k = self.k;
         let jr = &self.jr[..rows * k];
         let mut r2 = 0.0;
@@ -162,6 +170,7 @@ impl Acc {
                 }
             }
         }
+        r
     }
 }
 

@@ -318,3 +318,33 @@ fn grouped_pass_case(nominal: &Robot, obs: &Observations, group: &[usize], loss:
         .groups
         .is_none());
 }
+
+/// A pass of a problem keeping norms gives each observation's weighted residual norm, in
+/// order: the problem's fit norms (to rounding), grouped or not, over parallel chunks.
+#[test]
+fn a_pass_keeps_the_fit_norms_in_order() {
+    let (nominal, obs) = kr480_problem_data(700, 0.02);
+    let params = nominal.params();
+    let frame = TrackerFrame::identity();
+    let group: Vec<usize> = (0..obs.len()).map(|i| (i * 7) % 3).collect();
+    let plain = Problem::new(&nominal, &params, &obs, &frame);
+    let want = plain.fit_norms(&nominal);
+    let loss = Loss::Huber { k: 0.03 };
+    assert!(plain
+        .accumulate(&nominal, &loss, Level::Full)
+        .norms
+        .is_none());
+    for p in [
+        plain.clone().keeping_norms(),
+        plain.grouped(&group, 3).keeping_norms(),
+    ] {
+        let got = p
+            .accumulate(&nominal, &loss, Level::Full)
+            .norms
+            .expect("norms");
+        assert_eq!(got.len(), want.len());
+        for (g, w) in got.iter().zip(&want) {
+            assert!((g - w).abs() <= 1e-12 * w.max(1.0), "{g} against {w}");
+        }
+    }
+}

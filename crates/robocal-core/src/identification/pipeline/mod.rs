@@ -294,7 +294,8 @@ fn calibrate_once(
             &identified.identifiability.identified,
             &start.observations,
             &start.frame,
-        );
+        )
+        .keeping_norms();
         // A candidate's passes also sum each cross-validation fold's share.
         let folds = (purpose == Purpose::Candidate).then(|| pose_folds(&start.observations, FOLDS));
         let problem = match &folds {

@@ -79,7 +79,8 @@ pub(super) fn assemble(
     };
     let (validation, validation_frame) = validation_errors(nominal, data, settings, &start, robot)?;
     let downweighted = solved.robust_scale.map_or_else(Vec::new, |c| {
-        let norms = match &solved.final_norms {
+        // The reweighting's last norms, else the last pass's, else a pass of their own.
+        let norms = match solved.final_norms.as_ref().or(acc.norms.as_ref()) {
             Some(n) => std::borrow::Cow::Borrowed(n),
             None => std::borrow::Cow::Owned(problem.fit_norms(robot)),
         };

@@ -88,6 +88,15 @@ impl Runs<'_, '_> {
         Ok(())
     }
 
+    /// The fit's residual norms at the current model ([`Problem::fit_norms`]): the last run's
+    /// pass's when it ended on one that kept them, else a pass of their own.
+    fn norms(&self) -> Vec<f64> {
+        match self.final_pass.as_ref().and_then(|p| p.norms.clone()) {
+            Some(n) => n,
+            None => self.problem.fit_norms(&self.robot),
+        }
+    }
+
     /// Whether the last run converged (a run stopped by the iteration limit ends the
     /// identification: the result is partial, and later stages would only restart from a
     /// point that is not a minimum).
@@ -225,7 +234,7 @@ fn robust_rounds(runs: &mut Runs) -> Result<(Loss, f64, Option<Vec<f64>>)> {
         |norms: &[f64]| (sigmas * robust_sigma(norms, rows)).max(SUM_OF_NORMS_SMOOTHING_MM);
     let mut c = settings
         .robust_scale_mm
-        .unwrap_or_else(|| scale_of(&problem.fit_norms(&runs.robot)));
+        .unwrap_or_else(|| scale_of(&runs.norms()));
     let mut loss = make(c);
     // The fit's residual norms at the current model, once a run has been followed by them.
     let mut norms = None;
@@ -236,7 +245,7 @@ fn robust_rounds(runs: &mut Runs) -> Result<(Loss, f64, Option<Vec<f64>>)> {
         if settings.robust_scale_mm.is_some() || !runs.converged() {
             break;
         }
-        let at_model = problem.fit_norms(&runs.robot);
+        let at_model = runs.norms();
         let c2 = scale_of(&at_model);
         norms = Some(at_model);
         if (c2 - c).abs() <= settle * c {
