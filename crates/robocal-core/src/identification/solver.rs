@@ -255,6 +255,9 @@ fn solve_inner(
             x_new.copy_from(&x);
             x_new += &delta;
             problem.apply(&mut trial, &x_new);
+            // The current pass's norms are not read once a step is tried (on a million points
+            // two sets of them would be 16 MB).
+            acc.norms = None;
             let at_trial = problem.accumulate(&trial, loss, Level::Full);
             let f_new = at_trial.objective;
             report.evaluations += 1;
@@ -320,6 +323,9 @@ fn solve_inner(
                 // Where the model is trusted the step is likely taken: its pass then serves
                 // the next iteration.
                 let near = lambda <= opts.initial_lambda;
+                if near {
+                    acc.norms = None;
+                }
                 let (f_new, at_trial) = trial_pass(problem, &trial, loss, near);
                 report.evaluations += 1;
                 let gain = (acc.objective - f_new) / pred;

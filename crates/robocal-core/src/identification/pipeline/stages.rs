@@ -89,9 +89,9 @@ impl Runs<'_, '_> {
     }
 
     /// The fit's residual norms at the current model ([`Problem::fit_norms`]): the last run's
-    /// pass's when it ended on one that kept them, else a pass of their own.
-    fn norms(&self) -> Vec<f64> {
-        match self.final_pass.as_ref().and_then(|p| p.norms.clone()) {
+    /// pass's (taken from it) when it ended on one that kept them, else a pass of their own.
+    fn norms(&mut self) -> Vec<f64> {
+        match self.final_pass.as_mut().and_then(|p| p.norms.take()) {
             Some(n) => n,
             None => self.problem.fit_norms(&self.robot),
         }
