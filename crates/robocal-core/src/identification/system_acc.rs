@@ -1,12 +1,12 @@
 //! One pass's accumulation of the normal equations (the hot loop of [`super::Problem`]): the
 //! per-thread buffers, one observation's rows added, the Gram updates.
 
-use super::{Level, Problem};
+use super::{chunked, Accumulated, Level, Problem};
 use crate::identification::kinds;
 use crate::identification::objective::Loss;
 use crate::model::family::PoseFrames;
 use crate::model::Robot;
-use nalgebra::{DMatrix, Vector3};
+use nalgebra::{DMatrix, DVector, Vector3};
 
 /// Per-thread state of a pass.
 pub(super) struct Acc {
@@ -219,4 +219,80 @@ pub(super) fn symmetric(k: usize, upper: &[f64]) -> DMatrix<f64> {
             upper[c * k + r]
         }
     })
+}
+
+impl Problem<'_> {
+    /// One pass over the observations: objective and IRLS normal equations, and what `level`
+    /// adds.
+    pub fn accumulate(&self, robot: &Robot, loss: &Loss, level: Level) -> Accumulated {
+        let k = self.params.len();
+        let np = robot.param_count();
+        let rows = self.kind.rows();
+        let angular = self.angular;
+        let new = || Acc::new(k, rows, np, angular, level);
+        let keep = self.keep_norms;
+        // Each chunk's norms in order, the chunks' in order.
+        let join = |mut a: Vec<f64>, b: Vec<f64>| {
+            a.extend(b);
+            a
+        };
+        let (acc, groups, norms) = match self.groups.filter(|_| level >= Level::Newton) {
+            None => {
+                let (acc, norms) = chunked(
+                    self.len(),
+                    || (new(), Vec::new()),
+                    #[inline(always)]
+                    |(acc, norms), i| {
+                        let r = acc.add_observation(self, robot, loss, i);
+                        if keep {
+                            norms.push(r);
+                        }
+                    },
+                    |(a, na), (b, nb)| (a.merge(b), join(na, nb)),
+                );
+                (acc, None, norms)
+            }
+            Some((group, count)) => {
+                let (parts, norms) = chunked(
+                    self.len(),
+                    || ((0..count).map(|_| new()).collect::<Vec<Acc>>(), Vec::new()),
+                    #[inline(always)]
+                    |(accs, norms), i| {
+                        let r = accs[group[i]].add_observation(self, robot, loss, i);
+                        if keep {
+                            norms.push(r);
+                        }
+                    },
+                    |(a, na), (b, nb)| {
+                        let merged = a.into_iter().zip(b).map(|(x, y)| x.merge(y)).collect();
+                        (merged, join(na, nb))
+                    },
+                );
+                let shares = parts
+                    .iter()
+                    .map(|g| {
+                        let a = symmetric(k, &g.a);
+                        (&a + symmetric(k, &g.h), DVector::from_column_slice(&g.b))
+                    })
+                    .collect();
+                let whole = parts.into_iter().reduce(Acc::merge).unwrap_or_else(new);
+                (whole, Some(shares), norms)
+            }
+        };
+        let a = symmetric(k, &acc.a);
+        let s = (level == Level::Full).then(|| &a + symmetric(k, &acc.s));
+        let h = (level >= Level::Newton).then(|| &a + symmetric(k, &acc.h));
+        Accumulated {
+            objective: acc.objective,
+            weighted_sq: acc.weighted_sq,
+            b: DVector::from_vec(acc.b),
+            a,
+            s,
+            h,
+            psi_sq: acc.psi_sq,
+            rows: self.rows(),
+            groups,
+            norms: keep.then_some(norms),
+        }
+    }
 }

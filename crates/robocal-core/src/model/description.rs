@@ -10,7 +10,6 @@
 use super::{Convention, JointType, Param, Robot};
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
-use std::path::Path;
 
 /// One joint, as a `[[joints]]` table of the robot file (degrees, mm).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -178,26 +177,6 @@ impl RobotDescription {
     pub fn to_toml(&self) -> Result<String> {
         toml::to_string(self)
             .map_err(|e| Error::invalid("robot", format!("cannot write as TOML: {e}")))
-    }
-
-    /// Builds the robot, checked by the robot file's parser (every value within its range,
-    /// limits ordered, prismatic joints with limits, an invertible controller map). Errors name
-    /// `path` and the field as the robot file would (`joints[2].alpha`, `controller.sign`).
-    pub fn to_robot(&self, path: &Path) -> Result<Robot> {
-        super::robot_file::from_description(self, path).map_err(|e| match e {
-            Error::Parse {
-                path,
-                field,
-                message,
-                ..
-            } => Error::Parse {
-                path,
-                line: None,
-                field,
-                message,
-            },
-            other => other,
-        })
     }
 }
 

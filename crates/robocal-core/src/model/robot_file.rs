@@ -115,6 +115,28 @@ pub fn parse_robot_toml(text: &str, path: &Path) -> Result<Robot> {
     build(file, text, path)
 }
 
+impl super::description::RobotDescription {
+    /// Builds the robot, checked by the robot file's parser (every value within its range,
+    /// limits ordered, prismatic joints with limits, an invertible controller map). Errors name
+    /// `path` and the field as the robot file would (`joints[2].alpha`, `controller.sign`).
+    pub fn to_robot(&self, path: &Path) -> Result<Robot> {
+        from_description(self, path).map_err(|e| match e {
+            Error::Parse {
+                path,
+                field,
+                message,
+                ..
+            } => Error::Parse {
+                path,
+                line: None,
+                field,
+                message,
+            },
+            other => other,
+        })
+    }
+}
+
 /// The robot of a description ([`super::description::RobotDescription::to_robot`]), checked as
 /// its robot file would be: the description is handed to the file's checks directly, as the
 /// parsed file it would read back as (every value at an empty span; the caller drops the

@@ -49,7 +49,7 @@ pub(super) fn identifiable(
         }
     };
     let mut ident = analyze_reduced(&start.robot, cal, opts, reduced)?;
-    let sigma0 = noise_bound(start);
+    let sigma0 = start.noise_bound();
     let analyzed = ident.identified.clone();
     let shared_pass = shared
         .as_ref()
@@ -115,17 +115,6 @@ pub(super) fn identifiable(
         ill_conditioned,
         start_pass,
     })
-}
-
-/// The per-axis noise bound of the precision analysis ([`precision`]): the nominal geometry's
-/// per-axis RMS error with the fitted tools; zero when the tools were not applied (the estimate,
-/// and the bound, then mean nothing).
-pub(super) fn noise_bound(start: &StartModel) -> f64 {
-    if start.tool_fit.applied {
-        start.tool_fit.stats.rms_mm / 3f64.sqrt()
-    } else {
-        0.0
-    }
 }
 
 /// Why the identified parameters are too nearly dependent for double precision, if they are.

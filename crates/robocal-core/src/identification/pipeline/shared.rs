@@ -89,7 +89,7 @@ impl Shared {
             let start = start::prepare(widest, &data, settings, &shared.registered)?;
             let params = start.robot.param_list().to_vec();
             let reduced = jacobian_r(&start.robot, &start.observations);
-            let sigma0 = super::identify::noise_bound(&start);
+            let sigma0 = start.noise_bound();
             let pass =
                 (sigma0 > 0.0 && sigma0.is_finite()).then(|| {
                     Problem::new(&start.robot, &params, &start.observations, &start.frame)

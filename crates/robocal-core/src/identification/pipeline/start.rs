@@ -31,6 +31,20 @@ pub(super) struct StartModel {
     pub frame: TrackerFrame,
 }
 
+impl StartModel {
+    /// The per-axis noise bound of the precision analysis
+    /// ([`crate::identification::precision`]): the nominal geometry's per-axis RMS error with the
+    /// fitted tools; zero when the tools were not applied (the estimate, and the bound, then
+    /// mean nothing).
+    pub fn noise_bound(&self) -> f64 {
+        if self.tool_fit.applied {
+            self.tool_fit.stats.rms_mm / 3f64.sqrt()
+        } else {
+            0.0
+        }
+    }
+}
+
 /// The measurement frame registered to the nominal model and the tools fitted to it: what
 /// every model the calibration compares shares when they have the same tool points at the
 /// start (the candidates of a model selection: the nominal with families at zero).

@@ -5,6 +5,7 @@ use super::*;
 use crate::model::presets;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::path::Path;
 
 fn examples() -> Vec<Robot> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
