@@ -12,10 +12,10 @@ use robocal_core::io::{
     read_measurements, write_measurements, Measurement, MeasurementSet, Positions,
 };
 use robocal_core::planning::{
-    plan_observed, Criterion, Plan, PlanBuilder, PlanSettings, DEFAULT_CANDIDATES,
+    plan_observed, Criterion, Plan, PlanBuilder, PlanSettings, Quality, DEFAULT_CANDIDATES,
 };
 use robocal_core::simulation::{DEFAULT_NOISE_MM, DEFAULT_NOISE_PER_M};
-use robocal_core::Robot;
+use robocal_core::{Param, Robot};
 use std::path::PathBuf;
 
 #[derive(Args, Debug)]
@@ -227,19 +227,7 @@ fn print_plan(s: &Settings, p: &Plan) -> anyhow::Result<()> {
         )?;
     }
     outln!()?;
-    outln!("{:<44}{:>14}{:>14}", "", "planned", "random")?;
-    outln!(
-        "{:<44}{:>14.4}{:>14.4}",
-        "observability index O1 (scaled Jacobian)",
-        p.planned.observability,
-        p.random.observability
-    )?;
-    outln!(
-        "{:<44}{:>14.4}{:>14.4}",
-        "predicted workspace model error, RMS (mm)",
-        p.planned.workspace_rms_mm,
-        p.random.workspace_rms_mm
-    )?;
+    print_figures(&p.planned, &p.random)?;
     outln!()?;
     outln!(
         "Predicted standard deviations at {} mm noise per axis{}, {n} poses each",
@@ -250,6 +238,35 @@ fn print_plan(s: &Settings, p: &Plan) -> anyhow::Result<()> {
             String::new()
         }
     )?;
+    print_stds(&p.identified, &p.planned, &p.random)
+}
+
+/// The planned and random poses' observability and predicted workspace error, side by side
+/// (`plan` and `plan --constraint`).
+pub(super) fn print_figures(planned: &Quality, random: &Quality) -> anyhow::Result<()> {
+    outln!("{:<44}{:>14}{:>14}", "", "planned", "random")?;
+    outln!(
+        "{:<44}{:>14.4}{:>14.4}",
+        "observability index O1 (scaled Jacobian)",
+        planned.observability,
+        random.observability
+    )?;
+    outln!(
+        "{:<44}{:>14.4}{:>14.4}",
+        "predicted workspace model error, RMS (mm)",
+        planned.workspace_rms_mm,
+        random.workspace_rms_mm
+    )?;
+    Ok(())
+}
+
+/// Each identified parameter's predicted standard deviation from the planned and the random
+/// poses, in its display unit, then a blank line.
+pub(super) fn print_stds(
+    identified: &[Param],
+    planned: &Quality,
+    random: &Quality,
+) -> anyhow::Result<()> {
     outln!(
         "{:<12}{:>14}{:>14}{:>8}",
         "parameter",
@@ -257,13 +274,13 @@ fn print_plan(s: &Settings, p: &Plan) -> anyhow::Result<()> {
         "random",
         "unit"
     )?;
-    for (i, param) in p.identified.iter().enumerate() {
+    for (i, param) in identified.iter().enumerate() {
         let u = param.unit();
         outln!(
             "{:<12}{:>14.5}{:>14.5}{:>8}",
             param.name(),
-            u.from_internal(p.planned.std[i]),
-            u.from_internal(p.random.std[i]),
+            u.from_internal(planned.std[i]),
+            u.from_internal(random.std[i]),
             u.as_str()
         )?;
     }

@@ -21,23 +21,7 @@ struct Data {
 
 fn data() -> Data {
     let dir = Dir::new();
-    let data = dir.join("s.csv");
-    let dist = dir.join("d.csv");
-    ok(&[
-        "simulate",
-        "--robot",
-        KR,
-        "--truth",
-        "random",
-        "--constraint",
-        "point",
-        "--noise-mm",
-        "0.01",
-        "--out",
-        p(&data),
-        "--distances-out",
-        p(&dist),
-    ]);
+    let (data, dist) = simulate_constraints(&dir, "point", &[]);
     let text = std::fs::read_to_string(&data).unwrap();
     let mut warm = String::new();
     let mut temps = Vec::new();
@@ -243,30 +227,19 @@ fn a_sagging_robot_gets_compliance_by_default() {
     // simulate --constraint with gravity in the truth (joints 2 and 3 compliant, the paper's
     // masses and payload), then the default calibrate.
     let dir = Dir::new();
-    let data = dir.join("sag.csv");
-    let dist = dir.join("d.csv");
-    ok(&[
-        "simulate",
-        "--robot",
-        KR,
-        "--truth",
-        "random",
-        "--constraint",
+    let (data, dist) = simulate_constraints(
+        &dir,
         "point",
-        "--noise-mm",
-        "0.01",
-        "--compliance",
-        "0,2e-8,2e-8,0,0,0",
-        "--link-masses-kg",
-        "900,500,400,150,60,20",
-        "--payload-kg",
-        "300",
-        "--out",
-        p(&data),
-        "--distances-out",
-        p(&dist),
-    ]);
-    let truth = read_json(&dir.join("sag.truth.json"));
+        &[
+            "--compliance",
+            "0,2e-8,2e-8,0,0,0",
+            "--link-masses-kg",
+            "900,500,400,150,60,20",
+            "--payload-kg",
+            "300",
+        ],
+    );
+    let truth = read_json(&dir.join("point.truth.json"));
     assert_eq!(truth["settings"]["gravity"]["payload_kg"], 300.0, "{truth}");
     let out = dir.join("r.json");
     let o = ok(&[

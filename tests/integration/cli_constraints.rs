@@ -7,36 +7,10 @@ use crate::util::*;
 
 const KR: &str = "kuka-kr480-r3330";
 
-/// Simulates constraint data of `kind` into `dir` (with the distances file for points and
-/// spheres); returns the data and distances paths.
-fn simulate(dir: &Dir, kind: &str, extra: &[&str]) -> (std::path::PathBuf, std::path::PathBuf) {
-    let data = dir.join(format!("{kind}.csv"));
-    let dist = dir.join(format!("{kind}.distances.csv"));
-    let mut args = vec![
-        "simulate",
-        "--robot",
-        KR,
-        "--truth",
-        "random",
-        "--constraint",
-        kind,
-        "--noise-mm",
-        "0.01",
-        "--out",
-        p(&data),
-    ];
-    if kind != "plane" {
-        args.extend(["--distances-out", p(&dist)]);
-    }
-    args.extend(extra);
-    ok(&args);
-    (data, dist)
-}
-
 #[test]
 fn fixed_points_with_distances_calibrate_up_to_the_base_pose() {
     let dir = Dir::new();
-    let (data, dist) = simulate(&dir, "point", &[]);
+    let (data, dist) = simulate_constraints(&dir, "point", &[]);
     let (header, rows) = read_csv(&data);
     assert_eq!(header, ["q1", "q2", "q3", "q4", "q5", "q6", "constraint"]);
     assert_eq!(rows.len(), 80);
@@ -91,7 +65,7 @@ fn fixed_points_with_distances_calibrate_up_to_the_base_pose() {
 #[test]
 fn without_distances_the_scale_is_refused_unless_accepted() {
     let dir = Dir::new();
-    let (data, _) = simulate(&dir, "point", &["--features", "2"]);
+    let (data, _) = simulate_constraints(&dir, "point", &["--features", "2"]);
     let out = dir.join("cal.json");
     let args = [
         "calibrate",
@@ -126,7 +100,7 @@ fn without_distances_the_scale_is_refused_unless_accepted() {
 #[test]
 fn spheres_of_known_radius_and_planes_calibrate() {
     let dir = Dir::new();
-    let (data, _) = simulate(&dir, "sphere", &[]);
+    let (data, _) = simulate_constraints(&dir, "sphere", &[]);
     let (header, rows) = read_csv(&data);
     assert_eq!(header[7], "radius_mm");
     assert_eq!(rows[0][7], "25");
@@ -145,7 +119,8 @@ fn spheres_of_known_radius_and_planes_calibrate() {
         "{}",
         o.stdout()
     );
-    let (plane, _) = simulate(&dir, "plane", &["--features", "3", "--per-feature", "30"]);
+    let (plane, _) =
+        simulate_constraints(&dir, "plane", &["--features", "3", "--per-feature", "30"]);
     let out = dir.join("p.json");
     let o = ok(&[
         "calibrate",
@@ -163,7 +138,8 @@ fn spheres_of_known_radius_and_planes_calibrate() {
 #[test]
 fn bad_constraint_files_are_errors_naming_the_line_and_column() {
     let dir = Dir::new();
-    let (data, dist) = simulate(&dir, "point", &["--features", "2", "--per-feature", "4"]);
+    let (data, dist) =
+        simulate_constraints(&dir, "point", &["--features", "2", "--per-feature", "4"]);
     let text = std::fs::read_to_string(&data).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     let out = dir.join("cal.json");

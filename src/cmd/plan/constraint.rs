@@ -192,43 +192,14 @@ fn print_plan(
         )?;
     }
     outln!()?;
-    outln!("{:<44}{:>14}{:>14}", "", "planned", "random")?;
-    outln!(
-        "{:<44}{:>14.4}{:>14.4}",
-        "observability index O1 (scaled Jacobian)",
-        p.planned.observability,
-        p.random_quality.observability
-    )?;
-    outln!(
-        "{:<44}{:>14.4}{:>14.4}",
-        "predicted workspace model error, RMS (mm)",
-        p.planned.workspace_rms_mm,
-        p.random_quality.workspace_rms_mm
-    )?;
+    super::print_figures(&p.planned, &p.random_quality)?;
     outln!(
         "(random: as many configurations drawn as `simulate --constraint` draws them; the \
          error before the rigid alignment, at {} mm contact noise per axis)",
         s.spec.noise_mm
     )?;
     outln!()?;
-    outln!(
-        "{:<12}{:>14}{:>14}{:>8}",
-        "parameter",
-        "planned",
-        "random",
-        "unit"
-    )?;
-    for (i, param) in p.identified.iter().enumerate() {
-        let u = param.unit();
-        outln!(
-            "{:<12}{:>14.5}{:>14.5}{:>8}",
-            param.name(),
-            u.from_internal(p.planned.std[i]),
-            u.from_internal(p.random_quality.std[i]),
-            u.as_str()
-        )?;
-    }
-    outln!()?;
+    super::print_stds(&p.identified, &p.planned, &p.random_quality)?;
     if !p.weakest.is_empty() {
         outln!(
             "Directions the planned configurations see least (share of the predicted model \

@@ -14,6 +14,33 @@ use std::ffi::OsStr;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus};
 
+/// Simulates constraint data of `kind` (`simulate --constraint`, the Table I robot, a random
+/// truth, 0.01 mm noise, then `extra`) into `dir` (with the distances file for points and
+/// spheres); returns the data and distances paths.
+pub fn simulate_constraints(dir: &Dir, kind: &str, extra: &[&str]) -> (PathBuf, PathBuf) {
+    let data = dir.join(format!("{kind}.csv"));
+    let dist = dir.join(format!("{kind}.distances.csv"));
+    let mut args = vec![
+        "simulate",
+        "--robot",
+        KUKA,
+        "--truth",
+        "random",
+        "--constraint",
+        kind,
+        "--noise-mm",
+        "0.01",
+        "--out",
+        p(&data),
+    ];
+    if kind != "plane" {
+        args.extend(["--distances-out", p(&dist)]);
+    }
+    args.extend(extra);
+    ok(&args);
+    (data, dist)
+}
+
 /// The nominal robot of most tests (the paper's Table I).
 pub const KUKA: &str = "kuka-kr480-r3330";
 /// The robot that really moves in the simulated cells (the paper's Table III).

@@ -464,26 +464,6 @@ pub fn predict(
     residual_norms: &[f64],
     threshold_mm: Option<f64>,
 ) -> Option<Prediction> {
-    predict_with(
-        calibrated,
-        covariance,
-        calibration,
-        residual_norms,
-        threshold_mm,
-        true,
-    )
-}
-
-/// [`predict`], with the workspace map only when `map` (a model selection's candidates need
-/// the figures, not the map: it is most of the prediction's cost).
-pub(crate) fn predict_with(
-    calibrated: &Robot,
-    covariance: &Covariance,
-    calibration: &Observations,
-    residual_norms: &[f64],
-    threshold_mm: Option<f64>,
-    map: bool,
-) -> Option<Prediction> {
     // The residual norms are of the points (3 rows), whatever else the kind measures.
     let rows = 3;
     // The noise is not known yet: a predictor of zero noise gives the Jacobians' model parts.
@@ -580,7 +560,7 @@ pub(crate) fn predict_with(
         return None;
     }
     let pred = Predictor { sigma, ..pred };
-    Some(pred.predict_from(&models, floor, map))
+    Some(pred.predict_from(&models, floor, true))
 }
 
 /// The poses of `n` a prediction averages over: every one, or an even spread of at most
