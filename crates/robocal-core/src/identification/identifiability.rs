@@ -348,6 +348,9 @@ pub fn analyze_reduced(
     };
     let tol = opts.rank_tolerance;
     let mut basis: Vec<DVector<f64>> = Vec::new();
+    // Column m of the triangular factor T of the kept unit columns (K = Q T, Q = `basis`):
+    // their coefficients on the basis vectors before it, then their independence.
+    let mut factor: Vec<Vec<f64>> = Vec::new();
     let mut kept: Vec<(Param, f64)> = Vec::new();
     let mut fixed: Vec<FixedParam> = opts
         .fix
@@ -375,15 +378,19 @@ pub fn analyze_reduced(
             continue;
         }
         let mut v = unit(j);
+        let mut coefficients = vec![0.0; basis.len() + 1];
         for _ in 0..2 {
-            for q in &basis {
+            for (q, t) in basis.iter().zip(&mut coefficients) {
                 let c = q.dot(&v);
                 v.axpy(-c, q, 1.0);
+                *t += c;
             }
         }
         let rho = v.norm();
         if rho > tol {
             basis.push(v / rho);
+            *coefficients.last_mut().expect("one entry at least") = rho;
+            factor.push(coefficients);
             kept.push((p, rho));
         } else {
             dependent.push((p, rho));
@@ -405,17 +412,19 @@ pub fn analyze_reduced(
             )
         }));
     }
-    // Explain each dependent column by the kept ones.
+    // Explain each dependent column by the kept ones: the least-squares coefficients of the
+    // kept unit columns K = Q T, c = T^-1 Q^T u. (The kept columns have full rank: each one's
+    // independence is above the tolerance, so T's diagonal is.)
     let kept_cols: Vec<usize> = kept.iter().map(|(p, _)| col(*p)).collect();
-    let ks = DMatrix::from_fn(n, kept_cols.len(), |a, b| {
-        r[(a, kept_cols[b])] / norms[kept_cols[b]]
-    });
-    let svd = ks.clone().svd(true, true);
+    let k = kept.len();
+    let t = DMatrix::from_fn(k, k, |a, b| factor[b].get(a).copied().unwrap_or(0.0));
     for (p, rho) in dependent {
         let j = col(p);
-        let c = svd
-            .solve(&unit(j), 1e-12)
-            .map_err(|e| Error::Numerical(format!("identifiability: {e}")))?;
+        let u = unit(j);
+        let projections = DVector::from_iterator(k, basis.iter().map(|q| q.dot(&u)));
+        let c = t.solve_upper_triangular(&projections).ok_or_else(|| {
+            Error::Numerical("identifiability: the kept columns are dependent".to_string())
+        })?;
         let cmax = c.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         let mut terms: Vec<(usize, f64)> = c
             .iter()
@@ -459,7 +468,8 @@ pub fn analyze_reduced(
             bad.join("; ")
         )));
     }
-    let sv = svd.singular_values;
+    // K and T have the same singular values (Q is orthonormal), and T is only k x k.
+    let sv = t.singular_values();
     let (smax, smin) = sv
         .iter()
         .fold((0.0f64, f64::INFINITY), |(a, b), v| (a.max(*v), b.min(*v)));

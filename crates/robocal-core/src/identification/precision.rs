@@ -80,29 +80,95 @@ pub(crate) fn undetermined_from(
     keep_always: &[Param],
 ) -> Vec<Undetermined> {
     let Some(s) = &acc.s else { return Vec::new() };
-    let mut keep: Vec<usize> = (0..params.len()).collect();
+    let k = params.len();
     let mut out = Vec::new();
+    let Some(ch) = DMatrix::from_fn(k, k, |r, c| s[(r, c)]).cholesky() else {
+        return out;
+    };
+    // The inverse of the kept parameters' block, updated as each is dropped (the inverse of a
+    // block without row and column i is the Schur complement of the full inverse's entry i:
+    // `inv - inv[:, i] inv[i, :] / inv[i, i]` on the rest), one factorization in all.
+    let mut inv = ch.inverse();
+    let mut keep: Vec<usize> = (0..k).collect();
     while !keep.is_empty() {
-        let k = keep.len();
-        let sub = DMatrix::from_fn(k, k, |r, c| s[(keep[r], keep[c])]);
-        let Some(ch) = sub.cholesky() else { break };
-        let inv = ch.inverse();
-        let worst = (0..k)
-            .filter(|&r| !keep_always.contains(&params[keep[r]]))
-            .filter_map(|r| {
-                let p = params[keep[r]];
-                let std = sigma0_mm * inv[(r, r)].max(0.0).sqrt() * p.unit().from_internal(1.0);
+        let worst = keep
+            .iter()
+            .enumerate()
+            .filter(|(_, &i)| !keep_always.contains(&params[i]))
+            .filter_map(|(r, &i)| {
+                let p = params[i];
+                let std = sigma0_mm * inv[(i, i)].max(0.0).sqrt() * p.unit().from_internal(1.0);
                 std_limit(start, p).map(|limit| (r, std, limit))
             })
             .filter(|(_, std, limit)| std > limit)
             .max_by(|a, b| (a.1 / a.2).total_cmp(&(b.1 / b.2)));
         let Some((r, std, limit)) = worst else { break };
+        let i = keep.remove(r);
         out.push(Undetermined {
-            param: params[keep[r]],
+            param: params[i],
             std,
             limit,
         });
-        keep.remove(r);
+        if !drop_from_inverse(&mut inv, &keep, i) {
+            break;
+        }
     }
     out
+}
+
+/// Turns the entries at rows and columns `keep` of `inv`, the inverse of a symmetric positive
+/// definite block over `keep` and `i`, into the inverse of the block over `keep` alone (the
+/// Schur complement of `inv[i, i]`: `inv - inv[:, i] inv[i, :] / inv[i, i]`). `false` when that
+/// pivot is not positive (`inv` was no such inverse), leaving `inv` as it was.
+fn drop_from_inverse(inv: &mut DMatrix<f64>, keep: &[usize], i: usize) -> bool {
+    let pivot = inv[(i, i)];
+    if pivot.is_nan() || pivot <= 0.0 {
+        return false;
+    }
+    let column: Vec<f64> = keep.iter().map(|&a| inv[(a, i)]).collect();
+    for (&b, &cb) in keep.iter().zip(&column) {
+        for (&a, &ca) in keep.iter().zip(&column) {
+            inv[(a, b)] -= ca * cb / pivot;
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::drop_from_inverse;
+    use nalgebra::DMatrix;
+
+    /// Dropping parameters one by one from the inverse gives the inverse of what is left, as
+    /// a factorization of that block gives it.
+    #[test]
+    fn dropping_from_the_inverse_gives_the_inverse_of_the_rest() {
+        let n = 9;
+        let m = DMatrix::from_fn(n, n, |r, c| {
+            ((r * 7 + c * 3) % 11) as f64 - 5.0 + (r == c) as u8 as f64
+        });
+        let s = &m * m.transpose() + DMatrix::identity(n, n);
+        let mut inv = s.clone().cholesky().unwrap().inverse();
+        let mut keep: Vec<usize> = (0..n).collect();
+        for i in [4, 0, 7] {
+            keep.retain(|&a| a != i);
+            assert!(drop_from_inverse(&mut inv, &keep, i));
+            let k = keep.len();
+            let sub = DMatrix::from_fn(k, k, |r, c| s[(keep[r], keep[c])]);
+            let want = sub.cholesky().unwrap().inverse();
+            for r in 0..k {
+                for c in 0..k {
+                    let got = inv[(keep[r], keep[c])];
+                    assert!(
+                        (got - want[(r, c)]).abs() <= 1e-12 * want[(r, r)].abs().max(1.0),
+                        "{got} against {}",
+                        want[(r, c)]
+                    );
+                }
+            }
+        }
+        let mut broken = DMatrix::from_element(2, 2, -1.0);
+        assert!(!drop_from_inverse(&mut broken, &[1], 0));
+        assert_eq!(broken, DMatrix::from_element(2, 2, -1.0));
+    }
 }
