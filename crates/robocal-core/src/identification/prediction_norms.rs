@@ -12,15 +12,29 @@ use nalgebra::Matrix3;
 /// smooth (no kink at `u_i = 0`), and a product Gauss-Legendre rule in the polar angle and the
 /// azimuth (area element `sin(theta) dtheta dphi`) integrates it to about 1e-6 relative.
 pub(super) struct NormExpectation {
-    /// Nodes `(u_0^2, u_1^2, u_2^2)` and weights (summing to `E[r]`).
-    nodes: Vec<([f64; 3], f64)>,
+    /// Nodes `u_0^2`, `u_1^2`, `u_2^2` and weights (summing to `E[r]`), each in its own array
+    /// (so the sum runs in vector lanes), padded with zero weights to a multiple of
+    /// [`LANES`].
+    u0: Vec<f64>,
+    u1: Vec<f64>,
+    u2: Vec<f64>,
+    w: Vec<f64>,
 }
+
+/// Partial sums kept apart in [`NormExpectation::mean_norm`] (one AVX register of doubles).
+const LANES: usize = 4;
 
 impl NormExpectation {
     pub(super) fn new() -> Self {
         let er = 2.0 * (2.0 / std::f64::consts::PI).sqrt();
         let (x, w) = gauss_legendre(QUADRATURE_NODES);
-        let mut nodes = Vec::with_capacity(x.len() * x.len());
+        let len = (x.len() * x.len()).next_multiple_of(LANES);
+        let mut out = NormExpectation {
+            u0: Vec::with_capacity(len),
+            u1: Vec::with_capacity(len),
+            u2: Vec::with_capacity(len),
+            w: Vec::with_capacity(len),
+        };
         let quarter_pi = 0.25 * std::f64::consts::PI;
         for (&xt, &wt) in x.iter().zip(&w) {
             // Polar angle theta and azimuth phi, both in [0, pi/2].
@@ -29,21 +43,35 @@ impl NormExpectation {
                 let (sp, cp) = (quarter_pi * (xp + 1.0)).sin_cos();
                 // The octant's mean: (2 / pi) of the integral of f sin(theta), each rule
                 // scaled by pi / 4.
-                let weight = er * 0.125 * std::f64::consts::PI * wt * wp * st;
-                nodes.push(([st * st * cp * cp, st * st * sp * sp, ct * ct], weight));
+                out.w.push(er * 0.125 * std::f64::consts::PI * wt * wp * st);
+                out.u0.push(st * st * cp * cp);
+                out.u1.push(st * st * sp * sp);
+                out.u2.push(ct * ct);
             }
         }
-        NormExpectation { nodes }
+        for v in [&mut out.u0, &mut out.u1, &mut out.u2, &mut out.w] {
+            v.resize(len, 0.0);
+        }
+        out
     }
 
     /// `E|e|` for `e ~ N(0, s)`.
     pub(super) fn mean_norm(&self, s: &Matrix3<f64>) -> f64 {
         let ev = sym3_eigenvalues(s);
         let l = [ev[0].max(0.0), ev[1].max(0.0), ev[2].max(0.0)];
-        self.nodes
-            .iter()
-            .map(|(u, w)| w * (l[0] * u[0] + l[1] * u[1] + l[2] * u[2]).sqrt())
-            .sum()
+        let mut lanes = [0.0; LANES];
+        let chunks = self
+            .u0
+            .chunks_exact(LANES)
+            .zip(self.u1.chunks_exact(LANES))
+            .zip(self.u2.chunks_exact(LANES))
+            .zip(self.w.chunks_exact(LANES));
+        for (((u0, u1), u2), w) in chunks {
+            for k in 0..LANES {
+                lanes[k] += w[k] * (l[0] * u0[k] + l[1] * u1[k] + l[2] * u2[k]).sqrt();
+            }
+        }
+        lanes.iter().sum()
     }
 }
 
