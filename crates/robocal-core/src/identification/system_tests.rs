@@ -348,3 +348,42 @@ fn a_pass_keeps_the_fit_norms_in_order() {
         }
     }
 }
+
+/// A pass whose residuals are all within the range where a loss is least squares (the adaptive
+/// and Huber losses up to their thresholds) is the least-squares pass, bit for bit: the
+/// adaptive stage after a least-squares fit without outliers takes that fit's last pass as its
+/// own (`pipeline::stages`). Beyond the range it is not.
+#[test]
+fn a_pass_within_the_least_squares_range_is_the_least_squares_pass() {
+    let (nominal, obs) = kr480_problem_data(300, 0.02);
+    let params = nominal.params();
+    let frame = TrackerFrame::identity();
+    let group: Vec<usize> = (0..obs.len()).map(|i| (i * 5) % 4).collect();
+    let p = Problem::new(&nominal, &params, &obs, &frame)
+        .grouped(&group, 4)
+        .keeping_norms();
+    let squared = p.accumulate(&nominal, &Loss::Squared, Level::Full);
+    let largest = squared
+        .norms
+        .as_ref()
+        .unwrap()
+        .iter()
+        .fold(0.0, |m: f64, r| m.max(*r));
+    for loss in [
+        Loss::Adaptive { k: largest },
+        Loss::Huber { k: 2.0 * largest },
+    ] {
+        let other = p.accumulate(&nominal, &loss, Level::Full);
+        assert_eq!(other.objective.to_bits(), squared.objective.to_bits());
+        assert_eq!(other.weighted_sq.to_bits(), squared.weighted_sq.to_bits());
+        assert_eq!(other.psi_sq.to_bits(), squared.psi_sq.to_bits());
+        assert_eq!(other.a, squared.a);
+        assert_eq!(other.b, squared.b);
+        assert_eq!(other.s, squared.s);
+        assert_eq!(other.h, squared.h);
+        assert_eq!(other.groups, squared.groups);
+        assert_eq!(other.norms, squared.norms);
+    }
+    let beyond = p.accumulate(&nominal, &Loss::Adaptive { k: 0.5 * largest }, Level::Full);
+    assert_ne!(beyond.a, squared.a);
+}

@@ -51,6 +51,16 @@ struct Runs<'p, 'a> {
     first_pass: Option<Accumulated>,
 }
 
+/// The norm up to which `loss` is least squares (the same value, weight and curvature at
+/// every residual up to it); `None` for losses that differ from it everywhere.
+fn squared_up_to(loss: &Loss) -> Option<f64> {
+    match *loss {
+        Loss::Squared => Some(f64::INFINITY),
+        Loss::Huber { k } | Loss::Adaptive { k } => Some(k),
+        Loss::SumOfNorms { .. } | Loss::Cauchy { .. } => None,
+    }
+}
+
 impl Runs<'_, '_> {
     /// One solver run minimizing `loss` from the current model. The iteration limit is the whole
     /// solve's: each stage gets what the earlier left.
@@ -60,10 +70,10 @@ impl Runs<'_, '_> {
             max_iterations: self.settings.solver.max_iterations.saturating_sub(used),
             ..self.settings.solver
         };
-        let first = self
-            .first_pass
-            .take()
-            .filter(|_| self.stages.is_empty() && loss == Loss::Squared);
+        let first = match self.first_pass.take() {
+            Some(pass) if self.stages.is_empty() && loss == Loss::Squared => Some(pass),
+            _ => self.pass_for(&loss),
+        };
         let (report, pass) = solve_keeping(
             self.problem,
             &mut self.robot,
@@ -88,12 +98,32 @@ impl Runs<'_, '_> {
         Ok(())
     }
 
+    /// The last run's pass at the current model, as the next run's first with `loss`, when it
+    /// is that run's exactly: both losses are least squares up to a threshold that every
+    /// residual is within (the weights, curvatures and values are then the same, bit for bit:
+    /// an adaptive run after a least-squares fit without outliers needs no pass of its own).
+    fn pass_for(&mut self, loss: &Loss) -> Option<Accumulated> {
+        let before = squared_up_to(&self.stages.last()?.loss)?;
+        let limit = before.min(squared_up_to(loss)?);
+        let pass = self.final_pass.as_ref()?;
+        let within = pass.norms.as_ref()?.iter().all(|&r| r <= limit);
+        within.then(|| self.final_pass.take()).flatten()
+    }
+
     /// The fit's residual norms at the current model ([`Problem::fit_norms`]): the last run's
     /// pass's (taken from it) when it ended on one that kept them, else a pass of their own.
     fn norms(&mut self) -> Vec<f64> {
         match self.final_pass.as_mut().and_then(|p| p.norms.take()) {
             Some(n) => n,
             None => self.problem.fit_norms(&self.robot),
+        }
+    }
+
+    /// Puts `norms`, the fit's at the current model, back in the last run's pass (for
+    /// [`Runs::pass_for`]).
+    fn restore_norms(&mut self, norms: Vec<f64>) {
+        if let Some(pass) = self.final_pass.as_mut() {
+            pass.norms = Some(norms);
         }
     }
 
@@ -232,9 +262,15 @@ fn robust_rounds(runs: &mut Runs) -> Result<(Loss, f64, Option<Vec<f64>>)> {
     let rows = problem.kind().rows();
     let scale_of =
         |norms: &[f64]| (sigmas * robust_sigma(norms, rows)).max(SUM_OF_NORMS_SMOOTHING_MM);
-    let mut c = settings
-        .robust_scale_mm
-        .unwrap_or_else(|| scale_of(&runs.norms()));
+    let mut c = match settings.robust_scale_mm {
+        Some(c) => c,
+        None => {
+            let at_start = runs.norms();
+            let c = scale_of(&at_start);
+            runs.restore_norms(at_start);
+            c
+        }
+    };
     let mut loss = make(c);
     // The fit's residual norms at the current model, once a run has been followed by them.
     let mut norms = None;
@@ -247,10 +283,11 @@ fn robust_rounds(runs: &mut Runs) -> Result<(Loss, f64, Option<Vec<f64>>)> {
         }
         let at_model = runs.norms();
         let c2 = scale_of(&at_model);
-        norms = Some(at_model);
         if (c2 - c).abs() <= settle * c {
+            norms = Some(at_model);
             break;
         }
+        runs.restore_norms(at_model);
         c = c2;
     }
     Ok((loss, c, norms))

@@ -8,9 +8,10 @@ use crate::simulation::{random_poses, PoseSampler};
 use rand::{Rng, SeedableRng};
 use rand_distr::{Distribution, Normal};
 
-/// Noisy points of the paper's true robot, with a few gross outliers (which the adaptive
-/// objective's reweighting must down-weight on the subsample as on every point).
-fn data(n: usize, seed: u64) -> Observations {
+/// Noisy points of the paper's true robot, each a gross outlier with probability `outliers`
+/// (which the adaptive objective's reweighting must down-weight on the subsample as on every
+/// point).
+fn data(n: usize, seed: u64, outliers: f64) -> Observations {
     let truth = preset("kuka-kr480-r3330-table3").unwrap();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let qs = random_poses(&truth, n, &PoseSampler::default(), &mut rng).unwrap();
@@ -19,7 +20,7 @@ fn data(n: usize, seed: u64) -> Observations {
     for (i, q) in qs.iter().enumerate() {
         let mut m = truth.tool_position(q);
         m.iter_mut().for_each(|v| *v += noise.sample(&mut rng));
-        if rng.gen_bool(0.005) {
+        if rng.gen_bool(outliers) {
             m.x += 3.0;
         }
         obs.push(q, m, i + 2).unwrap();
@@ -44,7 +45,7 @@ fn fit(obs: &Observations, settings: &CalibrationSettings) -> Calibration {
 #[test]
 fn a_warm_start_on_a_subsample_reaches_the_same_minimum() {
     use crate::identification::objective::Objective;
-    let obs = data(6000, 7);
+    let obs = data(6000, 7, 0.005);
     for objective in [Objective::Adaptive, Objective::LeastSquares] {
         let cold = CalibrationSettings {
             objective,
@@ -90,7 +91,7 @@ fn a_warm_start_on_a_subsample_reaches_the_same_minimum() {
 /// A subsample outside its bounds is refused before any work.
 #[test]
 fn warm_start_settings_are_checked() {
-    let obs = data(200, 1);
+    let obs = data(200, 1, 0.005);
     let nominal = preset("kuka-kr480-r3330").unwrap();
     let data = CalibrationData {
         calibration: &obs,
@@ -105,5 +106,51 @@ fn warm_start_settings_are_checked() {
             .unwrap_err()
             .to_string();
         assert!(e.contains("solver.warm_start_points"), "{e}");
+    }
+}
+
+/// The adaptive run after a least-squares fit without outliers takes that fit's last pass (the
+/// same bits: `system`'s tests) and stops at its minimum without a step: one evaluation, its
+/// objective the least-squares fit's to the bit, nothing down-weighted, and the model the one
+/// the least-squares objective gives.
+#[test]
+fn an_adaptive_run_without_outliers_stops_at_the_least_squares_minimum() {
+    use crate::identification::objective::{Loss, Objective};
+    let obs = data(300, 3, 0.0);
+    let adaptive = fit(&obs, &CalibrationSettings::default());
+    let least_squares = fit(
+        &obs,
+        &CalibrationSettings {
+            objective: Objective::LeastSquares,
+            ..Default::default()
+        },
+    );
+    assert!(adaptive.downweighted.is_empty());
+    let [first, last] = &adaptive.stages[..] else {
+        panic!("{} runs", adaptive.stages.len())
+    };
+    assert_eq!(first.loss, Loss::Squared);
+    assert!(
+        matches!(last.loss, Loss::Adaptive { .. }),
+        "{:?}",
+        last.loss
+    );
+    assert_eq!(last.report.evaluations, 1);
+    assert!(last.report.termination.converged());
+    assert!(
+        last.report.last_step_mm.is_nan(),
+        "a step of {}",
+        last.report.last_step_mm
+    );
+    for objective in [last.report.initial_objective, last.report.final_objective] {
+        assert_eq!(objective.to_bits(), first.report.final_objective.to_bits());
+    }
+    for p in &adaptive.identifiability.identified {
+        let (a, b) = (
+            adaptive.calibrated.get(*p),
+            least_squares.calibrated.get(*p),
+        );
+        let std = adaptive.covariance.std_of(*p).unwrap();
+        assert!((a - b).abs() <= 1e-6 * std, "{}: {a} against {b}", p.name());
     }
 }
