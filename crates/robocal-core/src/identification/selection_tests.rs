@@ -313,5 +313,90 @@ fn shared_start_passes_and_fold_shares_give_the_candidates_own_fits() {
             y.mean_mm
         );
         assert!((x.std_error_mm - y.std_error_mm).abs() <= 1e-9 * y.std_error_mm);
+        // The gate's units and handedness checks, shared, are the candidate's own.
+        let shape = |c: &Calibration| -> Vec<_> {
+            use crate::identification::plausibility::CheckKind;
+            c.plausibility
+                .checks
+                .iter()
+                .filter(|k| matches!(k.kind, CheckKind::Units | CheckKind::Handedness))
+                .cloned()
+                .collect()
+        };
+        assert_eq!(shape(&with).len(), 2, "{name}");
+        assert_eq!(shape(&with), shape(&own), "{name}");
     }
+}
+
+/// The chosen candidate, completed (its last pass, covariance and solve reused), is the chosen
+/// model's own calibration: the same parameters, uncertainties, prediction and validation
+/// errors as a calibration of that model from the start.
+#[test]
+fn the_completed_candidate_is_the_chosen_models_own_calibration() {
+    use crate::identification::model_choice::ModelChoice;
+    use crate::identification::pipeline::calibrate_model;
+    let truth = preset("kuka-kr480-r3330-table3").unwrap();
+    let sag = GravityModel::new(
+        vec![0.0, 2e-8, 2e-8, 0.0, 0.0, 0.0],
+        PAPER_LINK_MASSES_KG.to_vec(),
+        PAPER_PAYLOAD_KG,
+    );
+    let mut rng = ChaCha8Rng::seed_from_u64(4);
+    let cal = measure(&truth, Some(&sag), 75, &mut rng);
+    let val = measure(&truth, Some(&sag), 40, &mut rng);
+    let data = CalibrationData {
+        calibration: &cal,
+        plane: None,
+        validation: Some(&val),
+    };
+    let nominal = preset("kuka-kr480-r3330").unwrap();
+    let a = calibrate(&nominal, data, &auto(), &()).unwrap();
+    let robot = &a.model_selection.as_ref().unwrap().robot;
+    let given = CalibrationSettings {
+        model: ModelChoice::Given,
+        ..Default::default()
+    };
+    let b = calibrate_model(robot, data, &given, &()).unwrap();
+    let close = |x: f64, y: f64, what: &str| {
+        assert!(
+            (x - y).abs() <= 1e-9 * y.abs().max(1e-6),
+            "{what}: {x} against {y}"
+        );
+    };
+    assert_eq!(a.identifiability.identified, b.identifiability.identified);
+    for p in &b.identifiability.identified {
+        close(a.calibrated.get(*p), b.calibrated.get(*p), &p.name());
+        close(
+            a.covariance.std_of(*p).unwrap(),
+            b.covariance.std_of(*p).unwrap(),
+            &p.name(),
+        );
+    }
+    let (pa, pb) = (
+        a.prediction.as_ref().unwrap(),
+        b.prediction.as_ref().unwrap(),
+    );
+    close(pa.mean_mm, pb.mean_mm, "predicted mean");
+    close(pa.noise_sigma_mm, pb.noise_sigma_mm, "noise");
+    let (va, vb) = (
+        a.validation.as_ref().unwrap(),
+        b.validation.as_ref().unwrap(),
+    );
+    close(
+        va.after_stats().mean_mm,
+        vb.after_stats().mean_mm,
+        "validation",
+    );
+    assert_eq!(
+        a.plausibility
+            .checks
+            .iter()
+            .map(|c| c.passed)
+            .collect::<Vec<_>>(),
+        b.plausibility
+            .checks
+            .iter()
+            .map(|c| c.passed)
+            .collect::<Vec<_>>()
+    );
 }

@@ -30,7 +30,7 @@ use crate::identification::identifiability::{FixReason, Identifiability, Identif
 use crate::identification::model_choice::{ModelChoice, ModelSelection};
 use crate::identification::objective::{Loss, Objective};
 use crate::identification::param_vector::ParamVector;
-use crate::identification::plausibility::Plausibility;
+use crate::identification::plausibility::{Plausibility, ShapeChecks};
 use crate::identification::prediction::Prediction;
 pub use crate::identification::set_errors::{DownWeighted, SetErrors};
 use crate::identification::solver::{SolverOptions, SolverReport};
@@ -142,6 +142,9 @@ pub struct Calibration {
     /// Hessian and gradient at the calibrated model ([`crate::identification::folds`]), from the
     /// solver's last pass, when it ended on one (the cross-validation's, not repeated then).
     pub(crate) fold_passes: Option<Vec<(nalgebra::DMatrix<f64>, nalgebra::DVector<f64>)>>,
+    /// A model selection's candidate: the solver's last full pass at the calibrated model, when
+    /// it ended on one (the covariance's; [`complete`] does not repeat it).
+    pub(crate) last_pass: Option<crate::identification::system::Accumulated>,
 }
 
 impl Calibration {
@@ -205,6 +208,8 @@ pub(super) struct Job<'a> {
     settings: &'a CalibrationSettings,
     purpose: Purpose,
     observer: &'a dyn Observer,
+    /// The gate's shape checks, when shared among a selection's candidates.
+    shape: Option<&'a ShapeChecks>,
 }
 
 /// The frame and tools registered to `nominal` for a calibration of `data` (the inputs checked
@@ -317,6 +322,7 @@ fn calibrate_once(
         settings,
         purpose,
         observer,
+        shape: shared.and_then(Shared::shape),
     };
     outcome::assemble(&job, start, identified, solved)
 }
@@ -362,7 +368,7 @@ pub(crate) fn complete(
         loss: cal.stages.last().expect("at least one stage").loss,
         stages: cal.stages,
         robust_scale: cal.robust_scale_mm,
-        final_pass: None,
+        final_pass: cal.last_pass,
         final_norms: None,
     };
     let job = Job {
@@ -371,6 +377,7 @@ pub(crate) fn complete(
         settings,
         purpose: Purpose::Result,
         observer,
+        shape: None,
     };
     outcome::assemble(&job, start, identified, solved)
 }

@@ -44,6 +44,7 @@ pub(super) fn assemble(
         settings,
         purpose,
         observer,
+        shape: _,
     } = *job;
     let data = &data;
     let problem = Problem::new(
@@ -93,15 +94,16 @@ pub(super) fn assemble(
         prediction: prediction.as_ref(),
         downweighted: downweighted.len(),
     };
-    let plausibility = gate(
-        nominal,
-        data,
-        settings,
-        &start,
-        &identified,
-        &solved,
-        &errors,
-    );
+    let plausibility = gate(job, &start, &identified, &solved, &errors);
+    // A candidate keeps its last pass for its completion ([`super::complete`]).
+    let own_pass = match acc {
+        std::borrow::Cow::Owned(pass) => Some(pass),
+        std::borrow::Cow::Borrowed(_) => None,
+    };
+    let last_pass = match purpose {
+        Purpose::Candidate => own_pass.or(solved.final_pass.take()),
+        Purpose::Result => None,
+    };
     Ok(Calibration {
         nominal: nominal.clone(),
         calibrated: solved.robot,
@@ -122,6 +124,7 @@ pub(super) fn assemble(
         weighting: start.weighting,
         model_selection: None,
         fold_passes,
+        last_pass,
     })
 }
 
@@ -153,14 +156,19 @@ fn validation_errors(
 /// nominal geometry with the fitted tools): Table II's second line, and the validation points
 /// under it.
 fn gate(
-    nominal: &Robot,
-    data: &CalibrationData,
-    settings: &CalibrationSettings,
+    job: &Job,
     start: &StartModel,
     identified: &Identified,
     solved: &Solved,
     errors: &Errors,
 ) -> Plausibility {
+    let Job {
+        nominal,
+        data,
+        settings,
+        shape,
+        ..
+    } = *job;
     let Errors {
         calibration,
         validation,
@@ -177,7 +185,7 @@ fn gate(
     } else {
         (start.registration.stats.rms_mm, None)
     };
-    plausibility::assess(&plausibility::Fit {
+    let fit = plausibility::Fit {
         nominal,
         start: &start.robot,
         calibrated: &solved.robot,
@@ -199,5 +207,6 @@ fn gate(
         noise_sigma_mm: prediction.map(|p| p.noise_sigma_mm),
         solver: &whole_solve(&solved.stages),
         max_iterations: settings.solver.max_iterations,
-    })
+    };
+    plausibility::assess_with(&fit, shape)
 }

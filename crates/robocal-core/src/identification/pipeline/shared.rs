@@ -16,6 +16,7 @@ use super::{CalibrationData, CalibrationSettings};
 use crate::error::Result;
 use crate::identification::identifiability::{jacobian_r, Reduced};
 use crate::identification::objective::Loss;
+use crate::identification::plausibility::ShapeChecks;
 use crate::identification::system::{Accumulated, Level, Problem};
 use crate::model::{Param, Robot};
 use crate::observations::Observations;
@@ -29,6 +30,9 @@ pub(crate) struct Shared {
     given_points: (usize, Vec<Vector3<f64>>),
     /// The widest model's start passes, when it has the robot as given's tool points.
     passes: Option<StartPasses>,
+    /// The plausibility gate's shape checks of the calibration points against those tool
+    /// points (with the start passes).
+    shape: Option<ShapeChecks>,
 }
 
 /// The start passes of the widest model (see the module docs).
@@ -84,6 +88,7 @@ impl Shared {
             registered,
             given_points,
             passes: None,
+            shape: None,
         };
         if shared.same_tool_points(widest, obs) {
             let start = start::prepare(widest, &data, settings, &shared.registered)?;
@@ -95,6 +100,7 @@ impl Shared {
                     Problem::new(&start.robot, &params, &start.observations, &start.frame)
                         .accumulate(&start.robot, &Loss::Squared, Level::Full)
                 });
+            shared.shape = Some(ShapeChecks::of(&start.observations, &start.robot));
             shared.passes = Some(StartPasses {
                 params,
                 reduced,
@@ -102,6 +108,11 @@ impl Shared {
             });
         }
         Ok(shared)
+    }
+
+    /// The gate's shape checks for a candidate that shares the start (see [`Shared::new`]).
+    pub(super) fn shape(&self) -> Option<&ShapeChecks> {
+        self.shape.as_ref()
     }
 
     /// Whether `robot` puts the tool points of `obs` (the calibration points) where the robot

@@ -20,6 +20,7 @@
 mod causes;
 pub mod diagnosis;
 mod ranges;
+mod shape;
 pub mod similarity;
 pub mod statistics;
 
@@ -34,8 +35,9 @@ use crate::observations::Observations;
 use crate::registration::Registration;
 use crate::stats::ErrorStats;
 use causes::Causes;
-use diagnosis::{explain, sig, unit_of_scale, Explanation};
-use similarity::{fit_similarity, Handedness};
+use diagnosis::{explain, Explanation};
+use shape::Shape;
+pub(crate) use shape::ShapeChecks;
 
 // The margins quoted below were measured with the release build on 148 good fits — the demo
 // (KR 480, seeds 1-30), the real UR5 and WAM grid sets (with their random sets as validation,
@@ -259,103 +261,14 @@ fn largest_move(fit: &Fit, unit: Unit) -> Option<(Param, f64)> {
         .max_by(|a, b| a.1.total_cmp(&b.1))
 }
 
-/// The measured points against a model's shape, free of any frame: the best rigid fit, the best
-/// uniform scale (units) and the best reflection (handedness).
-struct Shape {
-    /// RMS of the best rigid fit (mm; NaN when the points coincide).
-    rigid_rms: f64,
-    /// The best uniform scale (NaN when the points coincide).
-    scale: f64,
-}
-
-impl Shape {
-    /// Fits `obs`'s measured points to `robot`'s tool points, pushing the units and handedness
-    /// checks to `checks`.
-    fn of(obs: &Observations, robot: &Robot, checks: &mut Vec<Check>) -> Shape {
-        let measured = obs.measured();
-        let model = obs.model_positions(robot);
-        let rigid = fit_similarity(measured, &model, Handedness::Rotation, false);
-        let scaled = fit_similarity(measured, &model, Handedness::Rotation, true);
-        let mirrored = fit_similarity(measured, &model, Handedness::Reflection, true);
-        let baseline_rms = rigid.map_or(f64::NAN, |f| f.rms);
-        match (rigid, scaled) {
-            (Some(r), Some(s)) => {
-                let factor = s.scale.max(1.0 / s.scale);
-                let gain = r.rms / s.rms;
-                let passed = !(factor > SCALE_LIMIT && gain >= SCALE_GAIN);
-                let unit = unit_of_scale(s.scale)
-                    .filter(|(_, f)| *f != 1.0)
-                    .map_or(String::new(), |(u, _)| format!(", the scale of {u}"));
-                checks.push(check(
-                    CheckKind::Units,
-                    factor,
-                    SCALE_LIMIT,
-                    "factor",
-                    passed,
-                    format!(
-                        "the measured points fit the nominal model best at scale {}{unit} \
-                         ({:.3} mm RMS, against {:.3} mm at scale 1); limit: within a factor {} of \
-                         1 unless the scale improves the fit less than {}-fold",
-                        sig(s.scale),
-                        s.rms,
-                        r.rms,
-                        SCALE_LIMIT,
-                        SCALE_GAIN
-                    ),
-                ));
-            }
-            _ => checks.push(check(
-                CheckKind::Units,
-                f64::NAN,
-                SCALE_LIMIT,
-                "factor",
-                true,
-                "not measurable: the measured points coincide".into(),
-            )),
-        }
-        match (scaled, mirrored) {
-            (Some(s), Some(m)) => {
-                let ratio = if s.rms > 0.0 {
-                    m.rms / s.rms
-                } else {
-                    f64::INFINITY
-                };
-                checks.push(check(
-                    CheckKind::Handedness,
-                    ratio,
-                    HANDEDNESS_LIMIT,
-                    "ratio",
-                    ratio >= HANDEDNESS_LIMIT,
-                    format!(
-                        "the best reflection fits the measured points to {:.3} mm RMS, the best \
-                         rotation to {:.3} mm (ratio {}); limit: a reflection must not fit better \
-                         than {} times the rotation's RMS",
-                        m.rms,
-                        s.rms,
-                        sig(ratio),
-                        HANDEDNESS_LIMIT
-                    ),
-                ));
-            }
-            _ => checks.push(check(
-                CheckKind::Handedness,
-                f64::NAN,
-                HANDEDNESS_LIMIT,
-                "ratio",
-                true,
-                "not measurable: the measured points coincide".into(),
-            )),
-        }
-
-        Shape {
-            rigid_rms: baseline_rms,
-            scale: scaled.map_or(f64::NAN, |s| s.scale),
-        }
-    }
-}
-
 /// Runs every check on a fit and, if one fails, looks for the likely cause.
 pub fn assess(fit: &Fit) -> Plausibility {
+    assess_with(fit, None)
+}
+
+/// [`assess`], with the shape checks of `fit`'s calibration points against its start model's
+/// tool points when computed before ([`ShapeChecks::of`]).
+pub(crate) fn assess_with(fit: &Fit, shape: Option<&ShapeChecks>) -> Plausibility {
     let reach = reach_mm(fit.start);
     let mut checks = Vec::new();
 
@@ -374,7 +287,13 @@ pub fn assess(fit: &Fit) -> Plausibility {
         ),
     ));
 
-    let shape = Shape::of(fit.calibration, fit.start, &mut checks);
+    let shape = match shape {
+        Some(known) => {
+            checks.extend(known.checks.iter().cloned());
+            known.shape
+        }
+        None => Shape::of(fit.calibration, fit.start, &mut checks),
+    };
     let (baseline_rms, scaled) = (shape.rigid_rms, shape.scale);
 
     let limit_mm = NOMINAL_ERROR_LIMIT * reach;
