@@ -21,6 +21,7 @@ pub mod result_prediction;
 pub mod result_robot;
 pub mod result_sections;
 pub mod result_selection;
+mod result_skim;
 pub mod result_thermal;
 pub mod robot;
 pub mod row_conditions;

@@ -149,7 +149,11 @@ pub struct CalibrationResult {
     /// Per-point errors. Written directly, not through `sorted_opt`: its structs declare their
     /// fields in alphabetical order, and a million points through a `serde_json::Value` took
     /// 600 MB.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "crate::io::result_skim::option"
+    )]
     pub points: Option<Points>,
     /// The predicted accuracy at new poses.
     #[serde(
@@ -264,10 +268,16 @@ impl CalibrationResult {
     /// duplicate-key pass and the key-path tracking add nothing to it); anything else, or text
     /// that does not parse, takes the whole reading path, whose messages name the field.
     ///
+    /// The per-point sections are skimmed on that direct path (`io::result_skim`).
+    ///
     /// [`extra`]: CalibrationResult::extra
     fn read_back(&self, text: &str, path: &Path) -> Result<(CalibrationResult, Option<Robot>)> {
         if self.extra.is_empty() {
-            if let Ok(r) = serde_json::from_str::<CalibrationResult>(text) {
+            let skimmed = crate::io::result_skim::skimming(|| {
+                serde_json::from_str::<CalibrationResult>(text)
+            });
+            if let Ok(r) = skimmed {
+                crate::io::result_skim::finite_map(self.prediction.as_ref())?;
                 return check_read(r, text, path);
             }
         }

@@ -302,3 +302,68 @@ mod erased {
         }
     }
 }
+
+/// The read-back of `write` skims the per-point sections (`io::result_skim`): it does not build
+/// them, the reading path afterwards does (every value, a NaN written as null included), and a
+/// map position its readers would refuse stops the write in memory.
+#[test]
+fn the_read_back_skims_the_per_point_sections() {
+    use crate::io::result_prediction::{MapEntry, PredictionSection};
+    use crate::io::result_sections::Points;
+    let mut r = good_result();
+    let entry = |line: usize, after_mm: f64| PointEntry {
+        after_mm,
+        before_mm: 1.5,
+        line,
+    };
+    r.points = Some(Points {
+        calibration: vec![entry(2, 0.25), entry(3, f64::NAN)],
+        validation: Some(vec![entry(7, 0.5)]),
+    });
+    let spot = MapEntry {
+        mean_mm: 0.1,
+        model_mm: 0.05,
+        x: 1000.0,
+        y: -20.0,
+        z: 1500.0,
+    };
+    r.prediction = Some(PredictionSection {
+        map: vec![spot; 3],
+        mean_mm: 0.1,
+        std_mm: 0.02,
+        rms_mm: 0.11,
+        noise_sigma_mm: 0.03,
+        model_rms_mm: 0.04,
+    });
+    let path = Path::new("r.json");
+    let text = r.to_text().unwrap();
+    let (back, _) = r.read_back(&text, path).unwrap();
+    assert!(back.points.is_none());
+    assert!(back.prediction.as_ref().unwrap().map.is_empty());
+    let read = CalibrationResult::parse(&text, path).unwrap();
+    let points = read.points.as_ref().unwrap();
+    assert_eq!(points.calibration.len(), 2);
+    assert_eq!(points.calibration[0], entry(2, 0.25));
+    assert!(points.calibration[1].after_mm.is_nan());
+    assert_eq!(points.validation.as_deref(), Some(&[entry(7, 0.5)][..]));
+    assert_eq!(read.prediction.as_ref().unwrap().map, vec![spot; 3]);
+    let dir = scratch("skim");
+    let out = dir.join("r.json");
+    r.write(&out).unwrap();
+    let lines = |r: &CalibrationResult| -> Vec<usize> {
+        r.points
+            .as_ref()
+            .unwrap()
+            .calibration
+            .iter()
+            .map(|p| p.line)
+            .collect()
+    };
+    assert_eq!(lines(&CalibrationResult::read(&out).unwrap()), vec![2, 3]);
+    std::fs::remove_file(&out).unwrap();
+    r.prediction.as_mut().unwrap().map[1].y = f64::NAN;
+    let e = r.write(&out).unwrap_err().to_string();
+    assert!(e.contains("prediction.map[1]"), "{e}");
+    assert!(!out.exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,0 +1,84 @@
+//! Reading back a result robocal has just written ([`super::result::CalibrationResult::write`])
+//! without building its per-point sections again: `points` (an entry per calibration and
+//! validation row, a million of them for a million rows) and `prediction.map`. There they are
+//! only checked to be well-formed JSON, at a tenth of the cost of parsing every number.
+//!
+//! Nothing in them can make a reader refuse the file, which is what the read-back is for: their
+//! errors and weights read a `null` (a NaN written) as NaN, and their line numbers are integers
+//! the writer made. The one exception, a map point's position (not nullable), is checked in
+//! memory by the writer instead ([`finite_map`]).
+
+use super::result_prediction::PredictionSection;
+use crate::error::{Error, Result};
+use serde::de::{Deserialize, Deserializer, IgnoredAny};
+use std::cell::Cell;
+
+thread_local! {
+    /// Whether this thread is reading back a result it wrote (see the module docs).
+    static SKIMMING: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Runs `read` with the per-point sections skimmed (see the module docs), as before afterwards.
+pub(super) fn skimming<R>(read: impl FnOnce() -> R) -> R {
+    struct Restore(bool);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            SKIMMING.with(|s| s.set(self.0));
+        }
+    }
+    let _restore = Restore(SKIMMING.with(|s| s.replace(true)));
+    read()
+}
+
+fn skimmed<'de, D: Deserializer<'de>>(d: &mut Option<D>) -> std::result::Result<bool, D::Error> {
+    if !SKIMMING.with(Cell::get) {
+        return Ok(false);
+    }
+    if let Some(d) = d.take() {
+        IgnoredAny::deserialize(d)?;
+    }
+    Ok(true)
+}
+
+/// `deserialize_with` for an optional per-point section: `None` when skimmed.
+pub(crate) fn option<'de, D, T>(d: D) -> std::result::Result<Option<T>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let mut d = Some(d);
+    if skimmed(&mut d)? {
+        return Ok(None);
+    }
+    Option::<T>::deserialize(d.expect("not taken"))
+}
+
+/// `deserialize_with` for a per-point list: empty when skimmed.
+pub(crate) fn list<'de, D, T>(d: D) -> std::result::Result<Vec<T>, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    let mut d = Some(d);
+    if skimmed(&mut d)? {
+        return Ok(Vec::new());
+    }
+    Vec::<T>::deserialize(d.expect("not taken"))
+}
+
+/// What a reader of `prediction.map` would refuse and a skimmed read-back does not see: a
+/// position that is not finite (written as `null`).
+pub(super) fn finite_map(prediction: Option<&PredictionSection>) -> Result<()> {
+    let Some(p) = prediction else { return Ok(()) };
+    match p
+        .map
+        .iter()
+        .position(|m| !(m.x.is_finite() && m.y.is_finite() && m.z.is_finite()))
+    {
+        None => Ok(()),
+        Some(i) => Err(Error::Numerical(format!(
+            "prediction.map[{i}]: the position ({}, {}, {}) is not finite",
+            p.map[i].x, p.map[i].y, p.map[i].z
+        ))),
+    }
+}
