@@ -134,15 +134,36 @@ impl Robot {
     /// The frames of one forward pass at exactly the joint values `q`, without any family's
     /// deflection (`rigid` left empty), with the point of target `t` (0-based).
     pub fn rigid_pose_frames(&self, q: &[f64], t: usize) -> PoseFrames {
-        let mut ch = if self.joint_space().any_prismatic() {
-            self.chain_with::<true>(q)
-        } else {
-            self.chain_with::<false>(q)
-        };
-        let f = &ch.flange;
-        ch.point = f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
-        ch.target = t;
+        let mut ch = PoseFrames::identity();
+        self.rigid_pose_frames_into(q, t, &mut ch);
         ch
+    }
+
+    /// [`Robot::rigid_pose_frames`] written into `out` (a forward pass's frames reused from
+    /// call to call instead of a new one made and copied: four kilobytes for three numbers'
+    /// worth of work per joint). Only the first [`Robot::dof`] axis and link frames are
+    /// written; `rigid` is reset.
+    #[inline]
+    pub(crate) fn rigid_pose_frames_into(&self, q: &[f64], t: usize, out: &mut PoseFrames) {
+        if self.joint_space().any_prismatic() {
+            self.chain_into::<true>(q, out)
+        } else {
+            self.chain_into::<false>(q, out)
+        };
+        let f = &out.flange;
+        out.point =
+            f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
+        out.target = t;
+        out.rigid = RigidPose::default();
+    }
+
+    /// [`Robot::pose_frames_target`] written into `out` (see [`Robot::rigid_pose_frames_into`]).
+    #[inline]
+    pub(crate) fn pose_frames_target_into(&self, q: &[f64], t: usize, out: &mut PoseFrames) {
+        if !self.deflects_joints() {
+            return self.rigid_pose_frames_into(q, t, out);
+        }
+        *out = self.pose_frames_target(q, t);
     }
 
     /// What the families' deflections read at the commanded joints `q`: the rigid forward pass
@@ -188,16 +209,8 @@ impl Robot {
     }
 
     #[inline(always)]
-    fn chain_with<const MIXED: bool>(&self, q: &[f64]) -> PoseFrames {
+    fn chain_into<const MIXED: bool>(&self, q: &[f64], ch: &mut PoseFrames) {
         assert_eq!(q.len(), self.dof(), "joint vector length");
-        let mut ch = PoseFrames {
-            axis: [Frame::identity(); MAX_JOINTS],
-            link: [Frame::identity(); MAX_JOINTS],
-            flange: *self.base_frame(),
-            point: Vector3::zeros(),
-            target: 0,
-            rigid: RigidPose::default(),
-        };
         let mut f = *self.base_frame();
         let motion = self.joint_motions::<MIXED>(q);
         for i in 0..q.len() {
@@ -218,7 +231,6 @@ impl Robot {
             }
         }
         ch.flange = f;
-        ch
     }
 
     /// The tool point and, optionally, its Jacobians with respect to the joint values
@@ -267,8 +279,10 @@ impl Robot {
         jp: Option<&mut [Vector3<f64>]>,
         jw: Option<&mut [Vector3<f64>]>,
     ) -> (Vector3<f64>, Frame) {
-        let pose = self.pose_frames_target(q, t);
-        self.screws_at(&pose, jq, jp, jw)
+        with_scratch_frames(|pose| {
+            self.pose_frames_target_into(q, t, pose);
+            self.screws_at(pose, jq, jp, jw)
+        })
     }
 
     /// `pose`'s frames seen through target `t` (0-based): the same forward pass (deflection
@@ -339,6 +353,29 @@ impl Robot {
     pub(crate) fn joint_axis(&self, q: &[f64], i: usize) -> (Vector3<f64>, Vector3<f64>) {
         let f = &self.pose_frames(q).axis[i];
         (f.rotation.matrix().column(2).into(), f.translation.vector)
+    }
+}
+
+thread_local! {
+    /// Each thread's forward pass reused by [`with_scratch_frames`].
+    static SCRATCH_FRAMES: std::cell::RefCell<Option<Box<PoseFrames>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f` on this thread's reusable [`PoseFrames`] (a fresh one when it is in use higher up
+/// the stack): the Jacobian passes make one forward pass per observation, and a pass made in
+/// place costs a fraction of one made, returned and copied.
+#[inline]
+pub(crate) fn with_scratch_frames<R>(f: impl FnOnce(&mut PoseFrames) -> R) -> R {
+    let mut f = Some(f);
+    let out = SCRATCH_FRAMES.try_with(|cell| {
+        let mut slot = cell.try_borrow_mut().ok()?;
+        let frames = slot.get_or_insert_with(|| Box::new(PoseFrames::identity()));
+        Some((f.take().expect("run once"))(frames))
+    });
+    match out {
+        Ok(Some(r)) => r,
+        _ => (f.take().expect("not run"))(&mut PoseFrames::identity()),
     }
 }
 
