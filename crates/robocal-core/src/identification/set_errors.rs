@@ -44,6 +44,48 @@ impl SetErrors {
         }
     }
 
+    /// [`SetErrors::new`] for the calibration points `obs` that `reg` registered (the same
+    /// points in the same order): for point measurements without conditions the errors before
+    /// are the registration's residuals (Table II: the same numbers, the same forward pass and
+    /// arithmetic), not computed again.
+    pub(crate) fn of_calibration(
+        obs: &Observations,
+        reg: &Registration,
+        nominal: &Robot,
+        frame: &crate::frame::TrackerFrame,
+        cal: &Robot,
+    ) -> SetErrors {
+        let same = obs.kind().key() == "point"
+            && reg.residuals.len() == obs.len()
+            && (0..obs.len()).all(|i| obs.conditions(i).is_unknown());
+        // A registration of other points or of another model would show at once: the first,
+        // middle and last points' errors are computed and must be the residuals, to the bit.
+        let n = obs.len();
+        let probe = [0, n / 2, n.saturating_sub(1)];
+        let agrees = || {
+            let Ok(sub) = obs.rows_where(|i| probe.contains(&i)) else {
+                return false;
+            };
+            let e = Problem::new(nominal, &[], &sub, &reg.frame).error_norms(nominal);
+            let mut at = probe.to_vec();
+            at.dedup();
+            e.len() == at.len()
+                && e.iter()
+                    .zip(&at)
+                    .all(|(e, &i)| e.to_bits() == reg.residuals[i].to_bits())
+        };
+        if !(same && agrees()) {
+            return SetErrors::new(obs, reg, nominal, frame, cal);
+        }
+        let after = Problem::new(nominal, &[], obs, frame);
+        SetErrors {
+            lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
+            before: reg.residuals.clone(),
+            after: after.error_norms(cal),
+            orientation_deg: None,
+        }
+    }
+
     /// The errors of `obs` with a frame of their own for each model: the nominal model with the
     /// rigid frame fitted to it, the calibrated one with the frame fitted to it (data measured
     /// from another tracker station). Returns the errors and the calibrated model's frame.
