@@ -28,18 +28,20 @@ impl Robot {
         let mut buf = [0.0; MAX_JOINTS];
         let q = self.deflected(q, &mut buf);
         // All-revolute chains (the common case) run a loop without the per-joint type test.
-        if self.joint_space().any_prismatic() {
-            self.flange_pose_with::<true>(q)
-        } else {
-            self.flange_pose_with::<false>(q)
+        // Six joints (the common arm) take arrays of their own size: nothing of a sixteen-joint
+        // buffer to clear and copy per pass.
+        match (self.joint_space().any_prismatic(), q.len()) {
+            (false, 6) => self.flange_pose_with::<false, 6>(q),
+            (false, _) => self.flange_pose_with::<false, MAX_JOINTS>(q),
+            (true, _) => self.flange_pose_with::<true, MAX_JOINTS>(q),
         }
     }
 
     #[inline(always)]
-    fn flange_pose_with<const MIXED: bool>(&self, q: &[f64]) -> Frame {
+    fn flange_pose_with<const MIXED: bool, const N: usize>(&self, q: &[f64]) -> Frame {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut f = *self.base_frame();
-        let motion = self.joint_motions::<MIXED>(q);
+        let motion = self.joint_motions::<MIXED, N>(q);
         for i in 0..q.len() {
             let (s, co, d) = motion.of(i);
             match self.convention() {
@@ -142,19 +144,20 @@ impl Robot {
     /// [`Robot::rigid_pose_frames`] written into `out` (a forward pass's frames reused from
     /// call to call instead of a new one made and copied: four kilobytes for three numbers'
     /// worth of work per joint). Only the first [`Robot::dof`] axis and link frames are
-    /// written; `rigid` is reset.
+    /// written; of `rigid`, only its conditions (unknown): its other fields are read only by the
+    /// families that deflect the joints, whose passes ([`Robot::pose_frames_target`]) fill them.
     #[inline]
     pub(crate) fn rigid_pose_frames_into(&self, q: &[f64], t: usize, out: &mut PoseFrames) {
-        if self.joint_space().any_prismatic() {
-            self.chain_into::<true>(q, out)
-        } else {
-            self.chain_into::<false>(q, out)
-        };
+        match (self.joint_space().any_prismatic(), q.len()) {
+            (false, 6) => self.chain_into::<false, 6>(q, out),
+            (false, _) => self.chain_into::<false, MAX_JOINTS>(q, out),
+            (true, _) => self.chain_into::<true, MAX_JOINTS>(q, out),
+        }
         let f = &out.flange;
         out.point =
             f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
         out.target = t;
-        out.rigid = RigidPose::default();
+        out.rigid.conditions = crate::model::Conditions::UNKNOWN;
     }
 
     /// [`Robot::pose_frames_target`] written into `out` (see [`Robot::rigid_pose_frames_into`]).
@@ -188,9 +191,9 @@ impl Robot {
         let mut out = RigidPose::default();
         out.commanded[..q.len()].copy_from_slice(q);
         let motion = if self.joint_space().any_prismatic() {
-            self.joint_motions::<true>(q)
+            self.joint_motions::<true, MAX_JOINTS>(q)
         } else {
-            self.joint_motions::<false>(q)
+            self.joint_motions::<false, MAX_JOINTS>(q)
         };
         let mut f = *self.base_frame();
         for i in 0..q.len() {
@@ -209,10 +212,10 @@ impl Robot {
     }
 
     #[inline(always)]
-    fn chain_into<const MIXED: bool>(&self, q: &[f64], ch: &mut PoseFrames) {
+    fn chain_into<const MIXED: bool, const N: usize>(&self, q: &[f64], ch: &mut PoseFrames) {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut f = *self.base_frame();
-        let motion = self.joint_motions::<MIXED>(q);
+        let motion = self.joint_motions::<MIXED, N>(q);
         for i in 0..q.len() {
             let (s, co, d) = motion.of(i);
             match self.convention() {
@@ -381,13 +384,13 @@ pub(crate) fn with_scratch_frames<R>(f: impl FnOnce(&mut PoseFrames) -> R) -> R 
 
 /// Every joint's rotation (sin, cos) and translation along its axis at the joint values of one
 /// pass: `Rz(q + phi) Tz(d)` for a revolute joint, `Rz(phi) Tz(d + q)` for a prismatic one.
-struct JointMotions {
-    sin: [f64; MAX_JOINTS],
-    cos: [f64; MAX_JOINTS],
-    d: [f64; MAX_JOINTS],
+struct JointMotions<const N: usize> {
+    sin: [f64; N],
+    cos: [f64; N],
+    d: [f64; N],
 }
 
-impl JointMotions {
+impl<const N: usize> JointMotions<N> {
     /// Joint `i`'s `(sin, cos, d)`.
     #[inline(always)]
     fn of(&self, i: usize) -> (f64, f64, f64) {
@@ -396,18 +399,20 @@ impl JointMotions {
 }
 
 impl Robot {
-    /// The [`JointMotions`] at `q`: every angle first, then their sines and cosines in one loop
-    /// ([`trig::sin_cos_all`]) whose iterations do not wait on each other, nor on the frames
-    /// the pass then chains. Without `MIXED` every joint is revolute (the caller knows).
+    /// The [`JointMotions`] at `q` (at most `N` joints): every angle first, then their sines and
+    /// cosines in one loop ([`trig::sin_cos_all`]) whose iterations do not wait on each other,
+    /// nor on the frames the pass then chains. Without `MIXED` every joint is revolute (the
+    /// caller knows).
     #[inline(always)]
-    fn joint_motions<const MIXED: bool>(&self, q: &[f64]) -> JointMotions {
+    fn joint_motions<const MIXED: bool, const N: usize>(&self, q: &[f64]) -> JointMotions<N> {
         let n = q.len();
+        assert!(n <= N, "at most N joints");
         let types = self.joint_types();
-        let mut angle = [0.0; MAX_JOINTS];
+        let mut angle = [0.0; N];
         let mut m = JointMotions {
-            sin: [0.0; MAX_JOINTS],
-            cos: [0.0; MAX_JOINTS],
-            d: [0.0; MAX_JOINTS],
+            sin: [0.0; N],
+            cos: [0.0; N],
+            d: [0.0; N],
         };
         for (i, (l, &qi)) in self.links().iter().zip(q).enumerate() {
             let prismatic = MIXED && types[i] == JointType::Prismatic;
