@@ -360,9 +360,11 @@ impl Robot {
 }
 
 thread_local! {
-    /// Each thread's forward pass reused by [`with_scratch_frames`].
-    static SCRATCH_FRAMES: std::cell::RefCell<Option<Box<PoseFrames>>> =
-        const { std::cell::RefCell::new(None) };
+    /// Each thread's forward pass reused by [`with_scratch_frames`]: held in the thread's own
+    /// storage, not on the heap (the compensation loop allocates nothing, even on a thread's
+    /// first pass).
+    static SCRATCH_FRAMES: std::cell::RefCell<PoseFrames> =
+        std::cell::RefCell::new(PoseFrames::identity());
 }
 
 /// Runs `f` on this thread's reusable [`PoseFrames`] (a fresh one when it is in use higher up
@@ -372,9 +374,8 @@ thread_local! {
 pub(crate) fn with_scratch_frames<R>(f: impl FnOnce(&mut PoseFrames) -> R) -> R {
     let mut f = Some(f);
     let out = SCRATCH_FRAMES.try_with(|cell| {
-        let mut slot = cell.try_borrow_mut().ok()?;
-        let frames = slot.get_or_insert_with(|| Box::new(PoseFrames::identity()));
-        Some((f.take().expect("run once"))(frames))
+        let mut frames = cell.try_borrow_mut().ok()?;
+        Some((f.take().expect("run once"))(&mut frames))
     });
     match out {
         Ok(Some(r)) => r,
