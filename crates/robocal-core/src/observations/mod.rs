@@ -507,7 +507,7 @@ impl Observations {
                     continue;
                 };
                 let pair = (a.min(b), a.max(b));
-                if first.is_none_or(|(fa, fb)| (pair.1, pair.0) < (fb, fa)) {
+                if first.map_or(true, |(fa, fb)| (pair.1, pair.0) < (fb, fa)) {
                     first = Some(pair);
                 }
             }
