@@ -506,6 +506,9 @@ pub fn predict(
                 f64::INFINITY,
             )
         },
+        // Inlined into the chunk's loop, which runs with AVX where the processor has it (see
+        // `simd`): the Gram update then takes the wider instructions too.
+        #[inline(always)]
         |(s, j, m, lowest), i| {
             let p = jacobian(s, i, j);
             *lowest = lowest.min(p.z);
@@ -535,6 +538,7 @@ pub fn predict(
                 Vec::new(),
             )
         },
+        #[inline(always)]
         |(s, y, h, models), i| {
             if !(is_kept[i] || is_picked[i]) {
                 return;

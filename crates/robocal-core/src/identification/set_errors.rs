@@ -44,6 +44,48 @@ impl SetErrors {
         }
     }
 
+    /// [`SetErrors::new`] for the calibration points `obs` that `reg` registered (the same
+    /// points in the same order): for point measurements without conditions the errors before
+    /// are the registration's residuals (Table II: the same numbers, the same forward pass and
+    /// arithmetic), not computed again.
+    pub(crate) fn of_calibration(
+        obs: &Observations,
+        reg: &Registration,
+        nominal: &Robot,
+        frame: &crate::frame::TrackerFrame,
+        cal: &Robot,
+    ) -> SetErrors {
+        let same = obs.kind().key() == "point"
+            && reg.residuals.len() == obs.len()
+            && (0..obs.len()).all(|i| obs.conditions(i).is_unknown());
+        // A registration of other points or of another model would show at once: the first,
+        // middle and last points' errors are computed and must be the residuals, to the bit.
+        let n = obs.len();
+        let probe = [0, n / 2, n.saturating_sub(1)];
+        let agrees = || {
+            let Ok(sub) = obs.rows_where(|i| probe.contains(&i)) else {
+                return false;
+            };
+            let e = Problem::new(nominal, &[], &sub, &reg.frame).error_norms(nominal);
+            let mut at = probe.to_vec();
+            at.dedup();
+            e.len() == at.len()
+                && e.iter()
+                    .zip(&at)
+                    .all(|(e, &i)| e.to_bits() == reg.residuals[i].to_bits())
+        };
+        if !(same && agrees()) {
+            return SetErrors::new(obs, reg, nominal, frame, cal);
+        }
+        let after = Problem::new(nominal, &[], obs, frame);
+        SetErrors {
+            lines: (0..obs.len()).map(|i| obs.line(i)).collect(),
+            before: reg.residuals.clone(),
+            after: after.error_norms(cal),
+            orientation_deg: None,
+        }
+    }
+
     /// The errors of `obs` with a frame of their own for each model: the nominal model with the
     /// rigid frame fitted to it, the calibrated one with the frame fitted to it (data measured
     /// from another tracker station). Returns the errors and the calibrated model's frame.
@@ -124,5 +166,70 @@ impl DownWeighted {
             .collect();
         out.sort_by(|a, b| b.0.total_cmp(&a.0));
         out.into_iter().map(|(_, d)| d).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{pose, TrackerFrame};
+    use crate::model::presets::preset;
+    use crate::registration::{register, RegistrationOptions};
+    use crate::simulation::{random_poses, PoseSampler, Tracker};
+    use rand::SeedableRng;
+
+    /// The calibration points' errors from the registration's residuals are those computed
+    /// afresh, to the bit; points the registration did not see, or another model, fall back to
+    /// computing them.
+    #[test]
+    fn calibration_errors_reuse_the_registration_to_the_bit() {
+        let truth = preset("kuka-kr480-r3330-table3").unwrap();
+        let nominal = preset("kuka-kr480-r3330").unwrap();
+        let tracker = Tracker::new(
+            TrackerFrame::new(pose(&[3900.0, -2200.0, -350.0, 2.65, 0.007, -0.012])),
+            0.01,
+            0.005,
+        )
+        .unwrap();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let sampler = PoseSampler {
+            floor_z_mm: 0.0,
+            footprint_radius_mm: 800.0,
+            max_tries_per_pose: 10_000,
+        };
+        let measure = |n: usize, rng: &mut rand_chacha::ChaCha8Rng| {
+            let mut obs = Observations::new(6);
+            for (i, q) in random_poses(&truth, n, &sampler, rng)
+                .unwrap()
+                .iter()
+                .enumerate()
+            {
+                obs.push(q, tracker.measure(&truth.tool_position(q), rng), i + 2)
+                    .unwrap();
+            }
+            obs
+        };
+        let cal = measure(60, &mut rng);
+        let other = measure(60, &mut rng);
+        let reg = register(&nominal, &cal, None, &RegistrationOptions::default()).unwrap();
+        let frame = TrackerFrame::new(pose(&[3901.0, -2199.0, -350.5, 2.651, 0.007, -0.012]));
+        let fresh = SetErrors::new(&cal, &reg, &nominal, &frame, &truth);
+        let reused = SetErrors::of_calibration(&cal, &reg, &nominal, &frame, &truth);
+        assert_eq!(reused, fresh);
+        assert_eq!(reused.before, reg.residuals);
+        // Other points of the same count: computed, not taken from the registration.
+        let fresh = SetErrors::new(&other, &reg, &nominal, &frame, &truth);
+        assert_eq!(
+            SetErrors::of_calibration(&other, &reg, &nominal, &frame, &truth),
+            fresh
+        );
+        assert_ne!(fresh.before, reg.residuals);
+        // Another nominal model: likewise.
+        let fresh = SetErrors::new(&cal, &reg, &truth, &frame, &truth);
+        assert_eq!(
+            SetErrors::of_calibration(&cal, &reg, &truth, &frame, &truth),
+            fresh
+        );
+        assert_ne!(fresh.before, reg.residuals);
     }
 }

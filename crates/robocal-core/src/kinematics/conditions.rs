@@ -79,13 +79,30 @@ impl Robot {
         jp: Option<&mut [Vector3<f64>]>,
         jw: Option<&mut [Vector3<f64>]>,
     ) -> (Vector3<f64>, Frame) {
-        let pose = self.pose_frames_in(q, t, c);
         let mut jp = jp;
-        let out = self.screws_at(&pose, jq, jp.as_deref_mut(), jw);
+        let out = super::with_scratch_frames(|pose| {
+            self.pose_frames_in_into(q, t, c, pose);
+            self.screws_at(pose, jq, jp.as_deref_mut(), jw)
+        });
         if let Some(jp) = jp {
             self.scale_grown_columns(c, jp);
         }
         out
+    }
+
+    /// [`Robot::pose_frames_in`] written into `out` (see [`Robot::rigid_pose_frames_into`]).
+    #[inline]
+    pub(crate) fn pose_frames_in_into(
+        &self,
+        q: &[f64],
+        t: usize,
+        c: &Conditions,
+        out: &mut PoseFrames,
+    ) {
+        if c.is_unknown() {
+            return self.pose_frames_target_into(q, t, out);
+        }
+        *out = self.pose_frames_in(q, t, c);
     }
 
     /// Scales the columns of the lengths thermal growth scales (each link's `d` and `a`) by the

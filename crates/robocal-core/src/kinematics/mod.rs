@@ -28,18 +28,20 @@ impl Robot {
         let mut buf = [0.0; MAX_JOINTS];
         let q = self.deflected(q, &mut buf);
         // All-revolute chains (the common case) run a loop without the per-joint type test.
-        if self.joint_space().any_prismatic() {
-            self.flange_pose_with::<true>(q)
-        } else {
-            self.flange_pose_with::<false>(q)
+        // Six joints (the common arm) take arrays of their own size: nothing of a sixteen-joint
+        // buffer to clear and copy per pass.
+        match (self.joint_space().any_prismatic(), q.len()) {
+            (false, 6) => self.flange_pose_with::<false, 6>(q),
+            (false, _) => self.flange_pose_with::<false, MAX_JOINTS>(q),
+            (true, _) => self.flange_pose_with::<true, MAX_JOINTS>(q),
         }
     }
 
     #[inline(always)]
-    fn flange_pose_with<const MIXED: bool>(&self, q: &[f64]) -> Frame {
+    fn flange_pose_with<const MIXED: bool, const N: usize>(&self, q: &[f64]) -> Frame {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut f = *self.base_frame();
-        let motion = self.joint_motions::<MIXED>(q);
+        let motion = self.joint_motions::<MIXED, N>(q);
         for i in 0..q.len() {
             let (s, co, d) = motion.of(i);
             match self.convention() {
@@ -134,15 +136,37 @@ impl Robot {
     /// The frames of one forward pass at exactly the joint values `q`, without any family's
     /// deflection (`rigid` left empty), with the point of target `t` (0-based).
     pub fn rigid_pose_frames(&self, q: &[f64], t: usize) -> PoseFrames {
-        let mut ch = if self.joint_space().any_prismatic() {
-            self.chain_with::<true>(q)
-        } else {
-            self.chain_with::<false>(q)
-        };
-        let f = &ch.flange;
-        ch.point = f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
-        ch.target = t;
+        let mut ch = PoseFrames::identity();
+        self.rigid_pose_frames_into(q, t, &mut ch);
         ch
+    }
+
+    /// [`Robot::rigid_pose_frames`] written into `out` (a forward pass's frames reused from
+    /// call to call instead of a new one made and copied: four kilobytes for three numbers'
+    /// worth of work per joint). Only the first [`Robot::dof`] axis and link frames are
+    /// written; of `rigid`, only its conditions (unknown): its other fields are read only by the
+    /// families that deflect the joints, whose passes ([`Robot::pose_frames_target`]) fill them.
+    #[inline]
+    pub(crate) fn rigid_pose_frames_into(&self, q: &[f64], t: usize, out: &mut PoseFrames) {
+        match (self.joint_space().any_prismatic(), q.len()) {
+            (false, 6) => self.chain_into::<false, 6>(q, out),
+            (false, _) => self.chain_into::<false, MAX_JOINTS>(q, out),
+            (true, _) => self.chain_into::<true, MAX_JOINTS>(q, out),
+        }
+        let f = &out.flange;
+        out.point =
+            f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
+        out.target = t;
+        out.rigid.conditions = crate::model::Conditions::UNKNOWN;
+    }
+
+    /// [`Robot::pose_frames_target`] written into `out` (see [`Robot::rigid_pose_frames_into`]).
+    #[inline]
+    pub(crate) fn pose_frames_target_into(&self, q: &[f64], t: usize, out: &mut PoseFrames) {
+        if !self.deflects_joints() {
+            return self.rigid_pose_frames_into(q, t, out);
+        }
+        *out = self.pose_frames_target(q, t);
     }
 
     /// What the families' deflections read at the commanded joints `q`: the rigid forward pass
@@ -167,9 +191,9 @@ impl Robot {
         let mut out = RigidPose::default();
         out.commanded[..q.len()].copy_from_slice(q);
         let motion = if self.joint_space().any_prismatic() {
-            self.joint_motions::<true>(q)
+            self.joint_motions::<true, MAX_JOINTS>(q)
         } else {
-            self.joint_motions::<false>(q)
+            self.joint_motions::<false, MAX_JOINTS>(q)
         };
         let mut f = *self.base_frame();
         for i in 0..q.len() {
@@ -188,18 +212,10 @@ impl Robot {
     }
 
     #[inline(always)]
-    fn chain_with<const MIXED: bool>(&self, q: &[f64]) -> PoseFrames {
+    fn chain_into<const MIXED: bool, const N: usize>(&self, q: &[f64], ch: &mut PoseFrames) {
         assert_eq!(q.len(), self.dof(), "joint vector length");
-        let mut ch = PoseFrames {
-            axis: [Frame::identity(); MAX_JOINTS],
-            link: [Frame::identity(); MAX_JOINTS],
-            flange: *self.base_frame(),
-            point: Vector3::zeros(),
-            target: 0,
-            rigid: RigidPose::default(),
-        };
         let mut f = *self.base_frame();
-        let motion = self.joint_motions::<MIXED>(q);
+        let motion = self.joint_motions::<MIXED, N>(q);
         for i in 0..q.len() {
             let (s, co, d) = motion.of(i);
             match self.convention() {
@@ -218,7 +234,6 @@ impl Robot {
             }
         }
         ch.flange = f;
-        ch
     }
 
     /// The tool point and, optionally, its Jacobians with respect to the joint values
@@ -267,8 +282,10 @@ impl Robot {
         jp: Option<&mut [Vector3<f64>]>,
         jw: Option<&mut [Vector3<f64>]>,
     ) -> (Vector3<f64>, Frame) {
-        let pose = self.pose_frames_target(q, t);
-        self.screws_at(&pose, jq, jp, jw)
+        with_scratch_frames(|pose| {
+            self.pose_frames_target_into(q, t, pose);
+            self.screws_at(pose, jq, jp, jw)
+        })
     }
 
     /// `pose`'s frames seen through target `t` (0-based): the same forward pass (deflection
@@ -342,15 +359,39 @@ impl Robot {
     }
 }
 
-/// Every joint's rotation (sin, cos) and translation along its axis at the joint values of one
-/// pass: `Rz(q + phi) Tz(d)` for a revolute joint, `Rz(phi) Tz(d + q)` for a prismatic one.
-struct JointMotions {
-    sin: [f64; MAX_JOINTS],
-    cos: [f64; MAX_JOINTS],
-    d: [f64; MAX_JOINTS],
+thread_local! {
+    /// Each thread's forward pass reused by [`with_scratch_frames`]: held in the thread's own
+    /// storage, not on the heap (the compensation loop allocates nothing, even on a thread's
+    /// first pass).
+    static SCRATCH_FRAMES: std::cell::RefCell<PoseFrames> =
+        std::cell::RefCell::new(PoseFrames::identity());
 }
 
-impl JointMotions {
+/// Runs `f` on this thread's reusable [`PoseFrames`] (a fresh one when it is in use higher up
+/// the stack): the Jacobian passes make one forward pass per observation, and a pass made in
+/// place costs a fraction of one made, returned and copied.
+#[inline]
+pub(crate) fn with_scratch_frames<R>(f: impl FnOnce(&mut PoseFrames) -> R) -> R {
+    let mut f = Some(f);
+    let out = SCRATCH_FRAMES.try_with(|cell| {
+        let mut frames = cell.try_borrow_mut().ok()?;
+        Some((f.take().expect("run once"))(&mut frames))
+    });
+    match out {
+        Ok(Some(r)) => r,
+        _ => (f.take().expect("not run"))(&mut PoseFrames::identity()),
+    }
+}
+
+/// Every joint's rotation (sin, cos) and translation along its axis at the joint values of one
+/// pass: `Rz(q + phi) Tz(d)` for a revolute joint, `Rz(phi) Tz(d + q)` for a prismatic one.
+struct JointMotions<const N: usize> {
+    sin: [f64; N],
+    cos: [f64; N],
+    d: [f64; N],
+}
+
+impl<const N: usize> JointMotions<N> {
     /// Joint `i`'s `(sin, cos, d)`.
     #[inline(always)]
     fn of(&self, i: usize) -> (f64, f64, f64) {
@@ -359,18 +400,20 @@ impl JointMotions {
 }
 
 impl Robot {
-    /// The [`JointMotions`] at `q`: every angle first, then their sines and cosines in one loop
-    /// ([`trig::sin_cos_all`]) whose iterations do not wait on each other, nor on the frames
-    /// the pass then chains. Without `MIXED` every joint is revolute (the caller knows).
+    /// The [`JointMotions`] at `q` (at most `N` joints): every angle first, then their sines and
+    /// cosines in one loop ([`trig::sin_cos_all`]) whose iterations do not wait on each other,
+    /// nor on the frames the pass then chains. Without `MIXED` every joint is revolute (the
+    /// caller knows).
     #[inline(always)]
-    fn joint_motions<const MIXED: bool>(&self, q: &[f64]) -> JointMotions {
+    fn joint_motions<const MIXED: bool, const N: usize>(&self, q: &[f64]) -> JointMotions<N> {
         let n = q.len();
+        assert!(n <= N, "at most N joints");
         let types = self.joint_types();
-        let mut angle = [0.0; MAX_JOINTS];
+        let mut angle = [0.0; N];
         let mut m = JointMotions {
-            sin: [0.0; MAX_JOINTS],
-            cos: [0.0; MAX_JOINTS],
-            d: [0.0; MAX_JOINTS],
+            sin: [0.0; N],
+            cos: [0.0; N],
+            d: [0.0; N],
         };
         for (i, (l, &qi)) in self.links().iter().zip(q).enumerate() {
             let prismatic = MIXED && types[i] == JointType::Prismatic;

@@ -32,6 +32,7 @@ use plane::{plane_frame, plane_tilt_deg};
 pub(crate) use rigid::IrlsOptions;
 use rigid::{fit_rigid, fit_rigid_sum_of_norms, residual_norms};
 pub use tool_fit::{fit_tools, ToolFit, MAX_ALTERNATIONS, TOOL_TOLERANCE_MM};
+pub(crate) use tool_fit::{fit_tools_from, nominal_flanges, tool_points};
 
 /// What the rigid fit minimizes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -116,11 +117,24 @@ pub struct Registration {
 
 /// Fits the measurement frame of `cal` to the nominal model `robot` (see the module docs).
 /// `plane` holds the paper's plane points, if measured (empty or `None` otherwise).
+#[cfg(test)]
 pub(crate) fn register(
     robot: &Robot,
     cal: &Observations,
     plane: Option<&Observations>,
     opts: &RegistrationOptions,
+) -> Result<Registration> {
+    register_to(robot, cal, plane, opts, None)
+}
+
+/// [`register`] given `nominal`, the nominal tool point of every calibration point
+/// ([`Observations::model_positions`]) when already computed.
+pub(crate) fn register_to(
+    robot: &Robot,
+    cal: &Observations,
+    plane: Option<&Observations>,
+    opts: &RegistrationOptions,
+    nominal: Option<Vec<nalgebra::Vector3<f64>>>,
 ) -> Result<Registration> {
     if cal.len() < 3 {
         return Err(Error::invalid(
@@ -131,7 +145,10 @@ pub(crate) fn register(
             ),
         ));
     }
-    let nominal = cal.model_positions(robot);
+    let nominal = match nominal {
+        Some(p) if p.len() == cal.len() => p,
+        _ => cal.model_positions(robot),
+    };
     let measured = cal.measured();
     let ls = fit_rigid(measured, &nominal, None)?;
     let initial = match plane.filter(|p| !p.is_empty()) {

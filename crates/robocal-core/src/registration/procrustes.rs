@@ -86,6 +86,23 @@ pub fn fit_procrustes(
     handedness: Handedness,
     scale: Scale,
 ) -> Result<Procrustes> {
+    check_counts(from, to, weights)?;
+    let w = |i: usize| weights.map_or(1.0, |w| w[i]);
+    // The weights' sum and the weighted sums of the points in one pass (each sum in point
+    // order, as in separate passes).
+    let mut sums = CentroidSums::default();
+    for i in 0..from.len() {
+        sums.add(&from[i], &to[i], w(i));
+    }
+    solve_from_sums(from, to, weights, sums, handedness, scale)
+}
+
+/// Fails unless `from`, `to` (and `weights`, when given) have the same count, at least 3.
+pub(crate) fn check_counts(
+    from: &[Vector3<f64>],
+    to: &[Vector3<f64>],
+    weights: Option<&[f64]>,
+) -> Result<()> {
     let n = from.len();
     if n != to.len() || weights.is_some_and(|w| w.len() != n) {
         return Err(Error::invalid(
@@ -99,17 +116,55 @@ pub fn fit_procrustes(
             format!("a rigid fit needs at least 3 points, got {n}"),
         ));
     }
-    let w = |i: usize| weights.map_or(1.0, |w| w[i]);
-    // The weights' sum and the weighted sums of the points in one pass (each sum in point
-    // order, as in separate passes).
-    let mut wsum = 0.0;
-    let mut cm = Vector3::zeros();
-    let mut cp = Vector3::zeros();
-    for i in 0..n {
-        wsum += w(i);
-        cm += from[i] * w(i);
-        cp += to[i] * w(i);
+    Ok(())
+}
+
+/// The weights' sum and the weighted sums of the points, added point by point: the first pass
+/// of [`fit_procrustes`], which a caller that computes the weights can make with its own.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct CentroidSums {
+    wsum: f64,
+    cm: Vector3<f64>,
+    cp: Vector3<f64>,
+}
+
+impl Default for CentroidSums {
+    fn default() -> Self {
+        CentroidSums {
+            wsum: 0.0,
+            cm: Vector3::zeros(),
+            cp: Vector3::zeros(),
+        }
     }
+}
+
+impl CentroidSums {
+    /// Adds the pair `(m, p)` of weight `w`.
+    #[inline(always)]
+    pub(crate) fn add(&mut self, m: &Vector3<f64>, p: &Vector3<f64>, w: f64) {
+        self.wsum += w;
+        self.cm += m * w;
+        self.cp += p * w;
+    }
+}
+
+/// [`fit_procrustes`] after its first pass: `sums` of `from`, `to` and `weights` (whose counts
+/// the caller checked, [`check_counts`]).
+pub(crate) fn solve_from_sums(
+    from: &[Vector3<f64>],
+    to: &[Vector3<f64>],
+    weights: Option<&[f64]>,
+    sums: CentroidSums,
+    handedness: Handedness,
+    scale: Scale,
+) -> Result<Procrustes> {
+    let n = from.len();
+    let w = |i: usize| weights.map_or(1.0, |w| w[i]);
+    let CentroidSums {
+        wsum,
+        mut cm,
+        mut cp,
+    } = sums;
     if !(wsum > 0.0 && wsum.is_finite()) {
         return Err(Error::Numerical("registration: weights sum to zero".into()));
     }

@@ -1,7 +1,9 @@
 //! The rigid fit of the tracker frame: closed form (Kabsch/Horn, [`super::procrustes`]) and its
 //! sum-of-norms refinement.
 
-use super::procrustes::{fit_procrustes, Handedness, Scale};
+use super::procrustes::{
+    check_counts, fit_procrustes, solve_from_sums, CentroidSums, Handedness, Scale,
+};
 use crate::error::{Error, Result};
 use crate::frame::{self, TrackerFrame};
 use nalgebra::Vector3;
@@ -17,13 +19,17 @@ pub fn fit_rigid(
     target: &[Vector3<f64>],
     weights: Option<&[f64]>,
 ) -> Result<TrackerFrame> {
-    let fit = fit_procrustes(
+    rigid_frame(fit_procrustes(
         measured,
         target,
         weights,
         Handedness::Rotation,
         Scale::Fixed,
-    )?;
+    )?)
+}
+
+/// The tracker frame of a rotation fit, failing when the points leave it undetermined.
+fn rigid_frame(fit: super::procrustes::Procrustes) -> Result<TrackerFrame> {
     if !fit.is_determined() {
         return Err(Error::Numerical(
             "registration: the points are collinear (or coincide); the measurement frame is \
@@ -83,25 +89,51 @@ pub fn fit_rigid_sum_of_norms(
     init: &TrackerFrame,
     opts: &IrlsOptions,
 ) -> Result<(TrackerFrame, usize)> {
+    check_counts(measured, target, None)?;
+    let weight = |f: &TrackerFrame, m: &Vector3<f64>, p: &Vector3<f64>| {
+        1.0 / (f.to_base(m) - p).norm().max(opts.floor_mm)
+    };
+    // Each iteration's weights and their sums (the Kabsch fit's first pass) are computed in the
+    // pass that measures how far the previous iteration moved the points: two passes over the
+    // points an iteration instead of four, the same numbers in the same order.
     let mut f = *init;
     let mut w = vec![0.0; measured.len()];
+    let mut sums = CentroidSums::default();
+    for ((m, p), wi) in measured.iter().zip(target).zip(w.iter_mut()) {
+        *wi = weight(&f, m, p);
+        sums.add(m, p, *wi);
+    }
     for it in 1..=opts.max_iterations {
-        for ((wi, m), p) in w.iter_mut().zip(measured).zip(target) {
-            *wi = 1.0 / (f.to_base(m) - p).norm().max(opts.floor_mm);
-        }
-        let g = fit_rigid(measured, target, Some(&w))?;
+        let g = rigid_frame(solve_from_sums(
+            measured,
+            target,
+            Some(&w),
+            sums,
+            Handedness::Rotation,
+            Scale::Fixed,
+        )?)?;
         // How far each point moved, `(R_g - R_f) m + (t_g - t_f)`: one product a point.
         let (pg, pf) = (g.pose(), f.pose());
         let dr = pg.rotation.matrix() - pf.rotation.matrix();
         let dt = pg.translation.vector - pf.translation.vector;
-        let moved = measured
-            .iter()
-            .map(|m| (dr * m + dt).norm())
-            .fold(0.0, f64::max);
+        let mut moved = 0.0;
+        let mut next = CentroidSums::default();
+        if it < opts.max_iterations {
+            for ((m, p), wi) in measured.iter().zip(target).zip(w.iter_mut()) {
+                moved = f64::max(moved, (dr * m + dt).norm());
+                *wi = weight(&g, m, p);
+                next.add(m, p, *wi);
+            }
+        } else {
+            for m in measured {
+                moved = f64::max(moved, (dr * m + dt).norm());
+            }
+        }
         f = g;
         if moved <= opts.tolerance_mm {
             return Ok((f, it));
         }
+        sums = next;
     }
     Ok((f, opts.max_iterations))
 }

@@ -12,7 +12,7 @@ use crate::frame::{self, Frame, TrackerFrame};
 use crate::model::{Param, Robot};
 use crate::observations::Observations;
 use crate::stats::ErrorStats;
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3, SMatrix, SVector, Vector3};
 
 /// Most Gauss-Newton iterations of [`fit_tools`].
 pub const MAX_ALTERNATIONS: usize = 50;
@@ -70,9 +70,48 @@ impl ToolFit {
 /// Fits the frame and every target's tool point (see the module docs), starting from `start`.
 /// `robot`'s geometry is held; its tool vectors give the starting orientations.
 pub fn fit_tools(robot: &Robot, obs: &Observations, start: &TrackerFrame) -> Result<ToolFit> {
+    fit_tools_from(robot, obs, start, nominal_flanges(robot, obs))
+}
+
+/// `robot`'s flange frame at every observation's joints: what [`fit_tools_from`] holds fixed.
+pub(crate) fn nominal_flanges(robot: &Robot, obs: &Observations) -> Vec<Frame> {
+    (0..obs.len())
+        .map(|i| robot.flange_pose(obs.q(i)))
+        .collect()
+}
+
+/// The tool points of `flanges`' observations whose conditions are all unknown (the model's
+/// tool point at each, [`Observations::model_positions`], from the flange already computed);
+/// `None` when some row has conditions (a thermal or backlash model's point depends on them).
+pub(crate) fn tool_points(
+    robot: &Robot,
+    obs: &Observations,
+    flanges: &[Frame],
+) -> Option<Vec<Vector3<f64>>> {
+    if (0..obs.len()).any(|i| !obs.conditions(i).is_unknown()) {
+        return None;
+    }
+    Some(
+        flanges
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                f.rotation * robot.target_tool_frame(obs.target(i)).translation.vector
+                    + f.translation.vector
+            })
+            .collect(),
+    )
+}
+
+/// [`fit_tools`] given the nominal flange frames ([`nominal_flanges`]).
+pub(crate) fn fit_tools_from(
+    robot: &Robot,
+    obs: &Observations,
+    start: &TrackerFrame,
+    flanges: Vec<Frame>,
+) -> Result<ToolFit> {
     let n = obs.len();
     let k = obs.target_count().max(1);
-    let flanges: Vec<Frame> = (0..n).map(|i| robot.flange_pose(obs.q(i))).collect();
     let mut count = vec![0usize; k];
     for i in 0..n {
         count[obs.target(i)] += 1;
@@ -94,8 +133,14 @@ pub fn fit_tools(robot: &Robot, obs: &Observations, start: &TrackerFrame) -> Res
         iterations += 1;
         // r_i = F m_i - (o_i + R_i t_k); d r / d(rotation of F) = -[F m_i - t_F]x, d r / d t_F =
         // I, d r / d t_k = -R_i.
-        let mut a = DMatrix::<f64>::zeros(np, np);
-        let mut b = DVector::<f64>::zeros(np);
+        // The normal equations by blocks, each summed over its points in point order (the
+        // frame's block over every point, a target's blocks over its own): the sums a dense
+        // matrix indexed per entry would hold, without the indexing.
+        let mut frame_block = SMatrix::<f64, 6, 6>::zeros();
+        let mut frame_b = SVector::<f64, 6>::zeros();
+        let mut cross = vec![SMatrix::<f64, 6, 3>::zeros(); k];
+        let mut tool_block = vec![Matrix3::<f64>::zeros(); k];
+        let mut tool_b = vec![Vector3::<f64>::zeros(); k];
         let tf = frame.origin();
         for (i, f) in flanges.iter().enumerate() {
             let t = obs.target(i);
@@ -110,13 +155,25 @@ pub fn fit_tools(robot: &Robot, obs: &Observations, start: &TrackerFrame) -> Res
                 .copy_from(&(-f.rotation.matrix()));
             let jtj = j.transpose() * j;
             let jtr = j.transpose() * r;
-            let idx = |c: usize| if c < 6 { c } else { 6 + 3 * t + (c - 6) };
-            for x in 0..9 {
-                b[idx(x)] += jtr[x];
-                for y in 0..9 {
-                    a[(idx(x), idx(y))] += jtj[(x, y)];
-                }
-            }
+            frame_block += jtj.fixed_view::<6, 6>(0, 0);
+            frame_b += jtr.fixed_rows::<6>(0);
+            cross[t] += jtj.fixed_view::<6, 3>(0, 6);
+            tool_block[t] += jtj.fixed_view::<3, 3>(6, 6);
+            tool_b[t] += jtr.fixed_rows::<3>(6);
+        }
+        // `J^T J` is symmetric to the bit (each entry's products are the same, summed in the same
+        // order), so the block below the frame's is the transpose of the one beside it.
+        let mut a = DMatrix::<f64>::zeros(np, np);
+        let mut b = DVector::<f64>::zeros(np);
+        a.fixed_view_mut::<6, 6>(0, 0).copy_from(&frame_block);
+        b.fixed_rows_mut::<6>(0).copy_from(&frame_b);
+        for t in 0..k {
+            let o = 6 + 3 * t;
+            a.fixed_view_mut::<6, 3>(0, o).copy_from(&cross[t]);
+            a.fixed_view_mut::<3, 6>(o, 0)
+                .copy_from(&cross[t].transpose());
+            a.fixed_view_mut::<3, 3>(o, o).copy_from(&tool_block[t]);
+            b.fixed_rows_mut::<3>(o).copy_from(&tool_b[t]);
         }
         for (t, c) in count.iter().enumerate() {
             if *c == 0 {

@@ -66,7 +66,8 @@ pub(super) fn assemble(
         covariance.mark_unavailable(why.clone());
     }
     let cal = &start.observations;
-    let calibration = SetErrors::new(cal, &start.registration, nominal, &start.frame, robot);
+    let calibration =
+        SetErrors::of_calibration(cal, &start.registration, nominal, &start.frame, robot);
     // Points beyond the robust threshold are outliers, not noise a new measurement shares.
     let threshold = solved.robust_scale.unwrap_or_else(|| {
         ROBUST_SCALE_SIGMAS * robust_sigma(&calibration.after, problem.kind().rows())

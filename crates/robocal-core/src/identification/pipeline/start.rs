@@ -11,7 +11,8 @@ use crate::model::Robot;
 use crate::observations::{AppliedWeighting, Observations, Weighting};
 use crate::progress::{self, Observer};
 use crate::registration::{
-    fit_tools, register, Registration, RegistrationObjective, RegistrationOptions, ToolFit,
+    fit_tools_from, nominal_flanges, register_to, tool_points, Registration, RegistrationObjective,
+    RegistrationOptions, ToolFit,
 };
 
 /// Where the identification starts.
@@ -73,8 +74,12 @@ pub(crate) fn register_nominal(
         affine: settings.affine_registration,
         ..Default::default()
     };
-    let registration = register(nominal, cal, data.plane, &reg_opts)?;
-    let mut tool_fit = fit_tools(nominal, cal, &registration.frame)?;
+    // One forward pass per point for both fits: the tool fit holds the flange frames, the
+    // registration their tool points.
+    let flanges = nominal_flanges(nominal, cal);
+    let points = tool_points(nominal, cal, &flanges);
+    let registration = register_to(nominal, cal, data.plane, &reg_opts, points)?;
+    let mut tool_fit = fit_tools_from(nominal, cal, &registration.frame, flanges)?;
     // Only where the nominal geometry with the fitted tools fits the data as a calibration's
     // start can (the gate's nominal-error limit): on data in the wrong unit or of another robot
     // the fitted tools mean nothing, and the gate names the cause.

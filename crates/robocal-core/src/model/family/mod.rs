@@ -300,6 +300,18 @@ impl Default for RigidPose {
 }
 
 impl PoseFrames {
+    /// Every frame the identity, the point at the origin: a pass not made yet.
+    pub fn identity() -> PoseFrames {
+        PoseFrames {
+            axis: [Frame::identity(); MAX_JOINTS],
+            link: [Frame::identity(); MAX_JOINTS],
+            flange: Frame::identity(),
+            point: Vector3::zeros(),
+            target: 0,
+            rigid: RigidPose::default(),
+        }
+    }
+
     /// Joint `i`'s screw at the tool: the tool point's velocity and the tool frame's angular
     /// velocity per unit of the joint value (a revolute joint turns about its axis, a prismatic
     /// one translates along it).

@@ -64,11 +64,12 @@ impl MeasurementKind for Point {
         let k = cols.len();
         let (x, rest) = out.split_at_mut(k);
         let (y, z) = rest.split_at_mut(k);
-        for (c, &j) in cols.iter().enumerate() {
+        // Zipped rather than indexed: one bounds check a column (the screw's) instead of four.
+        for (((x, y), z), &j) in x.iter_mut().zip(y).zip(&mut z[..k]).zip(cols) {
             let v = jp[j];
-            x[c] = v.x;
-            y[c] = v.y;
-            z[c] = v.z;
+            *x = v.x;
+            *y = v.y;
+            *z = v.z;
         }
     }
 }
