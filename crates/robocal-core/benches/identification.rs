@@ -153,7 +153,7 @@ fn bench(c: &mut Criterion) {
         g.sample_size(samples);
         bench_calibrate(
             &mut g,
-            &format!("kr480 sum-of-norms {n} poses"),
+            &format!("kr480 {n} poses"),
             &nominal,
             &obs,
         );
