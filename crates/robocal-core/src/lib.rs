@@ -49,6 +49,7 @@ pub mod ranges;
 pub mod registration;
 pub mod simulation;
 pub mod stats;
+pub mod trig;
 pub mod unit;
 
 #[cfg(test)]

@@ -13,7 +13,7 @@
 
 pub mod conditions;
 pub mod poe;
-pub mod trig;
+pub use crate::trig;
 
 pub use conditions::Conditions;
 

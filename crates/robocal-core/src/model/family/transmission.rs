@@ -56,12 +56,12 @@ fn store_len(n: usize) -> usize {
 /// `(sin(h q), cos(h q))` for `h = 1..=count`, from one `sin_cos` by the angle-addition
 /// recurrence (a few ulps from the direct values for the few harmonics there are; the trigonometric
 /// functions were a fifth of a fit's time when each harmonic called its own), that one the
-/// forward kinematics' branch-free [`crate::kinematics::trig::sin_cos`] (the C library's was
+/// forward kinematics' branch-free [`crate::trig::sin_cos`] (the C library's was
 /// still 6% of the real UR5's calibration with harmonics).
 #[inline]
 fn harmonic_terms(q: f64, count: usize) -> [(f64, f64); MAX_HARMONICS] {
     let mut out = [(0.0, 0.0); MAX_HARMONICS];
-    let (s1, c1) = crate::kinematics::trig::sin_cos(q);
+    let (s1, c1) = crate::trig::sin_cos(q);
     let (mut s, mut c) = (s1, c1);
     for t in out.iter_mut().take(count) {
         *t = (s, c);
