@@ -151,12 +151,7 @@ fn bench(c: &mut Criterion) {
         let obs = data(&truth, n, 7);
         let mut g = c.benchmark_group("identification");
         g.sample_size(samples);
-        bench_calibrate(
-            &mut g,
-            &format!("kr480 {n} poses"),
-            &nominal,
-            &obs,
-        );
+        bench_calibrate(&mut g, &format!("kr480 {n} poses"), &nominal, &obs);
         g.finish();
     }
 }
