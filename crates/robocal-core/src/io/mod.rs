@@ -17,6 +17,7 @@ pub mod result_constraint;
 mod result_format;
 mod result_key_order;
 pub mod result_payload;
+pub mod result_plausibility;
 pub mod result_prediction;
 pub mod result_robot;
 pub mod result_sections;

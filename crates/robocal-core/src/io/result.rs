@@ -8,9 +8,10 @@ use crate::error::{Error, Result};
 use crate::frame::TrackerFrame;
 #[path = "result_checks.rs"]
 mod checks;
+use crate::io::result_plausibility::PlausibilitySection;
 use crate::io::result_sections::{
-    sorted_opt, DownweightedEntry, Identifiability, PlausibilitySection, Points, Registration,
-    Settings, Solver, Uncertainty,
+    sorted_opt, DownweightedEntry, Identifiability, Points, Registration, Settings, Solver,
+    Uncertainty,
 };
 use crate::model::{Param, Robot, Unit};
 use crate::stats::ErrorStats;

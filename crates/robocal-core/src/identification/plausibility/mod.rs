@@ -28,7 +28,7 @@ pub mod statistics;
 mod tests;
 
 use crate::identification::solver::SolverReport;
-use crate::io::result_sections::{CauseEntry, CheckEntry, PlausibilitySection};
+use crate::io::result_plausibility::{CauseEntry, CheckEntry, PlausibilitySection};
 use crate::model::family::plausible;
 use crate::model::{Param, Robot, Unit};
 use crate::observations::Observations;
