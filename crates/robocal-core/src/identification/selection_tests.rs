@@ -35,6 +35,16 @@ fn measure(
     obs
 }
 
+/// The paper's robot sagging under gravity (joints 2 and 3 compliant, its link masses and
+/// payload).
+fn paper_sag() -> GravityModel {
+    GravityModel::new(
+        vec![0.0, 2e-8, 2e-8, 0.0, 0.0, 0.0],
+        PAPER_LINK_MASSES_KG.to_vec(),
+        PAPER_PAYLOAD_KG,
+    )
+}
+
 fn auto() -> CalibrationSettings {
     CalibrationSettings {
         model: ModelChoice::Auto(AutoFamilies::default()),
@@ -77,11 +87,7 @@ fn geometric_errors_choose_the_geometric_model() {
 #[test]
 fn gravity_sag_chooses_compliance() {
     let truth = preset("kuka-kr480-r3330-table3").unwrap();
-    let sag = GravityModel::new(
-        vec![0.0, 2e-8, 2e-8, 0.0, 0.0, 0.0],
-        PAPER_LINK_MASSES_KG.to_vec(),
-        PAPER_PAYLOAD_KG,
-    );
+    let sag = paper_sag();
     for seed in [1, 2, 3] {
         let (families, c) = chosen(&truth, Some(&sag), seed);
         assert!(
@@ -166,11 +172,7 @@ fn the_one_step_cross_validation_matches_the_refits() {
     use crate::identification::cross_validation::{cross_validate, cross_validate_refit};
     use crate::model::family::compliance;
     let truth = preset("kuka-kr480-r3330-table3").unwrap();
-    let sag = GravityModel::new(
-        vec![0.0, 2e-8, 2e-8, 0.0, 0.0, 0.0],
-        PAPER_LINK_MASSES_KG.to_vec(),
-        PAPER_PAYLOAD_KG,
-    );
+    let sag = paper_sag();
     let nominal = preset("kuka-kr480-r3330").unwrap();
     let mut harmonic = nominal.clone();
     transmission::enable(&mut harmonic, &(0..6).collect::<Vec<_>>(), 1).unwrap();
@@ -229,11 +231,7 @@ fn shared_start_passes_and_fold_shares_give_the_candidates_own_fits() {
     use crate::identification::pipeline::{calibrate_model_for, Purpose, Shared};
     use crate::model::family::compliance;
     let truth = preset("kuka-kr480-r3330-table3").unwrap();
-    let sag = GravityModel::new(
-        vec![0.0, 2e-8, 2e-8, 0.0, 0.0, 0.0],
-        PAPER_LINK_MASSES_KG.to_vec(),
-        PAPER_PAYLOAD_KG,
-    );
+    let sag = paper_sag();
     let nominal = preset("kuka-kr480-r3330").unwrap();
     let mut widest = nominal.clone();
     compliance::enable(&mut widest, &compliance::auto_joints(&nominal), None).unwrap();
@@ -336,11 +334,7 @@ fn the_completed_candidate_is_the_chosen_models_own_calibration() {
     use crate::identification::model_choice::ModelChoice;
     use crate::identification::pipeline::calibrate_model;
     let truth = preset("kuka-kr480-r3330-table3").unwrap();
-    let sag = GravityModel::new(
-        vec![0.0, 2e-8, 2e-8, 0.0, 0.0, 0.0],
-        PAPER_LINK_MASSES_KG.to_vec(),
-        PAPER_PAYLOAD_KG,
-    );
+    let sag = paper_sag();
     let mut rng = ChaCha8Rng::seed_from_u64(4);
     let cal = measure(&truth, Some(&sag), 75, &mut rng);
     let val = measure(&truth, Some(&sag), 40, &mut rng);
