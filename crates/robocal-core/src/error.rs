@@ -143,6 +143,26 @@ impl Error {
             message: message.into(),
         }
     }
+
+    /// This error without its line, for an [`Error::Parse`] whose field names the place better
+    /// than a line of text the reader never saw (a robot built from a description, not a
+    /// file); other errors as they are.
+    pub fn without_line(self) -> Self {
+        match self {
+            Error::Parse {
+                path,
+                field,
+                message,
+                ..
+            } => Error::Parse {
+                path,
+                line: None,
+                field,
+                message,
+            },
+            other => other,
+        }
+    }
 }
 
 /// The library's result type.

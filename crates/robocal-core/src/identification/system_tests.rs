@@ -237,17 +237,7 @@ fn a_restricted_start_pass_is_the_subsets_own_and_the_solve_from_it_the_same() {
         .accumulate(&nominal, &Loss::Squared, Level::Full)
         .restricted(&cols);
     let own = small.accumulate(&nominal, &Loss::Squared, Level::Full);
-    let close = |a: &DMatrix<f64>, b: &DMatrix<f64>| (a - b).amax() <= 1e-12 * b.amax();
-    assert!(close(&restricted.a, &own.a));
-    assert!(close(
-        restricted.s.as_ref().unwrap(),
-        own.s.as_ref().unwrap()
-    ));
-    assert!(close(
-        restricted.h.as_ref().unwrap(),
-        own.h.as_ref().unwrap()
-    ));
-    assert!((&restricted.b - &own.b).amax() <= 1e-12 * own.b.amax());
+    assert_same_sums(&restricted, &own);
     assert_eq!(restricted.objective.to_bits(), own.objective.to_bits());
     use crate::identification::solver::{solve_keeping, SolverOptions};
     let opts = SolverOptions::default();
@@ -284,17 +274,8 @@ fn grouped_pass_case(nominal: &Robot, obs: &Observations, group: &[usize], loss:
         Problem::new(&nominal, &params, obs, &frame).accumulate(&nominal, &loss, Level::Full);
     let grouped_problem = Problem::new(&nominal, &params, obs, &frame).grouped(group, 3);
     let grouped = grouped_problem.accumulate(&nominal, &loss, Level::Full);
+    assert_same_sums(&grouped, &plain);
     let close = |a: &DMatrix<f64>, b: &DMatrix<f64>| (a - b).amax() <= 1e-12 * b.amax();
-    assert!(close(&grouped.a, &plain.a));
-    assert!(close(
-        grouped.s.as_ref().unwrap(),
-        plain.s.as_ref().unwrap()
-    ));
-    assert!(close(
-        grouped.h.as_ref().unwrap(),
-        plain.h.as_ref().unwrap()
-    ));
-    assert!((&grouped.b - &plain.b).amax() <= 1e-12 * plain.b.amax());
     assert!((grouped.objective - plain.objective).abs() <= 1e-12 * plain.objective);
     assert!(plain.groups.is_none());
     let shares = grouped.groups.expect("the groups' shares");
@@ -386,4 +367,13 @@ fn a_pass_within_the_least_squares_range_is_the_least_squares_pass() {
     }
     let beyond = p.accumulate(&nominal, &Loss::Adaptive { k: 0.5 * largest }, Level::Full);
     assert_ne!(beyond.a, squared.a);
+}
+
+/// Two full passes' sums `A`, `S`, `H` and `b` agree to 1e-12 of the largest entry.
+fn assert_same_sums(got: &Accumulated, want: &Accumulated) {
+    let close = |a: &DMatrix<f64>, b: &DMatrix<f64>| (a - b).amax() <= 1e-12 * b.amax();
+    assert!(close(&got.a, &want.a));
+    assert!(close(got.s.as_ref().unwrap(), want.s.as_ref().unwrap()));
+    assert!(close(got.h.as_ref().unwrap(), want.h.as_ref().unwrap()));
+    assert!((&got.b - &want.b).amax() <= 1e-12 * want.b.amax());
 }

@@ -535,15 +535,10 @@ mod tests {
     /// decimals files hold.
     #[test]
     fn plain_decimals_are_the_standard_parse() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x2545_f491);
         for _ in 0..100_000 {
-            let (r, decimals) = (next(), (next() % 16) as usize);
+            let (r, decimals) = (rng.gen::<u64>(), rng.gen_range(0..16usize));
             let v = (r % 10_000_000_000) as f64 / 1000.0 - 5e6;
             let s = format!("{v:.decimals$}");
             let want: f64 = s.parse().unwrap();

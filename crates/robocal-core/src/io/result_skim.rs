@@ -30,14 +30,18 @@ pub(super) fn skimming<R>(read: impl FnOnce() -> R) -> R {
     read()
 }
 
-fn skimmed<'de, D: Deserializer<'de>>(d: &mut Option<D>) -> std::result::Result<bool, D::Error> {
-    if !SKIMMING.with(Cell::get) {
-        return Ok(false);
-    }
-    if let Some(d) = d.take() {
+/// `d`'s value, or `skimmed` after checking it is JSON while [`skimming`].
+fn value_or<'de, D, T>(d: D, skimmed: T) -> std::result::Result<T, D::Error>
+where
+    D: Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    if SKIMMING.with(Cell::get) {
         IgnoredAny::deserialize(d)?;
+        Ok(skimmed)
+    } else {
+        T::deserialize(d)
     }
-    Ok(true)
 }
 
 /// `deserialize_with` for an optional per-point section: `None` when skimmed.
@@ -46,11 +50,7 @@ where
     D: Deserializer<'de>,
     T: Deserialize<'de>,
 {
-    let mut d = Some(d);
-    if skimmed(&mut d)? {
-        return Ok(None);
-    }
-    Option::<T>::deserialize(d.expect("not taken"))
+    value_or(d, None)
 }
 
 /// `deserialize_with` for a per-point list: empty when skimmed.
@@ -59,11 +59,7 @@ where
     D: Deserializer<'de>,
     T: Deserialize<'de>,
 {
-    let mut d = Some(d);
-    if skimmed(&mut d)? {
-        return Ok(Vec::new());
-    }
-    Vec::<T>::deserialize(d.expect("not taken"))
+    value_or(d, Vec::new())
 }
 
 /// What a reader of `prediction.map` would refuse and a skimmed read-back does not see: a

@@ -120,20 +120,7 @@ impl super::description::RobotDescription {
     /// limits ordered, prismatic joints with limits, an invertible controller map). Errors name
     /// `path` and the field as the robot file would (`joints[2].alpha`, `controller.sign`).
     pub fn to_robot(&self, path: &Path) -> Result<Robot> {
-        from_description(self, path).map_err(|e| match e {
-            Error::Parse {
-                path,
-                field,
-                message,
-                ..
-            } => Error::Parse {
-                path,
-                line: None,
-                field,
-                message,
-            },
-            other => other,
-        })
+        from_description(self, path).map_err(Error::without_line)
     }
 }
 

@@ -84,23 +84,8 @@ fn every_robot_round_trips_exactly_through_json_and_toml() {
 fn to_robot_is_the_robot_of_its_toml_text() {
     let path = Path::new("r.json");
     let via_text = |d: &RobotDescription| {
-        crate::model::robot_file::parse_robot_toml(&d.to_toml().unwrap(), path).map_err(|e| {
-            match e {
-                Error::Parse {
-                    path,
-                    field,
-                    message,
-                    ..
-                } => Error::Parse {
-                    path,
-                    line: None,
-                    field,
-                    message,
-                },
-                other => other,
-            }
-            .to_string()
-        })
+        crate::model::robot_file::parse_robot_toml(&d.to_toml().unwrap(), path)
+            .map_err(|e| e.without_line().to_string())
     };
     let direct = |d: &RobotDescription| d.to_robot(path).map_err(|e| e.to_string());
     for r in &all_robots() {
