@@ -261,7 +261,7 @@ impl<'a> Problem<'a> {
                     *j = i;
                 }
                 Some((j, pose)) => {
-                    **pose = robot.pose_frames_in(q, t, &self.obs.conditions(i));
+                    robot.pose_frames_in_into(q, t, &self.obs.conditions(i), pose);
                     *j = i;
                 }
                 None => {

@@ -26,20 +26,8 @@ impl Robot {
     /// (family `thermal`), the joints deflected knowing its approach directions (family
     /// `backlash`). `rigid.conditions` holds `c`.
     pub fn pose_frames_in(&self, q: &[f64], t: usize, c: &Conditions) -> PoseFrames {
-        if c.is_unknown() {
-            return self.pose_frames_target(q, t);
-        }
-        let r = self.at_temperature(c);
-        let r = r.as_ref();
-        let mut rigid = r.rigid_for_families(q);
-        rigid.conditions = *c;
-        let mut ch = if r.deflects_joints() {
-            let mut buf = [0.0; MAX_JOINTS];
-            r.rigid_pose_frames(r.deflect_with(&rigid, q, &mut buf), t)
-        } else {
-            r.rigid_pose_frames(q, t)
-        };
-        ch.rigid = rigid;
+        let mut ch = PoseFrames::identity();
+        self.pose_frames_in_into(q, t, c, &mut ch);
         ch
     }
 
@@ -102,7 +90,17 @@ impl Robot {
         if c.is_unknown() {
             return self.pose_frames_target_into(q, t, out);
         }
-        *out = self.pose_frames_in(q, t, c);
+        let r = self.at_temperature(c);
+        let r = r.as_ref();
+        let mut rigid = r.rigid_for_families(q);
+        rigid.conditions = *c;
+        if r.deflects_joints() {
+            let mut buf = [0.0; MAX_JOINTS];
+            r.rigid_pose_frames_into(r.deflect_with(&rigid, q, &mut buf), t, out);
+        } else {
+            r.rigid_pose_frames_into(q, t, out);
+        }
+        out.rigid = rigid;
     }
 
     /// Scales the columns of the lengths thermal growth scales (each link's `d` and `a`) by the

@@ -123,13 +123,8 @@ impl Robot {
 
     /// [`Robot::pose_frames`] with the point of target `t` (0-based) as the tool point.
     pub fn pose_frames_target(&self, q: &[f64], t: usize) -> PoseFrames {
-        if !self.deflects_joints() {
-            return self.rigid_pose_frames(q, t);
-        }
-        let rigid = self.rigid_for_families(q);
-        let mut buf = [0.0; MAX_JOINTS];
-        let mut ch = self.rigid_pose_frames(self.deflect_with(&rigid, q, &mut buf), t);
-        ch.rigid = rigid;
+        let mut ch = PoseFrames::identity();
+        self.pose_frames_target_into(q, t, &mut ch);
         ch
     }
 
@@ -166,7 +161,10 @@ impl Robot {
         if !self.deflects_joints() {
             return self.rigid_pose_frames_into(q, t, out);
         }
-        *out = self.pose_frames_target(q, t);
+        let rigid = self.rigid_for_families(q);
+        let mut buf = [0.0; MAX_JOINTS];
+        self.rigid_pose_frames_into(self.deflect_with(&rigid, q, &mut buf), t, out);
+        out.rigid = rigid;
     }
 
     /// What the families' deflections read at the commanded joints `q`: the rigid forward pass

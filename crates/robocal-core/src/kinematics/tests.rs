@@ -379,3 +379,51 @@ fn jacobians_match_finite_differences_with_prismatic_joints() {
         }
     }
 }
+
+/// A forward pass written over an earlier one (the reused buffers of the Jacobian passes) equals
+/// a fresh one, for the families that deflect the joints and under known and unknown conditions.
+#[test]
+fn a_pass_written_in_place_equals_a_fresh_one() {
+    use crate::model::family::{backlash, compliance, thermal, transmission, PoseFrames};
+    use crate::model::Conditions;
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    let mut r = preset("kuka-kr480-r3330").unwrap();
+    let t0 = *r.tool0();
+    r.set_target_tools(&[t0, [50.0, 0.0, 20.0, 0.0, 0.0, 0.0]])
+        .unwrap();
+    compliance::enable(&mut r, &[1, 2], Some(300.0)).unwrap();
+    transmission::enable(&mut r, &[0, 1, 2, 3, 4, 5], 2).unwrap();
+    backlash::enable(&mut r, &[0, 1, 2]).unwrap();
+    thermal::enable(&mut r, 20.0).unwrap();
+    // Every family parameter away from zero, so each deflects the pass.
+    for p in r.param_list().to_vec() {
+        if p.family_id() != crate::model::family::link::ID && r.get(p) == 0.0 {
+            r.set(p, rng.gen_range(1e-4..1e-3));
+        }
+    }
+    let known = Conditions {
+        temperature_c: 27.5,
+        dir: [1, -1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0],
+    };
+    for (c0, c1) in [
+        (Conditions::UNKNOWN, Conditions::UNKNOWN),
+        (known, Conditions::UNKNOWN),
+        (Conditions::UNKNOWN, known),
+    ] {
+        let (q0, q1) = (random_q(&mut rng, 6), random_q(&mut rng, 6));
+        let fresh = r.pose_frames_in(&q1, 1, &c1);
+        let mut reused: PoseFrames = r.pose_frames_in(&q0, 0, &c0);
+        r.pose_frames_in_into(&q1, 1, &c1, &mut reused);
+        assert_eq!(reused.flange, fresh.flange);
+        assert_eq!(reused.point, fresh.point);
+        assert_eq!(reused.target, fresh.target);
+        assert_eq!(reused.axis[..6], fresh.axis[..6]);
+        assert_eq!(reused.link[..6], fresh.link[..6]);
+        assert_eq!(reused.rigid.commanded, fresh.rigid.commanded);
+        assert_eq!(reused.rigid.axes, fresh.rigid.axes);
+        assert_eq!(reused.rigid.point, fresh.rigid.point);
+        assert!(reused.rigid.conditions.same(&fresh.rigid.conditions));
+        // The deflection moved the pass away from the rigid one.
+        assert_ne!(fresh.point, r.geometric().target_position(&q1, 1));
+    }
+}
