@@ -126,31 +126,11 @@ pub fn vec_rad_to_deg(v: &[f64; 6]) -> [f64; 6] {
 /// `[z, Rz(A) y, Rz(A) Ry(B) x]`. Used for the analytic derivatives of `pose(v)` with respect to A,
 /// B and C.
 pub(crate) fn euler_axes(a: f64, b: f64) -> [Vector3<f64>; 3] {
-    // The Jacobian passes ask for the same base (or tool) angles at every point: the last two
-    // answers of this thread are kept, each two sines and cosines saved (the same bits: a
-    // function of the angles' bits alone).
-    type Axes = [Vector3<f64>; 3];
-    thread_local! {
-        static LAST: std::cell::Cell<[Option<(u64, u64, Axes)>; 2]> =
-            const { std::cell::Cell::new([None, None]) };
-    }
-    let key = (a.to_bits(), b.to_bits());
-    let compute = || {
-        let rz = rot_z(a);
-        let rzy = rz * rot_y(b);
-        [Vector3::z(), rz.column(1).into(), rzy.column(0).into()]
-    };
-    LAST.try_with(|last| {
-        let mut l = last.get();
-        if let Some(axes) = l.iter().flatten().find(|e| (e.0, e.1) == key).map(|e| e.2) {
-            return axes;
-        }
-        let axes: Axes = compute();
-        l = [Some((key.0, key.1, axes)), l[0]];
-        last.set(l);
-        axes
-    })
-    .unwrap_or_else(|_| compute())
+    // The robot keeps those of its base and of each target with their frames (`Robot::
+    // base_euler_axes`, `Robot::target_euler_axes`): the Jacobian passes read them there.
+    let rz = rot_z(a);
+    let rzy = rz * rot_y(b);
+    [Vector3::z(), rz.column(1).into(), rzy.column(0).into()]
 }
 
 /// The pose of the laser tracker's frame in the robot's base frame (the paper's measurement frame

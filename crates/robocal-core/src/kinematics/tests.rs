@@ -427,3 +427,42 @@ fn a_pass_written_in_place_equals_a_fresh_one() {
         assert_ne!(fresh.point, r.geometric().target_position(&q1, 1));
     }
 }
+
+/// The base's and each target's Euler axes the robot keeps with their frames follow every change
+/// of the angles: by parameter, by a new set of target tools, and for a further target.
+#[test]
+fn the_kept_euler_axes_follow_the_angles() {
+    use crate::frame::euler_axes;
+    let mut r = preset("kuka-kr480-r3330").unwrap();
+    let t0 = *r.tool0();
+    r.set_target_tools(&[t0, [50.0, 0.0, 20.0, 0.3, -0.2, 0.1]])
+        .unwrap();
+    let check = |r: &Robot| {
+        let b = r.base();
+        assert_eq!(*r.base_euler_axes(), euler_axes(b[3], b[4]));
+        for t in 0..r.target_count() {
+            let (n, c) = (r.target_tool0(t), r.target_tool_correction(t));
+            assert_eq!(
+                *r.target_euler_axes(t),
+                euler_axes(n[3] + c[3], n[4] + c[4]),
+                "target {t}"
+            );
+        }
+    };
+    check(&r);
+    r.set(Param::base(3), 0.4);
+    r.set(Param::base(4), -0.3);
+    r.set(Param::tool(4), 0.05);
+    for name in ["tool2_a", "tool2_b"] {
+        let p = r.param_by_name(name).unwrap();
+        r.set(p, 0.02);
+    }
+    check(&r);
+    r.set_target_tools(&[
+        [1.0, 2.0, 300.0, 0.2, 0.1, 0.0],
+        [0.0, 50.0, 20.0, -0.1, 0.4, 0.0],
+    ])
+    .unwrap();
+    check(&r);
+    assert_ne!(r.target_euler_axes(0), r.target_euler_axes(1));
+}

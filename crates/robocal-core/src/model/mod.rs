@@ -123,6 +123,10 @@ pub struct Robot {
     link_rx: Vec<Option<[f64; 3]>>,
     base_frame: Frame,
     tool_frame: Frame,
+    /// The Euler axes of the base's angles and of the tool's (`T0 + T`), [`frame::euler_axes`]:
+    /// the base and tool families' angular columns at every point of a Jacobian pass.
+    base_axes: [Vector3<f64>; 3],
+    tool_axes: [Vector3<f64>; 3],
     /// Every parameter, in model order (ascending `Param` order).
     param_list: Vec<Param>,
     /// Per family with parameters on this robot: its id and its range in `param_list`.
@@ -196,6 +200,8 @@ impl Robot {
             link_rx: Vec::new(),
             base_frame: Frame::identity(),
             tool_frame: Frame::identity(),
+            base_axes: [Vector3::zeros(); 3],
+            tool_axes: [Vector3::zeros(); 3],
             param_list: Vec::new(),
             family_spans: Vec::new(),
             deflects: false,
@@ -207,9 +213,15 @@ impl Robot {
     fn refresh(&mut self) {
         self.link_const = self.links.iter().map(link_constant).collect();
         self.link_rx = self.links.iter().map(link_rx).collect();
-        self.base_frame = frame::pose(&self.base);
+        self.refresh_base();
         self.refresh_tool();
         self.refresh_params();
+    }
+
+    /// Recomputes the base frame and its Euler axes after B changed.
+    pub(crate) fn refresh_base(&mut self) {
+        self.base_frame = frame::pose(&self.base);
+        self.base_axes = frame::euler_axes(self.base[3], self.base[4]);
     }
 
     /// Recomputes link `i`'s constant part after one of its parameters changed.
@@ -225,6 +237,7 @@ impl Robot {
             *v += self.tool[k];
         }
         self.tool_frame = frame::pose(&t);
+        self.tool_axes = frame::euler_axes(t[3], t[4]);
     }
 
     /// Rebuilds the parameter list after the set of parameters changed (a tilt enabled, a

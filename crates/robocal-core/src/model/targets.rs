@@ -7,6 +7,7 @@
 use super::Robot;
 use crate::error::{Error, Result};
 use crate::frame::{self, Frame};
+use nalgebra::Vector3;
 
 /// A target beyond the first: its nominal tool vector, its correction and the cached frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -14,6 +15,8 @@ pub(crate) struct TargetTool {
     pub nominal: [f64; 6],
     pub correction: [f64; 6],
     pub frame: Frame,
+    /// The Euler axes of its angles ([`frame::euler_axes`]).
+    pub axes: [Vector3<f64>; 3],
 }
 
 impl TargetTool {
@@ -22,6 +25,7 @@ impl TargetTool {
             nominal,
             correction: [0.0; 6],
             frame: Frame::identity(),
+            axes: [Vector3::zeros(); 3],
         };
         t.refresh();
         t
@@ -33,6 +37,7 @@ impl TargetTool {
             *x += c;
         }
         self.frame = frame::pose(&v);
+        self.axes = frame::euler_axes(v[3], v[4]);
     }
 }
 
@@ -104,6 +109,22 @@ impl Robot {
             0 => &self.tool_frame,
             _ => &self.targets[t - 1].frame,
         }
+    }
+
+    /// The Euler axes of target `t`'s tool angles (`T0_t + T_t`, 0-based), about which its
+    /// angular corrections turn it ([`frame::euler_axes`]); kept with its frame.
+    #[inline]
+    pub(crate) fn target_euler_axes(&self, t: usize) -> &[Vector3<f64>; 3] {
+        match t {
+            0 => &self.tool_axes,
+            _ => &self.targets[t - 1].axes,
+        }
+    }
+
+    /// The Euler axes of the base's angles (see [`Robot::target_euler_axes`]).
+    #[inline]
+    pub(crate) fn base_euler_axes(&self) -> &[Vector3<f64>; 3] {
+        &self.base_axes
     }
 
     /// Sets component `k` of the correction of target `t >= 1` (internal units).

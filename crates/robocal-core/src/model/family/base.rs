@@ -1,7 +1,6 @@
 //! The base frame vector `base_{axis}` (B, paper eq. 7): the pose of the robot's base in the ACS.
 
 use super::{priority, put, FamilyId, ParameterFamily, PoseFrames};
-use crate::frame::{self, euler_axes};
 use crate::model::{Param, Robot, Unit};
 use nalgebra::Vector3;
 
@@ -43,7 +42,7 @@ impl ParameterFamily for Base {
 
     fn set(&self, robot: &mut Robot, p: Param, value: f64) {
         robot.base[p.index()] = value;
-        robot.base_frame = frame::pose(&robot.base);
+        robot.refresh_base();
     }
 
     fn priority(&self, _robot: &Robot, p: Param) -> u32 {
@@ -65,8 +64,8 @@ impl ParameterFamily for Base {
             put(&mut dw, e, Vector3::zeros());
         }
         let o = Vector3::new(b[0], b[1], b[2]);
-        for (e, ax) in euler_axes(b[3], b[4]).into_iter().enumerate() {
-            let (v, w) = pose.rotation_screw(ax, o);
+        for (e, ax) in robot.base_euler_axes().iter().enumerate() {
+            let (v, w) = pose.rotation_screw(*ax, o);
             dp[3 + e] = v;
             put(&mut dw, 3 + e, w);
         }

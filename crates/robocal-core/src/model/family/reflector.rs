@@ -5,7 +5,6 @@
 //! orientation turns its frame about its point, which only a 6-DoF measurement sees.
 
 use super::{priority, put, FamilyId, ParameterFamily, PoseFrames};
-use crate::frame::euler_axes;
 use crate::model::{Param, Robot, Unit};
 use nalgebra::Vector3;
 
@@ -93,12 +92,7 @@ impl ParameterFamily for Reflector {
             dp[col(e)] = rn.column(e).into();
         }
         if dw.is_some() {
-            let t0 = robot.target_tool0(t);
-            let tc = robot.target_tool_correction(t);
-            for (e, ax) in euler_axes(t0[3] + tc[3], t0[4] + tc[4])
-                .into_iter()
-                .enumerate()
-            {
+            for (e, ax) in robot.target_euler_axes(t).iter().enumerate() {
                 put(&mut dw, col(3 + e), rn * ax);
             }
         }

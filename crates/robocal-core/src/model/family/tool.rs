@@ -2,7 +2,6 @@
 //! Its orientation turns the tool frame about the tool point: a point measurement cannot see it.
 
 use super::{priority, put, FamilyId, ParameterFamily, PoseFrames};
-use crate::frame::euler_axes;
 use crate::model::{Param, Robot, Unit};
 use nalgebra::Vector3;
 
@@ -80,12 +79,7 @@ impl ParameterFamily for Tool {
             dp[3 + e] = Vector3::zeros();
         }
         if dw.is_some() {
-            let t0 = robot.tool0();
-            let t = robot.tool_correction();
-            for (e, ax) in euler_axes(t0[3] + t[3], t0[4] + t[4])
-                .into_iter()
-                .enumerate()
-            {
+            for (e, ax) in robot.target_euler_axes(0).iter().enumerate() {
                 put(&mut dw, 3 + e, rn * ax);
             }
         }
