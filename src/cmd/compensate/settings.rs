@@ -77,17 +77,15 @@ fn solvers(a: &CompensateArgs) -> anyhow::Result<(DampedLeastSquares, PoseNewton
         max_iterations: a.max_iterations,
         ..DampedLeastSquares::default()
     };
-    solver
-        .validate()
-        .map_err(|e| exit::usage(flags::cli_text(&e)))?;
     let pose_solver = PoseNewton {
         tolerance_mm: a.tolerance_mm,
         tolerance_deg: a.tolerance_deg,
         max_iterations: a.max_iterations,
         ..PoseNewton::default()
     };
-    pose_solver
+    solver
         .validate()
+        .and_then(|()| pose_solver.validate())
         .map_err(|e| exit::usage(flags::cli_text(&e)))?;
     limits::magnitude("--tolerance-deg", a.tolerance_deg, 3600.0, "deg")?;
     limits::count(
