@@ -4,7 +4,8 @@
 //!
 //! What is read: every `{...}` outside comments (`;` to the end of the line) and strings, with an
 //! optional type prefix (`{E6POS: X 1, ...}`), members `NAME value` separated by commas, values
-//! numbers, words or nested aggregates (`LOAD_DATA[1]={M 5,CM {X 0,...},J {...}}`). An aggregate
+//! numbers, words or nested aggregates (`LOAD_DATA[1]={M 5,CM {X 0,...},J {...}}`; the syntax is
+//! read by the module `krl_aggregate`, shared with the frames and the motion census). An aggregate
 //! is a target when it is declared or prefixed as one of the target types, or has a member of one
 //! (`A1..A6`, `X, Y, Z, A, B, C`), and holds all six of its kind. Such an aggregate is checked
 //! whole, and an error names its line and member: not closed on its line, a nested aggregate, a
@@ -17,6 +18,7 @@
 //! unchanged"). A hand-written parser: KRL has no maintained Rust parser, and this is all robocal
 //! needs of it.
 
+pub(crate) use super::krl_aggregate::{parse_aggregate, Aggregate};
 use super::lex::{line_end, past_string};
 use super::{Field, ProgramTarget, TargetKind};
 use crate::error::{Error, Result};
@@ -36,169 +38,6 @@ const TYPES: [(&str, TargetKind); 5] = [
     ("E6AXIS", TargetKind::Joints),
     ("AXIS", TargetKind::Joints),
 ];
-/// Deepest nesting of aggregates read.
-const MAX_DEPTH: usize = 8;
-
-/// A member's value.
-#[derive(Debug, Clone)]
-pub(crate) enum Value {
-    /// A number, word or string: its trimmed span.
-    Scalar(Range<usize>),
-    /// A nested aggregate.
-    Nested,
-}
-
-/// One member `NAME value` of an aggregate.
-#[derive(Debug, Clone)]
-pub(crate) struct Member {
-    /// Its name, upper case.
-    pub name: String,
-    /// Its value.
-    pub value: Value,
-}
-
-impl Member {
-    /// The span of a scalar value.
-    pub fn value_span(&self) -> Option<Range<usize>> {
-        match &self.value {
-            Value::Scalar(r) => Some(r.clone()),
-            Value::Nested => None,
-        }
-    }
-}
-
-/// A KRL aggregate `{[TYPE:] NAME value, ...}`.
-#[derive(Debug, Clone)]
-pub(crate) struct Aggregate {
-    /// The byte of its `}`.
-    pub close: usize,
-    /// Its type prefix, upper case.
-    pub prefix: Option<String>,
-    /// Its members, in order.
-    pub members: Vec<Member>,
-}
-
-impl Aggregate {
-    /// The member named `name` (upper case).
-    pub fn member(&self, name: &str) -> Option<&Member> {
-        self.members.iter().find(|m| m.name == name)
-    }
-}
-
-fn skip_blank(b: &[u8], mut i: usize) -> usize {
-    while i < b.len() && (b[i] == b' ' || b[i] == b'\t') {
-        i += 1;
-    }
-    i
-}
-
-fn is_word(c: u8) -> bool {
-    c.is_ascii_alphanumeric() || c == b'_' || c == b'$'
-}
-
-/// Reads the aggregate whose `{` is at `open` (on `line`). An aggregate not closed on its line,
-/// or a member without a name or value, is an error.
-pub(crate) fn parse_aggregate(
-    path: &Path,
-    text: &str,
-    open: usize,
-    line: usize,
-) -> Result<Aggregate> {
-    nested(path, text, open, line, 0)
-}
-
-fn nested(path: &Path, text: &str, open: usize, line: usize, depth: usize) -> Result<Aggregate> {
-    let b = text.as_bytes();
-    let err = |field: Option<&str>, msg: &str| Error::parse(path, Some(line), field, msg);
-    let unclosed = || {
-        err(
-            None,
-            "an aggregate `{` that is not closed by `}` on its line",
-        )
-    };
-    if depth > MAX_DEPTH {
-        return Err(err(None, "aggregates nested too deep"));
-    }
-    let mut i = skip_blank(b, open + 1);
-    let mut prefix = None;
-    // An optional type prefix `E6POS:`.
-    let w = (i..b.len()).find(|&k| !is_word(b[k])).unwrap_or(b.len());
-    let after = skip_blank(b, w);
-    if w > i && b.get(after) == Some(&b':') {
-        prefix = Some(text[i..w].to_ascii_uppercase());
-        i = skip_blank(b, after + 1);
-    }
-    let mut members = Vec::new();
-    if b.get(i) == Some(&b'}') {
-        return Ok(Aggregate {
-            close: i,
-            prefix,
-            members,
-        });
-    }
-    loop {
-        i = skip_blank(b, i);
-        let s = i;
-        while i < b.len()
-            && !matches!(
-                b[i],
-                b' ' | b'\t' | b',' | b'}' | b'{' | b'\n' | b'\r' | b';'
-            )
-        {
-            i += 1;
-        }
-        if i == s {
-            return Err(match b.get(i) {
-                None | Some(b'\n' | b'\r' | b';') => unclosed(),
-                _ => err(None, "an aggregate member without a name"),
-            });
-        }
-        let name = text[s..i].to_ascii_uppercase();
-        i = skip_blank(b, i);
-        let value = match b.get(i) {
-            Some(b'{') => {
-                let n = nested(path, text, i, line, depth + 1)?;
-                i = n.close + 1;
-                Value::Nested
-            }
-            _ => {
-                let vs = i;
-                while i < b.len() && !matches!(b[i], b',' | b'}' | b'{' | b'\n' | b';') {
-                    if b[i] == b'"' {
-                        i = past_string(b, i).min(b.len());
-                        continue;
-                    }
-                    i += 1;
-                }
-                let mut ve = i.min(b.len());
-                while ve > vs && b[ve - 1].is_ascii_whitespace() {
-                    ve -= 1;
-                }
-                if ve == vs {
-                    if matches!(b.get(i), None | Some(b'\n' | b';')) {
-                        return Err(unclosed());
-                    }
-                    return Err(err(Some(&name), "a member without a value"));
-                }
-                Value::Scalar(vs..ve)
-            }
-        };
-        members.push(Member { name, value });
-        i = skip_blank(b, i);
-        match b.get(i) {
-            Some(b',') => i += 1,
-            Some(b'}') => {
-                return Ok(Aggregate {
-                    close: i,
-                    prefix,
-                    members,
-                })
-            }
-            Some(b'{') => return Err(err(None, "a nested aggregate `{` where a member belongs")),
-            _ => return Err(unclosed()),
-        }
-    }
-}
 
 /// Finds the targets of a KRL file's text, in file order. A target (see the module
 /// documentation) that is malformed is an error naming its line and member.
@@ -369,20 +208,11 @@ fn check(
             return Err(err(n, format!("`{n}` is not a member of {what}")));
         }
         if int_field {
-            let (max, desc) = if n == "T" {
-                (63, "turn `T` (one bit per axis: 0..63)")
-            } else {
-                (7, "status `S` (3 bits: 0..7)")
-            };
-            let v = parse_krl_int(raw)
-                .ok_or_else(|| err(n, format!("`{raw}` is not an integer ({desc})")))?;
-            if !(0..=max).contains(&v) {
-                return Err(err(n, format!("{desc}: {v} is outside 0..{max}")));
-            }
+            let v = int_member(n, raw).map_err(|m| err(n, m))?;
             if n == "T" {
-                turn = Some((v as u32, span));
+                turn = Some((v, span));
             } else {
-                status = Some(v as u32);
+                status = Some(v);
             }
             continue;
         }
@@ -407,6 +237,21 @@ fn check(
         return Ok(None);
     }
     Ok(Some((values.into_iter().flatten().collect(), turn, status)))
+}
+
+/// The value of the status `S` or the turn `T` (member `n`) written `raw`, or what is wrong
+/// with it.
+fn int_member(n: &str, raw: &str) -> std::result::Result<u32, String> {
+    let (max, desc) = if n == "T" {
+        (63, "turn `T` (one bit per axis: 0..63)")
+    } else {
+        (7, "status `S` (3 bits: 0..7)")
+    };
+    let v = parse_krl_int(raw).ok_or_else(|| format!("`{raw}` is not an integer ({desc})"))?;
+    if !(0..=max).contains(&v) {
+        return Err(format!("{desc}: {v} is outside 0..{max}"));
+    }
+    Ok(v as u32)
 }
 
 /// The tool frame of a KRL pose `X, Y, Z` (mm), `A, B, C` (deg).

@@ -47,6 +47,7 @@ mod compensate;
 pub mod digits;
 pub mod frames;
 pub mod krl;
+mod krl_aggregate;
 mod lex;
 pub mod rapid;
 pub mod seed;
