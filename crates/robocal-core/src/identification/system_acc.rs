@@ -212,13 +212,14 @@ pub(crate) fn add_gram(m: &mut [f64], jr: &[f64], rows: usize, k: usize, scale: 
 
 /// Fills the lower triangle of a k x k row-major upper-triangular accumulator.
 pub(super) fn symmetric(k: usize, upper: &[f64]) -> DMatrix<f64> {
-    DMatrix::from_fn(k, k, |r, c| {
-        if r <= c {
-            upper[r * k + c]
-        } else {
-            upper[c * k + r]
-        }
-    })
+    // Column c (column-major): rows 0..=c are row r's entry c of the upper triangle (a stride
+    // of k), rows below are row c's own entries past the diagonal (contiguous).
+    let mut m = Vec::with_capacity(k * k);
+    for c in 0..k {
+        m.extend((0..=c).map(|r| upper[r * k + c]));
+        m.extend_from_slice(&upper[c * k + c + 1..(c + 1) * k]);
+    }
+    DMatrix::from_vec(k, k, m)
 }
 
 impl Problem<'_> {
@@ -293,6 +294,27 @@ impl Problem<'_> {
             rows: self.rows(),
             groups,
             norms: keep.then_some(norms),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::symmetric;
+
+    /// The column copies fill every entry from the upper triangle, mirrored below it.
+    #[test]
+    fn symmetric_mirrors_the_upper_triangle() {
+        for k in [1, 2, 5, 38] {
+            // Distinct values everywhere, the lower triangle's never read.
+            let upper: Vec<f64> = (0..k * k).map(|i| i as f64 + 0.5).collect();
+            let m = symmetric(k, &upper);
+            for r in 0..k {
+                for c in 0..k {
+                    let (a, b) = if r <= c { (r, c) } else { (c, r) };
+                    assert_eq!(m[(r, c)], upper[a * k + b], "k {k}, ({r}, {c})");
+                }
+            }
         }
     }
 }
