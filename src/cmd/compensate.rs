@@ -152,23 +152,21 @@ pub fn run(a: CompensateArgs) -> anyhow::Result<()> {
         tally: &mut tally,
         pb: &pb,
     };
-    let (input, full_pose, writer) = if let Some(path) = &joints_path {
-        let full_pose = !position_only;
-        (path, full_pose, rows.desired_joints(path, full_pose)?)
+    let (input, compensated) = if let Some(path) = &joints_path {
+        (path, rows.compensate_desired_joints(path, !position_only)?)
     } else {
         let path = targets
             .as_ref()
             .expect("clap requires --joints or --targets");
-        let (full_pose, w) = rows.targets(path, position_only)?;
-        (path, full_pose, w)
+        (path, rows.compensate_targets(path, position_only)?)
     };
     pb.finish_and_clear();
     // With --strict the writer is dropped on a failure: nothing is written.
     summary::failures(&tally, strict, input, &out)?;
-    writer.commit()?;
+    compensated.writer.commit()?;
     summary::print_summary(
         joints_path.is_some(),
-        full_pose,
+        compensated.full_pose,
         &params,
         (tolerance_mm, tolerance_deg),
         &out,

@@ -126,8 +126,8 @@ pub fn vec_rad_to_deg(v: &[f64; 6]) -> [f64; 6] {
 /// `[z, Rz(A) y, Rz(A) Ry(B) x]`. Used for the analytic derivatives of `pose(v)` with respect to A,
 /// B and C.
 pub(crate) fn euler_axes(a: f64, b: f64) -> [Vector3<f64>; 3] {
-    // The robot keeps those of its base and of each target with their frames (`Robot::
-    // base_euler_axes`, `Robot::target_euler_axes`): the Jacobian passes read them there.
+    // The robot keeps those of its base and of each target with their frames
+    // (`Robot::base_euler_axes`, `Robot::target_euler_axes`): the Jacobian passes read them there.
     let rz = rot_z(a);
     let rzy = rz * rot_y(b);
     [Vector3::z(), rz.column(1).into(), rzy.column(0).into()]

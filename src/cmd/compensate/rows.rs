@@ -12,6 +12,13 @@ use robocal_core::io::{MeasurementReader, Positions};
 use robocal_core::{Compensator, Robot};
 use std::path::Path;
 
+/// A file's rows compensated: the commanded joints written (for the caller to commit) and
+/// whether they were solved as full poses (else positions).
+pub(super) struct Compensated {
+    pub(super) full_pose: bool,
+    pub(super) writer: CommandedWriter,
+}
+
 /// What every row is solved with, where it is written, and what is gathered.
 pub(super) struct Rows<'a> {
     /// The nominal model: the desired joints' targets, and the joint units.
@@ -32,11 +39,11 @@ impl Rows<'_> {
     /// The desired joint vectors of `path` (`--joints`), each solved for its nominal tool pose
     /// (`full_pose`) or position from its own joints; a row outside the joint limits is solved
     /// and listed in a warning.
-    pub(super) fn desired_joints(
+    pub(super) fn compensate_desired_joints(
         &mut self,
         path: &Path,
         full_pose: bool,
-    ) -> anyhow::Result<CommandedWriter> {
+    ) -> anyhow::Result<Compensated> {
         let joints = self.nominal.joint_space();
         let dof = self.nominal.dof();
         let context = || format!("--joints {}", path.display());
@@ -81,7 +88,10 @@ impl Rows<'_> {
                 outside.text()
             )?;
         }
-        Ok(w)
+        Ok(Compensated {
+            full_pose,
+            writer: w,
+        })
     }
 
     /// The output started: its header, with or without the desired joints, position-only or
@@ -128,13 +138,12 @@ impl Rows<'_> {
     }
 
     /// The Cartesian targets of `path` (`--targets`), each solved for its pose, or its position
-    /// with `position_only` or when the file has no orientations (said in a note); whether
-    /// they were solved as full poses.
-    pub(super) fn targets(
+    /// with `position_only` or when the file has no orientations (said in a note).
+    pub(super) fn compensate_targets(
         &mut self,
         path: &Path,
         position_only: bool,
-    ) -> anyhow::Result<(bool, CommandedWriter)> {
+    ) -> anyhow::Result<Compensated> {
         let joints = self.nominal.joint_space();
         let mut full_pose = !position_only;
         let set =
@@ -165,7 +174,10 @@ impl Rows<'_> {
             w.write(&c, None, &conditions::with_directions(&t.extra, added))?;
             self.tally.tick(self.pb);
         }
-        Ok((full_pose, w))
+        Ok(Compensated {
+            full_pose,
+            writer: w,
+        })
     }
 
     /// The compensation of the target `t`: the commanded joints (in `q`) that reach its pose

@@ -466,3 +466,34 @@ fn the_kept_euler_axes_follow_the_angles() {
     check(&r);
     assert_ne!(r.target_euler_axes(0), r.target_euler_axes(1));
 }
+
+/// The per-thread buffer of the Jacobian passes serves robots of any size: a rigid 6-joint
+/// robot's columns after a deflecting 7-joint robot's pass (which leaves a seventh frame and a
+/// `rigid` the smaller robot does not write) equal those from a fresh pass, to the bit.
+#[test]
+fn the_shared_pass_buffer_serves_robots_of_any_size() {
+    use crate::model::family::compliance;
+    let mut rng = ChaCha8Rng::seed_from_u64(47);
+    let mut big = random_robot(&mut rng, Convention::Mdh, 7, true);
+    compliance::enable(&mut big, &[1, 2, 4], Some(10.0)).unwrap();
+    for p in big.param_list().to_vec() {
+        if p.family_id() == compliance::ID {
+            big.set(p, rng.gen_range(1e-4..1e-3));
+        }
+    }
+    assert!(big.deflects_joints());
+    let small = preset("kuka-kr480-r3330").unwrap();
+    assert!(!small.deflects_joints());
+    let (q7, q6) = (random_q(&mut rng, 7), random_q(&mut rng, 6));
+    let n = small.param_count();
+    let fresh = small.pose_frames_target(&q6, 0);
+    let (mut jp_fresh, mut jw_fresh) = (vec![Vector3::zeros(); n], vec![Vector3::zeros(); n]);
+    let p_fresh = small.screws_at(&fresh, None, Some(&mut jp_fresh), Some(&mut jw_fresh));
+    let mut jp_big = vec![Vector3::zeros(); big.param_count()];
+    big.target_screws(&q7, 0, None, Some(&mut jp_big), None);
+    let (mut jp, mut jw) = (vec![Vector3::zeros(); n], vec![Vector3::zeros(); n]);
+    let p = small.target_screws(&q6, 0, None, Some(&mut jp), Some(&mut jw));
+    assert_eq!(p, p_fresh);
+    assert_eq!(jp, jp_fresh);
+    assert_eq!(jw, jw_fresh);
+}

@@ -219,7 +219,7 @@ impl Robot {
     }
 
     /// Recomputes the base frame and its Euler axes after B changed.
-    pub(crate) fn refresh_base(&mut self) {
+    fn refresh_base(&mut self) {
         self.base_frame = frame::pose(&self.base);
         self.base_axes = frame::euler_axes(self.base[3], self.base[4]);
     }
@@ -230,7 +230,7 @@ impl Robot {
         self.link_rx[i] = link_rx(&self.links[i]);
     }
 
-    /// Recomputes the tool frame after T changed.
+    /// Recomputes the tool frame and its Euler axes after T0 or T changed.
     fn refresh_tool(&mut self) {
         let mut t = self.tool0;
         for (k, v) in t.iter_mut().enumerate() {
@@ -409,6 +409,19 @@ impl Robot {
     /// The base frame `pose(B)`.
     pub fn base_frame(&self) -> &Frame {
         &self.base_frame
+    }
+
+    /// The Euler axes of the base's angles ([`frame::euler_axes`]), kept with the base frame:
+    /// the base family's angular columns turn about them.
+    #[inline]
+    pub(crate) fn base_euler_axes(&self) -> &[Vector3<f64>; 3] {
+        // Every mutator of the base refreshes them (`refresh_base`); a debug build checks.
+        debug_assert_eq!(
+            self.base_axes,
+            frame::euler_axes(self.base[3], self.base[4]),
+            "the base's kept Euler axes"
+        );
+        &self.base_axes
     }
 
     /// The tool frame relative to the flange, `pose(T0 + T)`.

@@ -9,7 +9,8 @@ use crate::error::{Error, Result};
 use crate::frame::{self, Frame};
 use nalgebra::Vector3;
 
-/// A target beyond the first: its nominal tool vector, its correction and the cached frame.
+/// A target beyond the first: its nominal tool vector, its correction, and the frame and Euler
+/// axes kept from their sum.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct TargetTool {
     pub nominal: [f64; 6],
@@ -115,16 +116,20 @@ impl Robot {
     /// angular corrections turn it ([`frame::euler_axes`]); kept with its frame.
     #[inline]
     pub(crate) fn target_euler_axes(&self, t: usize) -> &[Vector3<f64>; 3] {
-        match t {
+        let axes = match t {
             0 => &self.tool_axes,
             _ => &self.targets[t - 1].axes,
-        }
-    }
-
-    /// The Euler axes of the base's angles (see [`Robot::target_euler_axes`]).
-    #[inline]
-    pub(crate) fn base_euler_axes(&self) -> &[Vector3<f64>; 3] {
-        &self.base_axes
+        };
+        // Every mutator of a tool refreshes them (`refresh_tool`, `TargetTool::refresh`); a
+        // debug build checks.
+        debug_assert!(
+            {
+                let (n, c) = (self.target_tool0(t), self.target_tool_correction(t));
+                *axes == frame::euler_axes(n[3] + c[3], n[4] + c[4])
+            },
+            "target {t}'s kept Euler axes"
+        );
+        axes
     }
 
     /// Sets component `k` of the correction of target `t >= 1` (internal units).

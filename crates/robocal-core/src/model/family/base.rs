@@ -64,6 +64,7 @@ impl ParameterFamily for Base {
             put(&mut dw, e, Vector3::zeros());
         }
         let o = Vector3::new(b[0], b[1], b[2]);
+
         for (e, ax) in robot.base_euler_axes().iter().enumerate() {
             let (v, w) = pose.rotation_screw(*ax, o);
             dp[3 + e] = v;

@@ -254,6 +254,13 @@ pub fn match_template(template: &str, name: &str) -> Option<usize> {
 }
 
 /// The frames of one forward pass, from which every family's columns are cross products.
+///
+/// A pass written in place over an earlier one (`Robot::pose_frames_target_into`, the
+/// per-thread buffer of the Jacobian passes, which robots of any size share) writes the first
+/// [`Robot::dof`] axis and link frames, the flange, the point, the target and `rigid.conditions`;
+/// the frames past `dof`, and the rest of `rigid` on a robot whose families do not deflect the
+/// joints, keep whatever an earlier pass left. Nothing reads them: every reader stops at `dof`,
+/// and only the families that deflect the joints read `rigid`.
 pub struct PoseFrames {
     /// `axis[i]`: joint i's axis frame, z along the axis, origin on it (MDH: `F_{i-1} Rx Tx Ry`;
     /// DH: `F_{i-1}`).
@@ -269,8 +276,9 @@ pub struct PoseFrames {
     /// [`Robot::target_count`]). Families of one target's tool give zero columns for another's.
     pub target: usize,
     /// The forward pass at the commanded joints without deflection, filled when some family
-    /// deflects the joints (the frames above are then at the deflected joints); families that
-    /// deflect the joints compute `d(dq)/d(theta)` from it.
+    /// deflects the joints (the frames above are then at the deflected joints; otherwise only
+    /// its `conditions` are written); families that deflect the joints compute `d(dq)/d(theta)`
+    /// from it.
     pub rigid: RigidPose,
 }
 
