@@ -33,6 +33,20 @@ pub fn axis_column(i: usize) -> String {
     format!("axis{}", i + 1)
 }
 
+/// A row's cells as a [`ColumnLayout`] reads them: a `csv` record, or a line of a small file
+/// without quotes split at its delimiter ([`crate::io::csv_text`]).
+pub(crate) trait Cells {
+    /// Cell `k` as written (the layout's readers trim it).
+    fn cell(&self, k: usize) -> &str;
+}
+
+impl Cells for csv::StringRecord {
+    #[inline]
+    fn cell(&self, k: usize) -> &str {
+        &self[k]
+    }
+}
+
 /// The header of a CSV file, split by role.
 pub(crate) struct ColumnLayout {
     /// All column names, in file order (a UTF-8 byte-order mark removed).
@@ -159,14 +173,27 @@ impl ColumnLayout {
         read_xyz: bool,
         expected: &str,
     ) -> Result<ColumnLayout> {
-        let perr = |field: Option<&str>, msg: String| Error::parse(path, Some(1), field, msg);
-        let headers: Vec<String> = rdr
+        let delimiter = rdr.get_ref().delimiter();
+        let headers = rdr
             .headers()
-            .map_err(|e| csv_error(path, e, None::<&LineCounted<R>>))?
+            .map_err(|e| csv_error(path, e, None::<&LineCounted<R>>))?;
+        ColumnLayout::of_header(headers, delimiter, path, dof, read_xyz, expected)
+    }
+
+    /// [`ColumnLayout::read`] of a header already read (trimmed), with the file's delimiter.
+    pub fn of_header(
+        header: &csv::StringRecord,
+        delimiter: u8,
+        path: &Path,
+        dof: usize,
+        read_xyz: bool,
+        expected: &str,
+    ) -> Result<ColumnLayout> {
+        let perr = |field: Option<&str>, msg: String| Error::parse(path, Some(1), field, msg);
+        let headers: Vec<String> = header
             .iter()
             .map(|h| known_name(h.trim_start_matches('\u{feff}')))
             .collect();
-        let delimiter = rdr.get_ref().delimiter();
         if headers.iter().all(|h| h.is_empty()) {
             return Err(perr(
                 None,
@@ -247,14 +274,8 @@ impl ColumnLayout {
     /// The number in column `k` of `record` (at `line`; the cell trimmed): rejects empty cells,
     /// text and non-finite values, naming the file, line and column.
     #[inline]
-    pub fn number(
-        &self,
-        record: &csv::StringRecord,
-        k: usize,
-        path: &Path,
-        line: usize,
-    ) -> Result<f64> {
-        let s = record[k].trim();
+    pub fn number(&self, record: &impl Cells, k: usize, path: &Path, line: usize) -> Result<f64> {
+        let s = record.cell(k).trim();
         let perr = |msg: String| Error::parse(path, Some(line), Some(&self.headers[k]), msg);
         if s.is_empty() {
             return Err(perr("empty cell".into()));
@@ -281,7 +302,7 @@ impl ColumnLayout {
     #[inline]
     pub fn number_in(
         &self,
-        record: &csv::StringRecord,
+        record: &impl Cells,
         k: usize,
         path: &Path,
         line: usize,
@@ -337,7 +358,7 @@ impl ColumnLayout {
     /// revolute joint's cell (degrees as written), for the radians warning.
     pub fn joint_values(
         &self,
-        record: &csv::StringRecord,
+        record: &impl Cells,
         cols: &JointColumns,
         joints: &JointSpace,
         path: &Path,
@@ -353,7 +374,7 @@ impl ColumnLayout {
     /// magnitude of a revolute joint's cell.
     pub fn joint_values_into(
         &self,
-        record: &csv::StringRecord,
+        record: &impl Cells,
         cols: &JointColumns,
         joints: &JointSpace,
         path: &Path,
@@ -423,19 +444,19 @@ impl ColumnLayout {
     }
 
     /// The values of the extra columns of `record` (trimmed).
-    pub fn extra_values(&self, record: &csv::StringRecord) -> Vec<String> {
+    pub fn extra_values(&self, record: &impl Cells) -> Vec<String> {
         self.extra
             .iter()
-            .map(|&k| record[k].trim().to_owned())
+            .map(|&k| record.cell(k).trim().to_owned())
             .collect()
     }
 
     /// [`ColumnLayout::extra_values`] written to `out`, reusing its strings.
-    pub fn extra_values_into(&self, record: &csv::StringRecord, out: &mut Vec<String>) {
+    pub fn extra_values_into(&self, record: &impl Cells, out: &mut Vec<String>) {
         out.resize_with(self.extra.len(), String::new);
         for (o, &k) in out.iter_mut().zip(&self.extra) {
             o.clear();
-            o.push_str(record[k].trim());
+            o.push_str(record.cell(k).trim());
         }
     }
 }
