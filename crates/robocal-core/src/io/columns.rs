@@ -480,17 +480,33 @@ fn plain_decimal(s: &str) -> Option<f64> {
         b'+' => (false, &b[1..]),
         _ => (false, b),
     };
-    let (mut mantissa, mut count, mut decimals, mut point) = (0u64, 0usize, 0usize, false);
-    for &c in digits {
-        match c {
-            b'0'..=b'9' => {
-                mantissa = mantissa * 10 + u64::from(c - b'0');
-                count += 1;
-                decimals += usize::from(point);
-            }
-            b'.' if !point => point = true,
-            _ => return None,
+    // The digits before the point, then those after it: one test a byte. (Wrapping: a number
+    // of more than 15 digits is refused below, whatever its value.)
+    let mut mantissa = 0u64;
+    let mut k = 0;
+    while let Some(d) = digits
+        .get(k)
+        .map(|c| c.wrapping_sub(b'0'))
+        .filter(|d| *d <= 9)
+    {
+        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+        k += 1;
+    }
+    let mut count = k;
+    let mut decimals = 0;
+    if k < digits.len() {
+        if digits[k] != b'.' {
+            return None;
         }
+        for &c in &digits[k + 1..] {
+            let d = c.wrapping_sub(b'0');
+            if d > 9 {
+                return None;
+            }
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+        }
+        decimals = digits.len() - k - 1;
+        count += decimals;
     }
     if count == 0 || count > 15 {
         return None;
@@ -577,6 +593,8 @@ mod tests {
             ".5",
             "-37.953953735",
             "123456789012345",
+            "+.5",
+            "-0.00000000000001",
         ] {
             let want: f64 = s.parse().unwrap();
             assert_eq!(
@@ -596,6 +614,12 @@ mod tests {
             "1,5",
             "1234567890123456",
             " 1",
+            "123456789012345678901234567",
+            "1..2",
+            "1.-2",
+            "-.",
+            "1.2e3",
+            "12 ",
         ] {
             assert_eq!(plain_decimal(s), None, "{s}");
         }

@@ -331,7 +331,10 @@ impl CalibrationResult {
     /// and its verdict and message are the ones given.
     pub fn write(&self, path: &Path) -> Result<()> {
         let text = match deferred::split(self, || self.serialized_text())? {
-            Some(d) if self.skeleton_readable(&d.skeleton, path).is_ok() => d.text(),
+            Some(d) if self.skeleton_readable(&d.skeleton, path).is_ok() => {
+                let pieces: Vec<&[u8]> = d.pieces().iter().map(|p| p.as_bytes()).collect();
+                return crate::io::atomic::write_atomic_parts(path, &pieces);
+            }
             Some(d) => self.readable(d.text(), path)?,
             None => self.readable(self.serialized_text()?, path)?,
         };

@@ -84,18 +84,23 @@ pub(super) struct Deferred {
 }
 
 impl Deferred {
-    /// The whole text: the skeleton with the sections in place of the placeholders.
-    pub fn text(&self) -> String {
-        let extra: usize = self.sections.iter().map(|(_, _, t)| t.len()).sum();
-        let mut out = String::with_capacity(self.skeleton.len() + extra);
+    /// The whole text, in pieces: the skeleton's, with the sections in place of the
+    /// placeholders.
+    pub fn pieces(&self) -> Vec<&str> {
+        let mut out = Vec::with_capacity(2 * self.sections.len() + 1);
         let mut from = 0;
         for (at, len, t) in &self.sections {
-            out.push_str(&self.skeleton[from..*at]);
-            out.push_str(t);
+            out.push(&self.skeleton[from..*at]);
+            out.push(t.as_str());
             from = at + len;
         }
-        out.push_str(&self.skeleton[from..]);
+        out.push(&self.skeleton[from..]);
         out
+    }
+
+    /// The whole text: [`Deferred::pieces`] joined.
+    pub fn text(&self) -> String {
+        self.pieces().concat()
     }
 }
 

@@ -470,6 +470,11 @@ fn the_skeleton_reads_as_the_skimmed_text() {
     assert!(skeleton.points.is_none());
     assert!(skeleton.prediction.as_ref().unwrap().map.is_empty());
     r.skeleton_readable(&d.skeleton, path).unwrap();
+    // Written in pieces, the file is the text.
+    let dir = scratch("skeleton");
+    let out = dir.join("r.json");
+    r.write(&out).unwrap();
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), r.to_text().unwrap());
     // What the whole text's reading refuses, the skeleton's does too, and `write` then gives
     // the whole text's message.
     let mut bad = r.clone();
@@ -481,8 +486,9 @@ fn the_skeleton_reads_as_the_skimmed_text() {
     let whole = CalibrationResult::parse(&d.text(), path)
         .unwrap_err()
         .to_string();
-    let dir = scratch("skeleton");
-    let e = bad.write(&dir.join("r.json")).unwrap_err().to_string();
+    std::fs::remove_file(&out).unwrap();
+    let e = bad.write(&out).unwrap_err().to_string();
+    assert!(!out.exists());
     assert!(e.ends_with(&whole), "{e}\n{whole}");
     assert!(e.contains("tracker_frame.a"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
