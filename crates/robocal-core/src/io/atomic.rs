@@ -244,8 +244,16 @@ impl Drop for AtomicFile {
 
 /// Writes `bytes` to `path` atomically.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_parts(path, &[bytes])
+}
+
+/// Writes the concatenation of `parts` to `path` atomically (without joining them in memory
+/// first).
+pub fn write_atomic_parts(path: &Path, parts: &[&[u8]]) -> Result<()> {
     let mut f = AtomicFile::create(path)?;
-    f.write_all(bytes).map_err(|e| io_err(path, e))?;
+    for bytes in parts {
+        f.write_all(bytes).map_err(|e| io_err(path, e))?;
+    }
     f.commit()
 }
 

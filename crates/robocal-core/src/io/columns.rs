@@ -33,6 +33,20 @@ pub fn axis_column(i: usize) -> String {
     format!("axis{}", i + 1)
 }
 
+/// A row's cells as a [`ColumnLayout`] reads them: a `csv` record, or a line of a small file
+/// without quotes split at its delimiter ([`crate::io::csv_text`]).
+pub(crate) trait Cells {
+    /// Cell `k` as written (the layout's readers trim it).
+    fn cell(&self, k: usize) -> &str;
+}
+
+impl Cells for csv::StringRecord {
+    #[inline]
+    fn cell(&self, k: usize) -> &str {
+        &self[k]
+    }
+}
+
 /// The header of a CSV file, split by role.
 pub(crate) struct ColumnLayout {
     /// All column names, in file order (a UTF-8 byte-order mark removed).
@@ -159,14 +173,27 @@ impl ColumnLayout {
         read_xyz: bool,
         expected: &str,
     ) -> Result<ColumnLayout> {
-        let perr = |field: Option<&str>, msg: String| Error::parse(path, Some(1), field, msg);
-        let headers: Vec<String> = rdr
+        let delimiter = rdr.get_ref().delimiter();
+        let headers = rdr
             .headers()
-            .map_err(|e| csv_error(path, e, None::<&LineCounted<R>>))?
+            .map_err(|e| csv_error(path, e, None::<&LineCounted<R>>))?;
+        ColumnLayout::of_header(headers, delimiter, path, dof, read_xyz, expected)
+    }
+
+    /// [`ColumnLayout::read`] of a header already read (trimmed), with the file's delimiter.
+    pub fn of_header(
+        header: &csv::StringRecord,
+        delimiter: u8,
+        path: &Path,
+        dof: usize,
+        read_xyz: bool,
+        expected: &str,
+    ) -> Result<ColumnLayout> {
+        let perr = |field: Option<&str>, msg: String| Error::parse(path, Some(1), field, msg);
+        let headers: Vec<String> = header
             .iter()
             .map(|h| known_name(h.trim_start_matches('\u{feff}')))
             .collect();
-        let delimiter = rdr.get_ref().delimiter();
         if headers.iter().all(|h| h.is_empty()) {
             return Err(perr(
                 None,
@@ -247,14 +274,8 @@ impl ColumnLayout {
     /// The number in column `k` of `record` (at `line`; the cell trimmed): rejects empty cells,
     /// text and non-finite values, naming the file, line and column.
     #[inline]
-    pub fn number(
-        &self,
-        record: &csv::StringRecord,
-        k: usize,
-        path: &Path,
-        line: usize,
-    ) -> Result<f64> {
-        let s = record[k].trim();
+    pub fn number(&self, record: &impl Cells, k: usize, path: &Path, line: usize) -> Result<f64> {
+        let s = record.cell(k).trim();
         let perr = |msg: String| Error::parse(path, Some(line), Some(&self.headers[k]), msg);
         if s.is_empty() {
             return Err(perr("empty cell".into()));
@@ -281,7 +302,7 @@ impl ColumnLayout {
     #[inline]
     pub fn number_in(
         &self,
-        record: &csv::StringRecord,
+        record: &impl Cells,
         k: usize,
         path: &Path,
         line: usize,
@@ -337,7 +358,7 @@ impl ColumnLayout {
     /// revolute joint's cell (degrees as written), for the radians warning.
     pub fn joint_values(
         &self,
-        record: &csv::StringRecord,
+        record: &impl Cells,
         cols: &JointColumns,
         joints: &JointSpace,
         path: &Path,
@@ -353,7 +374,7 @@ impl ColumnLayout {
     /// magnitude of a revolute joint's cell.
     pub fn joint_values_into(
         &self,
-        record: &csv::StringRecord,
+        record: &impl Cells,
         cols: &JointColumns,
         joints: &JointSpace,
         path: &Path,
@@ -423,19 +444,19 @@ impl ColumnLayout {
     }
 
     /// The values of the extra columns of `record` (trimmed).
-    pub fn extra_values(&self, record: &csv::StringRecord) -> Vec<String> {
+    pub fn extra_values(&self, record: &impl Cells) -> Vec<String> {
         self.extra
             .iter()
-            .map(|&k| record[k].trim().to_owned())
+            .map(|&k| record.cell(k).trim().to_owned())
             .collect()
     }
 
     /// [`ColumnLayout::extra_values`] written to `out`, reusing its strings.
-    pub fn extra_values_into(&self, record: &csv::StringRecord, out: &mut Vec<String>) {
+    pub fn extra_values_into(&self, record: &impl Cells, out: &mut Vec<String>) {
         out.resize_with(self.extra.len(), String::new);
         for (o, &k) in out.iter_mut().zip(&self.extra) {
             o.clear();
-            o.push_str(record[k].trim());
+            o.push_str(record.cell(k).trim());
         }
     }
 }
@@ -459,17 +480,33 @@ fn plain_decimal(s: &str) -> Option<f64> {
         b'+' => (false, &b[1..]),
         _ => (false, b),
     };
-    let (mut mantissa, mut count, mut decimals, mut point) = (0u64, 0usize, 0usize, false);
-    for &c in digits {
-        match c {
-            b'0'..=b'9' => {
-                mantissa = mantissa * 10 + u64::from(c - b'0');
-                count += 1;
-                decimals += usize::from(point);
-            }
-            b'.' if !point => point = true,
-            _ => return None,
+    // The digits before the point, then those after it: one test a byte. (Wrapping: a number
+    // of more than 15 digits is refused below, whatever its value.)
+    let mut mantissa = 0u64;
+    let mut k = 0;
+    while let Some(d) = digits
+        .get(k)
+        .map(|c| c.wrapping_sub(b'0'))
+        .filter(|d| *d <= 9)
+    {
+        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+        k += 1;
+    }
+    let mut count = k;
+    let mut decimals = 0;
+    if k < digits.len() {
+        if digits[k] != b'.' {
+            return None;
         }
+        for &c in &digits[k + 1..] {
+            let d = c.wrapping_sub(b'0');
+            if d > 9 {
+                return None;
+            }
+            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
+        }
+        decimals = digits.len() - k - 1;
+        count += decimals;
     }
     if count == 0 || count > 15 {
         return None;
@@ -556,6 +593,8 @@ mod tests {
             ".5",
             "-37.953953735",
             "123456789012345",
+            "+.5",
+            "-0.00000000000001",
         ] {
             let want: f64 = s.parse().unwrap();
             assert_eq!(
@@ -575,6 +614,12 @@ mod tests {
             "1,5",
             "1234567890123456",
             " 1",
+            "123456789012345678901234567",
+            "1..2",
+            "1.-2",
+            "-.",
+            "1.2e3",
+            "12 ",
         ] {
             assert_eq!(plain_decimal(s), None, "{s}");
         }

@@ -138,7 +138,7 @@ fn next_break(bytes: &[u8]) -> Option<usize> {
 }
 
 /// The delimiter of a header line: the most frequent of `,`, `;` and tab outside double quotes.
-fn sniff(head: &[u8]) -> u8 {
+pub(crate) fn sniff(head: &[u8]) -> u8 {
     let mut counts = [0usize; 3];
     let mut quoted = false;
     for b in head {

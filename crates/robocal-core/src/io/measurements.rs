@@ -10,8 +10,9 @@
 
 use crate::error::{Error, Result};
 use crate::io::columns::{
-    csv_reader_header_trimmed, joint_column, next_record, ColumnLayout, JointColumns,
+    csv_reader_header_trimmed, joint_column, next_record, Cells, ColumnLayout, JointColumns,
 };
+use crate::io::csv_text::CsvText;
 use crate::model::JointSpace;
 use crate::ranges;
 use nalgebra::Vector3;
@@ -119,7 +120,7 @@ pub fn parse_measurements<R: Read>(
 /// rejects a file without rows and returns the warnings. [`read_measurements`] is this reader
 /// collecting every row.
 pub struct MeasurementReader<R: Read> {
-    rdr: csv::Reader<crate::io::columns::LineCounted<R>>,
+    source: Rows<R>,
     path: PathBuf,
     joints: JointSpace,
     layout: ColumnLayout,
@@ -130,10 +131,36 @@ pub struct MeasurementReader<R: Read> {
     max_abs_deg: f64,
 }
 
+/// Where a reader's rows come from: the `csv` reader, or a small file without quotes read from
+/// memory ([`CsvText`]: the same rows, lines and errors).
+enum Rows<R: Read> {
+    Csv(csv::Reader<crate::io::columns::LineCounted<R>>),
+    Text(CsvText),
+}
+
+/// The columns a measurement file must have, for the empty-file message.
+fn expected_columns(dof: usize) -> String {
+    format!("q1..q{dof} (or axis1..axis{dof}) and x,y,z")
+}
+
 impl MeasurementReader<std::io::BufReader<std::fs::File>> {
     /// Opens a measurement file for a robot with the joints `joints` and checks its header.
     pub fn open(path: &Path, joints: &JointSpace, positions: Positions) -> Result<Self> {
-        let file = crate::io::input::open_input(path)?;
+        let mut file = crate::io::input::open_input(path)?;
+        if let Some(mut text) = CsvText::of_file(&mut file, path)? {
+            let mut header = csv::StringRecord::new();
+            text.header(&mut header);
+            let dof = joints.dof();
+            let layout = ColumnLayout::of_header(
+                &header,
+                text.delimiter(),
+                path,
+                dof,
+                positions != Positions::Ignored,
+                &expected_columns(dof),
+            )?;
+            return Self::with_layout(Rows::Text(text), layout, path, joints, positions);
+        }
         MeasurementReader::new(std::io::BufReader::new(file), path, joints, positions)
     }
 }
@@ -141,9 +168,6 @@ impl MeasurementReader<std::io::BufReader<std::fs::File>> {
 impl<R: Read> MeasurementReader<R> {
     /// Reads and checks the header of measurement CSV text; `path` is used in messages.
     pub fn new(reader: R, path: &Path, joints: &JointSpace, positions: Positions) -> Result<Self> {
-        let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
-            Error::parse(path, line, field, msg)
-        };
         let dof = joints.dof();
         let mut rdr = csv_reader_header_trimmed(reader);
         let layout = ColumnLayout::read(
@@ -151,8 +175,23 @@ impl<R: Read> MeasurementReader<R> {
             path,
             dof,
             positions != Positions::Ignored,
-            &format!("q1..q{dof} (or axis1..axis{dof}) and x,y,z"),
+            &expected_columns(dof),
         )?;
+        Self::with_layout(Rows::Csv(rdr), layout, path, joints, positions)
+    }
+
+    /// The reader of `source` whose header is `layout`, checked for the columns it must have.
+    fn with_layout(
+        source: Rows<R>,
+        layout: ColumnLayout,
+        path: &Path,
+        joints: &JointSpace,
+        positions: Positions,
+    ) -> Result<Self> {
+        let perr = |line: Option<usize>, field: Option<&str>, msg: String| {
+            Error::parse(path, line, field, msg)
+        };
+        let dof = joints.dof();
         let Some(q) = layout.joint_columns(path)? else {
             return Err(perr(
                 Some(1),
@@ -182,7 +221,7 @@ impl<R: Read> MeasurementReader<R> {
             _ => None,
         };
         Ok(MeasurementReader {
-            rdr,
+            source,
             path: path.to_owned(),
             joints: joints.clone(),
             q_col: q,
@@ -232,31 +271,25 @@ impl<R: Read> MeasurementReader<R> {
     /// buffers: a file of any length is read without an allocation per row. `false` at the end
     /// of the file (`row` then unchanged).
     pub fn next_row_into(&mut self, row: &mut Measurement) -> Result<bool> {
-        let Some(line) = next_record(&mut self.rdr, &mut self.record, &self.path)? else {
-            return Ok(false);
+        let at = Columns {
+            layout: &self.layout,
+            q_col: &self.q_col,
+            xyz_col: self.xyz_col,
+            joints: &self.joints,
+            path: &self.path,
         };
-        let (layout, record, path) = (&self.layout, &self.record, &self.path);
-        let largest_angle =
-            layout.joint_values_into(record, &self.q_col, &self.joints, path, line, &mut row.q)?;
+        let largest_angle = match &mut self.source {
+            Rows::Csv(rdr) => match next_record(rdr, &mut self.record, &self.path)? {
+                Some(line) => at.row_into(&self.record, line, row)?,
+                None => return Ok(false),
+            },
+            Rows::Text(text) => match text.next_record(&self.path)? {
+                Some((line, cells)) => at.row_into(&cells, line, row)?,
+                None => return Ok(false),
+            },
+        };
         self.max_abs_deg = self.max_abs_deg.max(largest_angle);
-        let pos = |k| {
-            layout.number_in(
-                record,
-                k,
-                path,
-                line,
-                &ranges::LENGTH,
-                "not a plausible tracker reading",
-            )
-        };
-        let p = match self.xyz_col {
-            Some([x, y, z]) => Some(Vector3::new(pos(x)?, pos(y)?, pos(z)?)),
-            None => None,
-        };
         self.rows += 1;
-        row.line = line;
-        row.p = p;
-        layout.extra_values_into(record, &mut row.extra);
         Ok(true)
     }
 
@@ -301,6 +334,43 @@ impl<R: Read> MeasurementReader<R> {
         }
         set.warnings = self.finish()?;
         Ok(set)
+    }
+}
+
+/// What a reader needs to read one row: its header's layout and the robot's joints.
+struct Columns<'a> {
+    layout: &'a ColumnLayout,
+    q_col: &'a JointColumns,
+    xyz_col: Option<[usize; 3]>,
+    joints: &'a JointSpace,
+    path: &'a Path,
+}
+
+impl Columns<'_> {
+    /// The row at `line` of cells `record` into `row` (every field replaced); the largest
+    /// magnitude of a revolute joint's cell, for the radians warning.
+    fn row_into(&self, record: &impl Cells, line: usize, row: &mut Measurement) -> Result<f64> {
+        let (layout, path) = (self.layout, self.path);
+        let largest_angle =
+            layout.joint_values_into(record, self.q_col, self.joints, path, line, &mut row.q)?;
+        let pos = |k| {
+            layout.number_in(
+                record,
+                k,
+                path,
+                line,
+                &ranges::LENGTH,
+                "not a plausible tracker reading",
+            )
+        };
+        let p = match self.xyz_col {
+            Some([x, y, z]) => Some(Vector3::new(pos(x)?, pos(y)?, pos(z)?)),
+            None => None,
+        };
+        row.line = line;
+        row.p = p;
+        layout.extra_values_into(record, &mut row.extra);
+        Ok(largest_angle)
     }
 }
 

@@ -4,6 +4,7 @@ pub mod atomic;
 pub mod claims;
 pub(crate) mod columns;
 pub(crate) mod csv_lines;
+pub(crate) mod csv_text;
 pub mod export;
 pub mod import;
 pub mod input;

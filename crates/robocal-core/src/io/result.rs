@@ -8,6 +8,8 @@ use crate::error::{Error, Result};
 use crate::frame::TrackerFrame;
 #[path = "result_checks.rs"]
 mod checks;
+#[path = "result_deferred.rs"]
+pub(crate) mod deferred;
 use crate::io::result_plausibility::PlausibilitySection;
 use crate::io::result_sections::{
     sorted_opt, DownweightedEntry, Identifiability, Points, Registration, Settings, Solver,
@@ -153,6 +155,7 @@ pub struct CalibrationResult {
     #[serde(
         default,
         skip_serializing_if = "Option::is_none",
+        serialize_with = "deferred::points",
         deserialize_with = "crate::io::result_skim::option"
     )]
     pub points: Option<Points>,
@@ -288,7 +291,17 @@ impl CalibrationResult {
     /// The result's text as robocal writes it: pretty JSON with each per-point entry on one
     /// line, ending with a newline. Every writer of a result (the CLI, the demo's files, the
     /// Python bindings) uses it, so that the same result is the same bytes wherever it is made.
+    /// The per-point sections are written apart and put in place (`io::result_deferred`); the
+    /// bytes are those of serializing the whole result.
     pub fn to_text(&self) -> Result<String> {
+        Ok(match deferred::split(self, || self.serialized_text())? {
+            Some(d) => d.text(),
+            None => self.serialized_text()?,
+        })
+    }
+
+    /// [`CalibrationResult::to_text`] made by serializing the whole result with serde_json.
+    fn serialized_text(&self) -> Result<String> {
         // Sized for the per-point entries (one line of at most about 90 bytes each: two errors
         // written to the last digit and a line number), so that a million points' text is
         // neither copied as it grows nor given twice the room it needs.
@@ -307,14 +320,45 @@ impl CalibrationResult {
             .map_err(|e| Error::Numerical(format!("cannot serialize result: {e}")))
     }
 
-    /// Writes the result atomically as pretty JSON (each per-point entry on one line), after reading the text back as every command
-    /// that takes a result does ([`CalibrationResult::parse`], then the calibrated model): what
-    /// robocal writes, robocal reads. A result its readers would refuse (a value outside its
-    /// range) is not written: [`Error::Implausible`] names the field.
+    /// Writes the result atomically as pretty JSON (each per-point entry on one line), after
+    /// reading the text back as every command that takes a result does
+    /// ([`CalibrationResult::parse`], then the calibrated model): what robocal writes, robocal
+    /// reads. A result its readers would refuse (a value outside its range) is not written:
+    /// [`Error::Implausible`] names the field.
+    ///
+    /// The text read back is the one without its per-point sections (`io::result_deferred`
+    /// says why that is the same check); when it does not pass, the whole text is read back,
+    /// and its verdict and message are the ones given.
     pub fn write(&self, path: &Path) -> Result<()> {
-        let s = self.to_text()?;
+        let text = match deferred::split(self, || self.serialized_text())? {
+            Some(d) if self.skeleton_readable(&d.skeleton, path).is_ok() => {
+                let pieces: Vec<&[u8]> = d.pieces().iter().map(|p| p.as_bytes()).collect();
+                return crate::io::atomic::write_atomic_parts(path, &pieces);
+            }
+            Some(d) => self.readable(d.text(), path)?,
+            None => self.readable(self.serialized_text()?, path)?,
+        };
+        crate::io::atomic::write_atomic(path, text.as_bytes())
+    }
+
+    /// Whether the skeleton of this result's text (`io::result_deferred`) reads back and its
+    /// calibrated model can be made. Its errors are not shown: on any, the whole text is read.
+    fn skeleton_readable(&self, skeleton: &str, path: &Path) -> Result<()> {
+        let r: CalibrationResult = serde_json::from_str(skeleton)
+            .map_err(|e| Error::Numerical(format!("skeleton: {e}")))?;
+        crate::io::result_skim::finite_map(self.prediction.as_ref())?;
+        let (back, nominal) = check_read(r, skeleton, path)?;
+        match nominal {
+            Some(nominal) => back.calibrated_robot(&nominal, path).map(|_| ()),
+            None => Ok(()),
+        }
+    }
+
+    /// `text`, which [`CalibrationResult::to_text`] made of `self`, when it reads back and its
+    /// calibrated model can be made; else [`Error::Implausible`] with the reader's message.
+    fn readable(&self, text: String, path: &Path) -> Result<String> {
         let readable = self
-            .read_back(&s, path)
+            .read_back(&text, path)
             .and_then(|(back, nominal)| match nominal {
                 Some(nominal) => back.calibrated_robot(&nominal, path).map(|_| ()),
                 None => Ok(()),
@@ -325,7 +369,7 @@ impl CalibrationResult {
                  export, fk) would refuse it, so it is not written: {e}"
             )));
         }
-        crate::io::atomic::write_atomic(path, s.as_bytes())
+        Ok(text)
     }
 
     /// Why this result is not a finished calibration, if it is not: its `status` is

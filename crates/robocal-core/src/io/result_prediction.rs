@@ -10,7 +10,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PredictionSection {
     /// The predicted error at random poses of the workspace.
-    #[serde(default, deserialize_with = "crate::io::result_skim::list")]
+    #[serde(
+        default,
+        serialize_with = "crate::io::result::deferred::map",
+        deserialize_with = "crate::io::result_skim::list"
+    )]
     pub map: Vec<MapEntry>,
     /// Expected mean error norm at new poses spread like the calibration poses (mm).
     #[serde(deserialize_with = "nullable::f64")]

@@ -1,5 +1,7 @@
-//! Reading back a result robocal has just written ([`super::result::CalibrationResult::write`])
-//! without building its per-point sections again: `points` (an entry per calibration and
+//! Reading back the whole text of a result robocal has just written
+//! ([`super::result::CalibrationResult::write`], when the text without its per-point sections,
+//! which it reads back first, does not pass: `io::result_deferred`) without building its
+//! per-point sections again: `points` (an entry per calibration and
 //! validation row, a million of them for a million rows) and `prediction.map`. There they are
 //! only checked to be well-formed JSON, at a tenth of the cost of parsing every number.
 //!

@@ -367,3 +367,129 @@ fn the_read_back_skims_the_per_point_sections() {
     assert!(!out.exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The per-point sections written apart (`io::result_deferred`) give the bytes of serializing
+/// the whole result: a calibration's result, and entries of every kind of number (NaN and
+/// infinities written as null, signed zero, the smallest and largest doubles, exponents) with
+/// empty, missing and one-entry lists.
+#[test]
+fn per_point_sections_written_apart_are_the_serialized_bytes() {
+    use crate::io::result_prediction::{MapEntry, PredictionSection};
+    use crate::io::result_sections::Points;
+    let same = |r: &CalibrationResult, split: bool| {
+        let d = deferred::split(r, || r.serialized_text()).unwrap();
+        assert_eq!(d.is_some(), split);
+        let whole = r.serialized_text().unwrap();
+        assert_eq!(r.to_text().unwrap(), whole);
+        if let Some(d) = d {
+            assert_eq!(d.text(), whole);
+            // The skeleton is the text with the sections as placeholders.
+            assert!(d.skeleton.len() < whole.len());
+            assert!(!d.skeleton.contains("after_mm") && !d.skeleton.contains("model_mm"));
+        }
+    };
+    same(&simulated_result(), true);
+    let odd = [
+        f64::NAN,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        -0.0,
+        0.0,
+        f64::MIN_POSITIVE,
+        5e-324,
+        f64::MAX,
+        -1e16,
+        1e-7,
+        123456789.125,
+        0.1 + 0.2,
+    ];
+    let entry = |k: usize| PointEntry {
+        after_mm: odd[k % odd.len()],
+        before_mm: odd[(k * 7 + 3) % odd.len()],
+        line: [0, 1, 17, usize::MAX][k % 4],
+    };
+    let spot = |k: usize| MapEntry {
+        mean_mm: odd[(k + 1) % odd.len()],
+        model_mm: odd[(k * 5) % odd.len()],
+        x: odd[(k + 4) % odd.len()],
+        y: -odd[(k + 9) % odd.len()],
+        z: odd[k % odd.len()],
+    };
+    let prediction = |n: usize| PredictionSection {
+        map: (0..n).map(spot).collect(),
+        mean_mm: 0.1,
+        std_mm: f64::NAN,
+        rms_mm: 0.11,
+        noise_sigma_mm: 0.03,
+        model_rms_mm: 0.04,
+    };
+    let lists: [(usize, Option<usize>); 5] = [
+        (0, None),
+        (0, Some(0)),
+        (1, Some(1)),
+        (30, None),
+        (5, Some(29)),
+    ];
+    for (k, (cal, val)) in lists.into_iter().enumerate() {
+        for with_map in [0, 1, 25] {
+            let mut r = good_result();
+            r.points = Some(Points {
+                calibration: (0..cal).map(|i| entry(i + k)).collect(),
+                validation: val.map(|n| (0..n).map(|i| entry(3 * i + 1)).collect()),
+            });
+            r.prediction = Some(prediction(with_map));
+            same(&r, true);
+            r.points = None;
+            same(&r, with_map > 0);
+            r.prediction = None;
+            same(&r, false);
+        }
+    }
+    // Extra keys: serialized whole.
+    let mut r = simulated_result();
+    r.extra.insert("points".to_owned(), json!(null));
+    same(&r, false);
+}
+
+/// The skeleton `write` reads back is the text read with the per-point sections skimmed: the
+/// same result, field for field.
+#[test]
+fn the_skeleton_reads_as_the_skimmed_text() {
+    let r = simulated_result();
+    let path = Path::new("r.json");
+    let d = deferred::split(&r, || r.serialized_text())
+        .unwrap()
+        .unwrap();
+    let skeleton: CalibrationResult = serde_json::from_str(&d.skeleton).unwrap();
+    let (skimmed, _) = r.read_back(&d.text(), path).unwrap();
+    // Compared as text: a NaN (written null) is not equal to itself.
+    assert_eq!(
+        skeleton.serialized_text().unwrap(),
+        skimmed.serialized_text().unwrap()
+    );
+    assert!(skeleton.points.is_none());
+    assert!(skeleton.prediction.as_ref().unwrap().map.is_empty());
+    r.skeleton_readable(&d.skeleton, path).unwrap();
+    // Written in pieces, the file is the text.
+    let dir = scratch("skeleton");
+    let out = dir.join("r.json");
+    r.write(&out).unwrap();
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), r.to_text().unwrap());
+    // What the whole text's reading refuses, the skeleton's does too, and `write` then gives
+    // the whole text's message.
+    let mut bad = r.clone();
+    bad.tracker_frame.a = 1e9;
+    let d = deferred::split(&bad, || bad.serialized_text())
+        .unwrap()
+        .unwrap();
+    assert!(bad.skeleton_readable(&d.skeleton, path).is_err());
+    let whole = CalibrationResult::parse(&d.text(), path)
+        .unwrap_err()
+        .to_string();
+    std::fs::remove_file(&out).unwrap();
+    let e = bad.write(&out).unwrap_err().to_string();
+    assert!(!out.exists());
+    assert!(e.ends_with(&whole), "{e}\n{whole}");
+    assert!(e.contains("tracker_frame.a"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
