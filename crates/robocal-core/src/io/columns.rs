@@ -1,9 +1,10 @@
-//! What every CSV reader of robocal shares: a trimmed reader, the header split into joint
-//! columns (`q1..qn`, model joint values, or `axis1..axisN`, controller values), position
-//! columns `x,y,z` and extra columns (with the checks every file gets: empty file, unnamed or
-//! repeated columns, joints the robot does not have), blank rows skipped, numeric cells that must
-//! be finite, and joint values turned into model values (internal units) through the robot's
-//! [`JointSpace`]. Each file format then decides which columns it requires.
+//! What every CSV reader of robocal shares: a trimmed reader and blank rows skipped
+//! ([`crate::io::csv_reader`], re-exported here), the header split into joint columns (`q1..qn`,
+//! model joint values, or `axis1..axisN`, controller values), position columns `x,y,z` and extra
+//! columns (with the checks every file gets: empty file, unnamed or repeated columns, joints the
+//! robot does not have), numeric cells that must be finite, and joint values turned into model
+//! values (internal units) through the robot's [`JointSpace`]. Each file format then decides
+//! which columns it requires.
 //!
 //! Joint columns: a file gives `q1..qn` (degrees, or mm for a prismatic joint) or
 //! `axis1..axisN` (the controller's values, same units, converted through the robot's
@@ -14,6 +15,10 @@
 
 use crate::error::{Error, Result};
 pub(crate) use crate::io::csv_lines::LineCounted;
+pub(crate) use crate::io::csv_reader::{
+    csv_error, csv_reader, csv_reader_header_trimmed, next_record,
+};
+use crate::io::plain_decimal::plain_decimal;
 use crate::model::{JointSpace, JointType};
 use std::io::Read;
 use std::path::Path;
@@ -114,30 +119,6 @@ fn near_miss(h: &str, dof: usize) -> Option<String> {
         None => ["x", "y", "z"].contains(&core.as_str()),
     };
     (wanted && core != lower).then_some(core)
-}
-
-/// A CSV reader with robocal's settings: a header row, fields trimmed, equal row lengths, the
-/// delimiter of the header line (`,`, `;` or tab), true line numbers ([`LineCounted`]).
-pub(crate) fn csv_reader<R: Read>(reader: R) -> csv::Reader<LineCounted<R>> {
-    reader_trimming(reader, csv::Trim::All)
-}
-
-/// [`csv_reader`] that trims only the header: the cells of each row are left as written, for a
-/// reader that reads them through [`ColumnLayout::number`], [`ColumnLayout::extra_values_into`]
-/// and [`next_record`], which trim each cell they read (`csv` trims a row by building a new
-/// record, an allocation per row).
-pub(crate) fn csv_reader_header_trimmed<R: Read>(reader: R) -> csv::Reader<LineCounted<R>> {
-    reader_trimming(reader, csv::Trim::Headers)
-}
-
-fn reader_trimming<R: Read>(reader: R, trim: csv::Trim) -> csv::Reader<LineCounted<R>> {
-    let counted = LineCounted::new(reader);
-    csv::ReaderBuilder::new()
-        .has_headers(true)
-        .trim(trim)
-        .flexible(false)
-        .delimiter(counted.delimiter())
-        .from_reader(counted)
 }
 
 /// `q{k}` or `axis{k}`: whether it is an axis column, and k.
@@ -457,171 +438,6 @@ impl ColumnLayout {
         for (o, &k) in out.iter_mut().zip(&self.extra) {
             o.clear();
             o.push_str(record.cell(k).trim());
-        }
-    }
-}
-
-/// The exact powers of ten of a double, 1e0..=1e22.
-const POWERS_OF_TEN: [f64; 23] = [
-    1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
-    1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
-];
-
-/// A plain decimal (`-12.345`: an optional sign, digits, at most one point, at most 15 digits in
-/// all) the quick way, `None` for anything else: its digits as an integer and ten to the number
-/// of decimals are both exact doubles, so their quotient is the correctly rounded value, the
-/// same bits as `str::parse` gives (Clinger's fast path); the standard parser (a few hundred
-/// instructions a cell) then reads only what this does not.
-#[inline]
-fn plain_decimal(s: &str) -> Option<f64> {
-    let b = s.as_bytes();
-    let (neg, digits) = match b.first()? {
-        b'-' => (true, &b[1..]),
-        b'+' => (false, &b[1..]),
-        _ => (false, b),
-    };
-    // The digits before the point, then those after it: one test a byte. (Wrapping: a number
-    // of more than 15 digits is refused below, whatever its value.)
-    let mut mantissa = 0u64;
-    let mut k = 0;
-    while let Some(d) = digits
-        .get(k)
-        .map(|c| c.wrapping_sub(b'0'))
-        .filter(|d| *d <= 9)
-    {
-        mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
-        k += 1;
-    }
-    let mut count = k;
-    let mut decimals = 0;
-    if k < digits.len() {
-        if digits[k] != b'.' {
-            return None;
-        }
-        for &c in &digits[k + 1..] {
-            let d = c.wrapping_sub(b'0');
-            if d > 9 {
-                return None;
-            }
-            mantissa = mantissa.wrapping_mul(10).wrapping_add(u64::from(d));
-        }
-        decimals = digits.len() - k - 1;
-        count += decimals;
-    }
-    if count == 0 || count > 15 {
-        return None;
-    }
-    let v = mantissa as f64 / POWERS_OF_TEN[decimals];
-    Some(if neg { -v } else { v })
-}
-
-/// Reads the next row that is not blank into `record`; its 1-based line, or `None` at the end.
-pub(crate) fn next_record<R: Read>(
-    rdr: &mut csv::Reader<LineCounted<R>>,
-    record: &mut csv::StringRecord,
-    path: &Path,
-) -> Result<Option<usize>> {
-    loop {
-        let read = rdr.read_record(record);
-        if !read.map_err(|e| csv_error(path, e, Some(rdr.get_ref())))? {
-            return Ok(None);
-        }
-        if !record.iter().all(|f| f.trim().is_empty()) {
-            let byte = record.position().map_or(0, csv::Position::byte);
-            return Ok(Some(rdr.get_ref().line_at(byte)));
-        }
-    }
-}
-
-/// A CSV reader's error as a robocal error: an I/O failure (e.g. the path is a directory) as
-/// [`Error::Io`], anything else as [`Error::Parse`] with the line (counted by `lines` where
-/// given: the header's errors are on line 1).
-pub(crate) fn csv_error<R: Read>(
-    path: &Path,
-    e: csv::Error,
-    lines: Option<&LineCounted<R>>,
-) -> Error {
-    let line = e.position().map(|p| match lines {
-        Some(l) => l.line_at(p.byte()),
-        None => p.line() as usize,
-    });
-    let msg = match e.kind() {
-        csv::ErrorKind::UnequalLengths {
-            expected_len, len, ..
-        } => format!("{len} fields, but the header has {expected_len}"),
-        csv::ErrorKind::Utf8 { .. } => "not valid UTF-8 text".to_owned(),
-        csv::ErrorKind::Io(_) => {
-            return match e.into_kind() {
-                csv::ErrorKind::Io(source) => Error::Io {
-                    path: path.to_owned(),
-                    source,
-                },
-                other => Error::parse(path, line, None, format!("{other:?}")),
-            }
-        }
-        _ => e.to_string(),
-    };
-    Error::parse(path, line, None, msg)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::plain_decimal;
-
-    /// The quick parse gives the standard parser's bits wherever it answers, and answers for the
-    /// decimals files hold.
-    #[test]
-    fn plain_decimals_are_the_standard_parse() {
-        use rand::{Rng, SeedableRng};
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(0x2545_f491);
-        for _ in 0..100_000 {
-            let (r, decimals) = (rng.gen::<u64>(), rng.gen_range(0..16usize));
-            let v = (r % 10_000_000_000) as f64 / 1000.0 - 5e6;
-            let s = format!("{v:.decimals$}");
-            let want: f64 = s.parse().unwrap();
-            match plain_decimal(&s) {
-                Some(got) => assert_eq!(got.to_bits(), want.to_bits(), "{s}"),
-                None => assert!(s.trim_start_matches('-').len() > 16, "{s}"),
-            }
-        }
-        for s in [
-            "0",
-            "-0",
-            "-0.0",
-            "+5",
-            "5.",
-            ".5",
-            "-37.953953735",
-            "123456789012345",
-            "+.5",
-            "-0.00000000000001",
-        ] {
-            let want: f64 = s.parse().unwrap();
-            assert_eq!(
-                plain_decimal(s).map(f64::to_bits),
-                Some(want.to_bits()),
-                "{s}"
-            );
-        }
-        for s in [
-            "",
-            "-",
-            ".",
-            "1e5",
-            "1.2.3",
-            "inf",
-            "NaN",
-            "1,5",
-            "1234567890123456",
-            " 1",
-            "123456789012345678901234567",
-            "1..2",
-            "1.-2",
-            "-.",
-            "1.2e3",
-            "12 ",
-        ] {
-            assert_eq!(plain_decimal(s), None, "{s}");
         }
     }
 }
