@@ -87,7 +87,7 @@ pub fn rejected(message: impl Into<String>) -> anyhow::Error {
 }
 
 /// The message of an error and its causes, outermost first, joined by `: `, with the library's
-/// setting names shown as this program's flags ([`crate::cmd::flags`]). A cause whose text
+/// setting names shown as this program's flags (`cmd::flags`). A cause whose text
 /// the message already ends with is left out (an I/O error is part of its wrapper's text:
 /// `FILE: No such file or directory`, not `FILE: No such file...: No such file...`).
 pub fn message(e: &anyhow::Error) -> String {

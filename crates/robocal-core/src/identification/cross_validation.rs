@@ -8,7 +8,7 @@
 //! order. The left-out points are then evaluated exactly (forward kinematics) under the stepped
 //! model. The whole costs one pass over the data where refits cost several per fold, and none
 //! when the fit's own last pass summed the folds' shares (a model selection's candidates,
-//! [`Calibration::fold_passes`]).
+//! `Calibration::fold_passes`).
 //! [`cross_validate_refit`] iterates each fold's refit to convergence (warm-started from the full
 //! fit: same identified parameters, tracker frame and final loss); the tests hold the two
 //! together, and a fold whose step cannot be solved is refitted that way.
@@ -104,7 +104,7 @@ fn refit_fold(
 /// Cross-validates `cal` (fitted to `calibration`, the points as given to the calibration) over
 /// `folds` folds by pose: each fold's refit is one Newton step from the full fit on the normal
 /// equations of the other folds (see the module docs). Each fold's share of the normal equations
-/// comes from the fit's last pass when it summed them ([`Calibration::fold_passes`]), else from a
+/// comes from the fit's last pass when it summed them (`Calibration::fold_passes`), else from a
 /// pass of its own, the folds in parallel.
 pub fn cross_validate(
     cal: &Calibration,

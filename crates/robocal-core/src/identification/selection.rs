@@ -193,7 +193,7 @@ impl Families {
     }
 }
 
-/// Chooses the model the calibration data support among the [`candidates`] of `nominal` (see
+/// Chooses the model the calibration data support among the candidates of `nominal` (see
 /// the module docs). `settings.model` is ignored: each candidate is fitted as given.
 pub fn select(
     nominal: &Robot,

@@ -9,7 +9,7 @@
 //! per observation (k x k and k numbers; the stacked Jacobian is never formed) with per-thread
 //! buffers allocated once per pass, so the per-observation work allocates nothing. Passes run in
 //! fixed chunks, on several threads from a few hundred observations, with the same result bits
-//! on any number of threads ([`chunked`]).
+//! on any number of threads (`chunked`).
 
 use crate::frame::TrackerFrame;
 use crate::identification::kinds::{self, MeasurementKind, ToolState};
@@ -124,10 +124,10 @@ pub struct Accumulated {
     pub psi_sq: f64,
     /// The number of residual rows summed over (rows per observation times observations).
     pub rows: usize,
-    /// For a [`Problem::grouped`] problem at [`Level::Newton`] and above: each group's share of
+    /// For a `Problem::grouped` problem at [`Level::Newton`] and above: each group's share of
     /// the objective's Hessian `H` and of `b` (they sum to the whole's, up to rounding).
     pub groups: Option<Vec<(DMatrix<f64>, DVector<f64>)>>,
-    /// For a problem [`Problem::keeping_norms`]: each observation's weighted residual norm at
+    /// For a problem `Problem::keeping_norms`: each observation's weighted residual norm at
     /// the pass's model (its [`Problem::fit_norms`], to rounding).
     pub norms: Option<Vec<f64>>,
 }

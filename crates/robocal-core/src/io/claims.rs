@@ -4,7 +4,7 @@
 //! naming the first one's process, before it writes anything.
 //!
 //! A claim is an advisory lock (`flock`) on a lock file named after the output's absolute path
-//! in robocal's private directory ([`private_dir`]), never beside the outputs:
+//! in robocal's private directory (`private_dir`), never beside the outputs:
 //! nothing is created in the user's directories, and the operating system releases every lock
 //! when the process ends, however it ends. Claims are held until the process exits. Without
 //! Unix, claims are not made.

@@ -102,7 +102,7 @@ impl Robot {
     }
 
     /// Makes `p` a parameter of this model if its family allows (a Hayati tilt of an existing
-    /// joint; see [`ParameterFamily::enable`]); else does nothing.
+    /// joint; see [`crate::model::family::ParameterFamily::enable`]); else does nothing.
     pub fn enable_param(&mut self, p: Param) -> Result<()> {
         p.family().enable(self, p)
     }

@@ -51,7 +51,7 @@ pub struct ThermalModel {
     /// aluminium 2.3e-5).
     pub expansion_per_k: f64,
     /// How much each link warms relative to the arm's measured temperature (one factor per
-    /// link, within `0..=`[`MAX_LINK_GAIN`]): link j's lengths grow by
+    /// link, within `0..=MAX_LINK_GAIN`): link j's lengths grow by
     /// `exp(k g_j (T - ambient_c))`. `None`: every link as measured (`g_j` = 1), the arm warming
     /// evenly. Real arms warm unevenly (the links next to the motors and reducers more than the
     /// sensor's spot, a long cast link less); the calibration family `thermal` with one
@@ -107,8 +107,8 @@ impl ThermalModel {
 
     /// Checks every setting: temperatures within -50..150 deg C, a rise within -100..100 K,
     /// times positive (the start not negative) and below a year, the coefficient within
-    /// `0..=`[`MAX_EXPANSION_PER_K`], one link gain per joint of the robot (`dof`), each within
-    /// `0..=`[`MAX_LINK_GAIN`]. Errors name the setting (`thermal.FIELD`).
+    /// `0..=MAX_EXPANSION_PER_K`, one link gain per joint of the robot (`dof`), each within
+    /// `0..=MAX_LINK_GAIN`. Errors name the setting (`thermal.FIELD`).
     pub fn validate_for(&self, dof: usize) -> Result<()> {
         self.validate()?;
         let Some(g) = &self.link_gain else {

@@ -51,7 +51,7 @@ use unseen::{column_name, feature_advice, structural, unseen_family_parameters, 
 pub struct ConstraintOptions {
     /// Accept a result up to scale when the data have no known length (else an error).
     pub accept_unknown_scale: bool,
-    /// The structural analysis's rank tolerance ([`IdentifiabilityOptions::rank_tolerance`]).
+    /// The structural analysis's rank tolerance ([`crate::identification::identifiability::IdentifiabilityOptions::rank_tolerance`]).
     pub rank_tolerance: f64,
     /// A singular value of the column-scaled Jacobian below this times the largest is a
     /// direction the data do not see.

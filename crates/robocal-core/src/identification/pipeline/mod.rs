@@ -9,8 +9,8 @@
 //! `pose(tracker_frame) * m` compared with the calibrated model's tool point gives the "after"
 //! errors, for the calibration and for the validation points alike.
 
-//! Its steps, in order: [`inputs`] (checks), [`start`] (registration, tool fit, weights),
-//! [`identify`] (identifiability), [`stages`] (the solver runs), [`outcome`] (uncertainty,
+//! Its steps, in order: `inputs` (checks), `start` (registration, tool fit, weights),
+//! `identify` (identifiability), `stages` (the solver runs), `outcome` (uncertainty,
 //! errors, prediction, validation, the gate).
 
 mod identify;
@@ -48,7 +48,7 @@ pub struct CalibrationSettings {
     /// The objective (default: [`Objective::Adaptive`]; the paper's is
     /// [`Objective::SumOfNorms`]).
     pub objective: Objective,
-    /// Scale of the robust loss (mm); `None`: from the residuals (see [`RobustLoss`]).
+    /// Scale of the robust loss (mm); `None`: from the residuals (see [`crate::identification::objective::RobustLoss`]).
     pub robust_scale_mm: Option<f64>,
     /// Also fit and report the paper's affine Tr (eq. 8-11).
     pub affine_registration: bool,
@@ -129,7 +129,7 @@ pub struct Calibration {
     /// Points whose error exceeds the robust scale (Cauchy weight below 1/2, Huber weight below
     /// 1), largest error first.
     pub downweighted: Vec<DownWeighted>,
-    /// The plausibility gate's outcome (see [`plausibility`]): a converged fit that fails it is
+    /// The plausibility gate's outcome (see [`crate::identification::plausibility`]): a converged fit that fails it is
     /// not a calibration.
     pub plausibility: Plausibility,
     /// The settings used.
