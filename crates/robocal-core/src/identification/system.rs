@@ -449,10 +449,7 @@ impl<'a> Problem<'a> {
             let f = f * robot.target_tool_frame(t);
             (Some(*f.rotation.matrix()), f.translation.vector)
         } else {
-            (
-                None,
-                f.rotation * robot.target_tool_frame(t).translation.vector + f.translation.vector,
-            )
+            (None, robot.target_point_on(&f, t))
         };
         let tool = ToolState {
             point,

@@ -22,19 +22,26 @@ use crate::model::family::{self, PoseFrames, RigidPose};
 use crate::model::{mul_rot_z, Convention, JointType, Robot, MAX_JOINTS};
 use nalgebra::{Matrix3, Vector3};
 
+/// Calls the `<MIXED, N>` instance of a forward pass for the chain of `q`: all-revolute chains
+/// (the common case) run a loop without the per-joint type test, and six joints (the common
+/// arm) take arrays of their own size, nothing of a sixteen-joint buffer to clear and copy per
+/// pass; a chain with a prismatic joint takes the type test.
+macro_rules! for_chain {
+    ($robot:expr, $q:expr, $pass:ident($($arg:expr),*)) => {
+        match ($robot.joint_space().any_prismatic(), $q.len()) {
+            (false, 6) => $robot.$pass::<false, 6>($($arg),*),
+            (false, _) => $robot.$pass::<false, MAX_JOINTS>($($arg),*),
+            (true, _) => $robot.$pass::<true, MAX_JOINTS>($($arg),*),
+        }
+    };
+}
+
 impl Robot {
     /// The flange frame `pose(B) * T1(q1) * ... * Tn(qn)` (direct DH product).
     pub fn flange_pose(&self, q: &[f64]) -> Frame {
         let mut buf = [0.0; MAX_JOINTS];
         let q = self.deflected(q, &mut buf);
-        // All-revolute chains (the common case) run a loop without the per-joint type test.
-        // Six joints (the common arm) take arrays of their own size: nothing of a sixteen-joint
-        // buffer to clear and copy per pass.
-        match (self.joint_space().any_prismatic(), q.len()) {
-            (false, 6) => self.flange_pose_with::<false, 6>(q),
-            (false, _) => self.flange_pose_with::<false, MAX_JOINTS>(q),
-            (true, _) => self.flange_pose_with::<true, MAX_JOINTS>(q),
-        }
+        for_chain!(self, q, flange_pose_with(q))
     }
 
     #[inline(always)]
@@ -71,15 +78,20 @@ impl Robot {
 
     /// Target `t`'s tool point (mm, ACS; 0-based target).
     pub fn target_position(&self, q: &[f64], t: usize) -> Vector3<f64> {
-        let f = self.flange_pose(q);
+        self.target_point_on(&self.flange_pose(q), t)
+    }
+
+    /// Target `t`'s point (mm, ACS; 0-based) with the flange at `f`: the origin of
+    /// `f * pose(T0_t + T_t)`.
+    #[inline(always)]
+    pub(crate) fn target_point_on(&self, f: &Frame, t: usize) -> Vector3<f64> {
         f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector
     }
 
     /// The tool point (mm, base frame = ACS) at joint values `q` (rad): the paper's P_nom (eq. 1)
     /// for the nominal model.
     pub fn tool_position(&self, q: &[f64]) -> Vector3<f64> {
-        let f = self.flange_pose(q);
-        f.rotation * self.tool_frame().translation.vector + f.translation.vector
+        self.target_point_on(&self.flange_pose(q), 0)
     }
 
     /// The joint values forward kinematics evaluates: `q` itself, or `q + dq` when a family
@@ -143,14 +155,8 @@ impl Robot {
     /// families that deflect the joints, whose passes ([`Robot::pose_frames_target`]) fill them.
     #[inline]
     pub(crate) fn rigid_pose_frames_into(&self, q: &[f64], t: usize, out: &mut PoseFrames) {
-        match (self.joint_space().any_prismatic(), q.len()) {
-            (false, 6) => self.chain_into::<false, 6>(q, out),
-            (false, _) => self.chain_into::<false, MAX_JOINTS>(q, out),
-            (true, _) => self.chain_into::<true, MAX_JOINTS>(q, out),
-        }
-        let f = &out.flange;
-        out.point =
-            f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
+        for_chain!(self, q, chain_into(q, out));
+        out.point = self.target_point_on(&out.flange, t);
         out.target = t;
         out.rigid.conditions = crate::model::Conditions::UNKNOWN;
     }
@@ -185,14 +191,15 @@ impl Robot {
     /// The joint axes and the tool point at exactly the joint values `q`, without deflection: a
     /// lean forward pass for the families that deflect the joints.
     pub fn rigid_pose(&self, q: &[f64]) -> RigidPose {
+        for_chain!(self, q, rigid_pose_with(q))
+    }
+
+    #[inline(always)]
+    fn rigid_pose_with<const MIXED: bool, const N: usize>(&self, q: &[f64]) -> RigidPose {
         assert_eq!(q.len(), self.dof(), "joint vector length");
         let mut out = RigidPose::default();
         out.commanded[..q.len()].copy_from_slice(q);
-        let motion = if self.joint_space().any_prismatic() {
-            self.joint_motions::<true, MAX_JOINTS>(q)
-        } else {
-            self.joint_motions::<false, MAX_JOINTS>(q)
-        };
+        let motion = self.joint_motions::<MIXED, N>(q);
         let mut f = *self.base_frame();
         for i in 0..q.len() {
             let (s, co, d) = motion.of(i);
@@ -205,7 +212,7 @@ impl Robot {
                 self.apply_link_constant(i, &mut f);
             }
         }
-        out.point = f.rotation * self.tool_frame().translation.vector + f.translation.vector;
+        out.point = self.target_point_on(&f, 0);
         out
     }
 
@@ -290,9 +297,7 @@ impl Robot {
     /// included: it does not depend on the target), the point of target `t`. Several
     /// reflectors measured at one pose share one pass this way.
     pub(crate) fn retarget(&self, pose: &mut PoseFrames, t: usize) {
-        let f = &pose.flange;
-        pose.point =
-            f.rotation * self.target_tool_frame(t).translation.vector + f.translation.vector;
+        pose.point = self.target_point_on(&pose.flange, t);
         pose.target = t;
     }
 

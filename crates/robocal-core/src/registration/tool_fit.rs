@@ -95,10 +95,7 @@ pub(crate) fn tool_points(
         flanges
             .iter()
             .enumerate()
-            .map(|(i, f)| {
-                f.rotation * robot.target_tool_frame(obs.target(i)).translation.vector
-                    + f.translation.vector
-            })
+            .map(|(i, f)| robot.target_point_on(f, obs.target(i)))
             .collect(),
     )
 }
