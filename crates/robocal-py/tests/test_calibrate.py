@@ -192,3 +192,17 @@ def test_explicit_families_that_overfit_warn(ur5):
     assert "overfitting" in sel["remark"]
     ref = [c for c in sel["candidates"] if c.get("reference")]
     assert len(ref) == 1 and ref[0]["families"] == []
+
+
+def test_screened_candidates_carry_their_estimates(ur5):
+    # The default model choice on the example's geometric 60 points: the families, far from
+    # lowering the geometric model's error, are estimated from its fit and not fitted. They are
+    # marked, keep their cross-validated estimates, and are not the choice (as the CLI's table).
+    res = robocal.calibrate_files(ur5, example("data/ur5-cell.csv"))
+    cands = res.model_selection["candidates"]
+    screened = [c for c in cands if c.get("screened")]
+    assert [c["families"] for c in screened] == [["compliance"], ["harmonics 1"]], cands
+    chosen = [c for c in cands if c["chosen"]]
+    assert len(chosen) == 1 and chosen[0]["families"] == [] and not chosen[0].get("screened")
+    for c in screened:
+        assert not c["chosen"] and c["cv_mean_mm"] > 0 and c["cv_std_error_mm"] > 0

@@ -44,6 +44,10 @@ pub(crate) fn print_selection(
             match (&c.rejected, c.reference) {
                 (Some(r), _) => format!("  not selectable: {r}"),
                 (None, true) => "  (reference: the families given are fixed)".into(),
+                (None, false) if c.screened => {
+                    "  (estimated from the fit it extends: far from lowering its error, not fitted)"
+                        .into()
+                }
                 (None, false) => String::new(),
             }
         )?;

@@ -14,10 +14,11 @@
 //! together, and a fold whose step cannot be solved is refitted that way.
 
 use crate::error::Result;
+use crate::frame::TrackerFrame;
 use crate::identification::pipeline::Calibration;
 use crate::identification::solver::{solve, undamped_step, SolverOptions};
 use crate::identification::system::{Level, Problem};
-use crate::model::Robot;
+use crate::model::{Param, Robot};
 use crate::observations::{Observations, Weighting};
 use nalgebra::{DMatrix, DVector};
 use rayon::prelude::*;
@@ -71,7 +72,7 @@ pub fn cross_validate_refit(
 }
 
 /// The calibration points with the weights the fit gave them.
-fn weighted(cal: &Calibration, calibration: &Observations) -> Result<Observations> {
+pub(crate) fn weighted(cal: &Calibration, calibration: &Observations) -> Result<Observations> {
     Weighting {
         tracker: cal.weighting.tracker,
         ..cal.settings.weighting
@@ -156,18 +157,9 @@ pub fn cross_validate(
     let runs: Vec<Result<(Vec<f64>, bool)>> = (0..parts.len())
         .into_par_iter()
         .map(|p| {
-            let (f, test, (hf, bf)) = &parts[p];
-            let h_train = &h - hf;
-            let b_train = &b - bf;
-            match undamped_step(&h_train, &b_train) {
-                Some(step) => {
-                    let problem = Problem::new(robot, params, test, &cal.frame);
-                    let mut stepped: Robot = robot.clone();
-                    problem.apply(&mut stepped, &(problem.values(robot) + step));
-                    let errors =
-                        Problem::new(&stepped, &[], test, &cal.frame).error_norms(&stepped);
-                    Ok((errors, true))
-                }
+            let (f, test, share) = &parts[p];
+            match stepped_errors(robot, params, &cal.frame, test, (&h, &b), share) {
+                Some(errors) => Ok((errors, true)),
                 // Not positive definite (a fold whose removal leaves a parameter
                 // undetermined, or a loss whose curvature turns): the refit decides.
                 None => refit_fold(cal, &weighted, &fold, *f, test),
@@ -175,6 +167,24 @@ pub fn cross_validate(
         })
         .collect();
     summarize(runs)
+}
+
+/// The position errors of a fold's points `test` under one Newton step from `robot` (over
+/// `params`) on the normal equations of the other folds: the whole's `(h, b)` minus the fold's
+/// `share`. `None` when the step cannot be solved (not positive definite).
+pub(crate) fn stepped_errors(
+    robot: &Robot,
+    params: &[Param],
+    frame: &TrackerFrame,
+    test: &Observations,
+    (h, b): (&DMatrix<f64>, &DVector<f64>),
+    share: &(DMatrix<f64>, DVector<f64>),
+) -> Option<Vec<f64>> {
+    let step = undamped_step(&(h - &share.0), &(b - &share.1))?;
+    let problem = Problem::new(robot, params, test, frame);
+    let mut stepped: Robot = robot.clone();
+    problem.apply(&mut stepped, &(problem.values(robot) + step));
+    Some(Problem::new(&stepped, &[], test, frame).error_norms(&stepped))
 }
 
 /// A fold: its index, its points and their share of the objective's Hessian and gradient.

@@ -39,6 +39,7 @@ pub mod plausibility;
 pub mod precision;
 pub mod prediction;
 pub mod report;
+pub mod screen;
 pub mod selection;
 pub mod set_errors;
 pub(crate) mod simd;

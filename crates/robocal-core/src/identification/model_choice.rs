@@ -55,6 +55,10 @@ pub struct Candidate {
     pub rejected: Option<String>,
     /// Whether it is the chosen model.
     pub chosen: bool,
+    /// Whether its cross-validated error is estimated from the fit of the model it extends
+    /// instead of a fit of its own ([`crate::identification::screen`]): far from lowering that
+    /// model's error, it was not fitted (it is never the chosen model).
+    pub screened: bool,
     /// A model compared but never chosen: the geometric model, beside families the user gave
     /// explicitly, to tell whether they lower the error at all ([`ModelSelection::remark`]).
     pub reference: bool,

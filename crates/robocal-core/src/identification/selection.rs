@@ -11,8 +11,13 @@
 //! of families that earned their place, and a geometric robot costs the robot as given and one
 //! round of single families.
 //!
-//! Each candidate is fitted once to all calibration points (the whole calibration, plausibility
-//! gate included) and cross-validated over [`FOLDS`] folds by pose (see
+//! Each candidate is first screened ([`crate::identification::screen`]): its cross-validated
+//! error estimated by one Newton step from the fit of the model it extends, at the cost of one
+//! pass over the data. One whose estimate stays [`SCREEN_MARGIN`] of the current model's standard
+//! errors away from lowering its error is not fitted: it keeps its estimate, marked
+//! [`Candidate::screened`], and is never the choice (one the choice would pick is fitted first).
+//! Every other candidate is fitted once to all calibration points (the whole calibration,
+//! plausibility gate included) and cross-validated over [`FOLDS`] folds by pose (see
 //! [`super::cross_validation`]: one Newton step from the full fit on the other folds' normal
 //! equations). Rows of one pose (several reflectors, 6-DoF rows) stay in one fold. The
 //! candidate's cross-validated error is the mean position error of every calibration point
@@ -34,9 +39,10 @@ pub use crate::identification::model_choice::{
     AutoFamilies, Candidate, ModelChoice, ModelSelection,
 };
 use crate::identification::pipeline::{
-    calibrate_model, calibrate_model_for, complete, Calibration, CalibrationData,
-    CalibrationSettings, Purpose, Shared,
+    calibrate_model, calibrate_model_for, complete, identified_params, Calibration,
+    CalibrationData, CalibrationSettings, Purpose, Shared,
 };
+use crate::identification::screen::{screen, SCREEN_MARGIN};
 use crate::model::family::{backlash, compliance, thermal, transmission};
 use crate::model::Robot;
 use crate::progress::{self, Observer};
@@ -234,10 +240,19 @@ fn select_fitted(
     let widest = Families::widest(auto, !compliance::auto_joints(nominal).is_empty())
         .robot(nominal, reference_c)?;
     let shared = Shared::new(&given, &widest, data, &fit_settings)?;
-    let fit = |robot: &Robot, reference: bool| -> (Candidate, Option<Calibration>) {
+    let fit = |robot: &Robot,
+               reference: bool,
+               from: Option<(&Calibration, &Candidate)>|
+     -> (Candidate, Option<Calibration>) {
         let shared = shared
             .same_tool_points(robot, data.calibration)
             .then_some(&shared);
+        let screened = from.and_then(|(current, judged)| {
+            screen_candidate(current, judged, robot, data, &fit_settings, shared)
+        });
+        if let Some(c) = screened {
+            return (c, None);
+        }
         match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &(), shared) {
             Err(e) => {
                 let mut cand = Candidate::new(robot, reference);
@@ -257,8 +272,37 @@ fn select_fitted(
     search(nominal, auto, reference_c, given_fit, &fit)
 }
 
-/// Fits and judges one candidate model for [`search`] (`true`: the reference candidate).
-pub(crate) type FitCandidate<'a, T> = dyn Fn(&Robot, bool) -> (Candidate, Option<T>) + Sync + 'a;
+/// `robot`, a candidate with one family more than the model of `current` (its fit) and
+/// `judged` (its candidate), screened (see [`crate::identification::screen`]): the candidate
+/// with its estimated cross-validated error when that stays [`SCREEN_MARGIN`] standard errors of
+/// `judged` from lowering its error; `None` when it is to be fitted (it may lower the error, or
+/// the estimate cannot be made).
+fn screen_candidate(
+    current: &Calibration,
+    judged: &Candidate,
+    robot: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    shared: Option<&Shared>,
+) -> Option<Candidate> {
+    let (mean, se) = (judged.cv_mean_mm?, judged.cv_std_error_mm?);
+    let params = identified_params(robot, data, settings, shared).ok()?;
+    let cv = screen(current, robot, &params, data.calibration, FOLDS).ok()??;
+    let far = cv.mean_mm + cv.std_error_mm >= mean + SCREEN_MARGIN * se;
+    (far && cv.mean_mm.is_finite() && cv.std_error_mm.is_finite()).then(|| Candidate {
+        identified: params.len(),
+        cv_mean_mm: Some(cv.mean_mm),
+        cv_std_error_mm: Some(cv.std_error_mm),
+        screened: true,
+        ..Candidate::new(robot, false)
+    })
+}
+
+/// Fits and judges one candidate model for [`search`] (`true`: the reference candidate). Given
+/// the fit and the candidate of the model it extends, it may screen it first: then the
+/// candidate with its estimated error ([`Candidate::screened`]) when it need not be fitted.
+pub(crate) type FitCandidate<'a, T> =
+    dyn Fn(&Robot, bool, Option<(&T, &Candidate)>) -> (Candidate, Option<T>) + Sync + 'a;
 
 /// The forward search and the choice (see the module docs) over candidates that `fit` fits and
 /// judges (a [`Candidate`] with its cross-validated error, or rejected, and the fit when it
@@ -266,8 +310,9 @@ pub(crate) type FitCandidate<'a, T> = dyn Fn(&Robot, bool) -> (Candidate, Option
 /// constraint rows in [`crate::identification::constraint::selection`]. `auto` names the
 /// families to try (those the data cannot support already left out); `given` fits the robot as
 /// given, whose failure is the calibration's; thermal candidates are referred to
-/// `reference_c`.
-pub(crate) fn search<T: Send>(
+/// `reference_c`. `fit` may screen a candidate instead of fitting it (given the model it
+/// extends); a screened candidate the choice would pick is fitted after all.
+pub(crate) fn search<T: Send + Sync>(
     nominal: &Robot,
     auto: AutoFamilies,
     reference_c: Option<f64>,
@@ -296,8 +341,9 @@ pub(crate) fn search<T: Send>(
             .iter()
             .map(|f| f.robot(nominal, reference_c))
             .collect::<Result<_>>()?;
+        let from = fits[current].as_ref().map(|f| (f, &candidates[current]));
         let outcomes: Vec<(Candidate, Option<T>)> =
-            built.par_iter().map(|r| fit(r, false)).collect();
+            built.par_iter().map(|r| fit(r, false, from)).collect();
         let first = candidates.len();
         for ((f, r), o) in next.into_iter().zip(built).zip(outcomes) {
             let (c, fitted) = o;
@@ -318,12 +364,19 @@ pub(crate) fn search<T: Send>(
     // whether they lower the error at all.
     if !families(nominal).is_empty() {
         let geometric = nominal.geometric();
-        let (c, _) = fit(&geometric, true);
+        let (c, _) = fit(&geometric, true, None);
         robots.push(geometric);
         candidates.push(c);
         fits.push(None);
     }
-    let chosen = choose(&candidates);
+    // A screened candidate is only ever a loser: one the choice would pick is fitted first.
+    let mut chosen = choose(&candidates);
+    while candidates[chosen].screened {
+        let (c, f) = fit(&robots[chosen], false, None);
+        candidates[chosen] = c;
+        fits[chosen] = f;
+        chosen = choose(&candidates);
+    }
     candidates[chosen].chosen = true;
     let selection = ModelSelection {
         folds: FOLDS,
@@ -391,6 +444,7 @@ impl Candidate {
             cv_std_error_mm: None,
             rejected: None,
             chosen: false,
+            screened: false,
             reference,
         }
     }
@@ -470,6 +524,7 @@ mod tests {
             cv_std_error_mm: Some(se),
             rejected: rejected.then(|| "no".into()),
             chosen: false,
+            screened: false,
             reference: false,
         }
     }

@@ -22,6 +22,10 @@ pub struct CandidateEntry {
     pub rejected: Option<String>,
     /// Whether it is the chosen model.
     pub chosen: bool,
+    /// Its cross-validated error estimated from the fit of the model it extends, not fitted
+    /// (far from lowering that model's error).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub screened: bool,
     /// A model compared but never chosen (the geometric model beside explicit families).
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub reference: bool,
@@ -57,6 +61,7 @@ impl ModelSelectionSection {
                     cv_std_error_mm: c.cv_std_error_mm,
                     rejected: c.rejected.clone(),
                     chosen: c.chosen,
+                    screened: c.screened,
                     reference: c.reference,
                 })
                 .collect(),

@@ -47,7 +47,11 @@ pub fn select(
         thermal: auto.thermal && reference_c.is_some(),
         ..auto
     };
-    let fit = |robot: &Robot, reference: bool| -> (Candidate, Option<ConstraintCalibration>) {
+    // Constraint candidates are fitted, none screened.
+    let fit = |robot: &Robot,
+               reference: bool,
+               _from: Option<(&ConstraintCalibration, &Candidate)>|
+     -> (Candidate, Option<ConstraintCalibration>) {
         match calibrate_constraints(robot, data, opts) {
             Err(e) => {
                 let mut c = Candidate::new(robot, reference);

@@ -35,7 +35,7 @@ use crate::identification::prediction::Prediction;
 pub use crate::identification::set_errors::{DownWeighted, SetErrors};
 use crate::identification::solver::{SolverOptions, SolverReport};
 use crate::identification::system::Problem;
-use crate::model::Robot;
+use crate::model::{Param, Robot};
 use crate::observations::AppliedWeighting;
 use crate::observations::Observations;
 use crate::observations::Weighting;
@@ -272,6 +272,35 @@ pub(crate) fn calibrate_model_for(
     }
     c.settings = settings.clone();
     Ok(c)
+}
+
+/// The parameters a calibration of `nominal` would identify (the start and identifiability steps
+/// of [`calibrate_model_for`], without the solve): what a model selection's screened candidate
+/// is estimated over ([`crate::identification::screen`]). `shared` as for
+/// [`calibrate_model_for`].
+pub(crate) fn identified_params(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    shared: Option<&Shared>,
+) -> Result<Vec<Param>> {
+    let own;
+    let registered = match shared {
+        Some(s) => &s.registered,
+        None => {
+            own = start::register_nominal(nominal, &data, settings, &())?;
+            &own
+        }
+    };
+    let start = start::prepare(nominal, &data, settings, registered)?;
+    let identified = identify::identifiable(
+        nominal,
+        &start,
+        &settings.identifiability,
+        &(),
+        shared.and_then(|s| s.candidate(&start.robot)),
+    )?;
+    Ok(identified.identifiability.identified)
 }
 
 /// One calibration of the model as given, from the frame and tools `registered` (and the start
