@@ -39,12 +39,12 @@ pub use crate::identification::model_choice::{
     AutoFamilies, Candidate, ModelChoice, ModelSelection,
 };
 use crate::identification::pipeline::{
-    calibrate_model, calibrate_model_for, complete, identified_params, Calibration,
+    begin_for, calibrate_model, calibrate_model_for, calibrate_model_from, complete, Calibration,
     CalibrationData, CalibrationSettings, Purpose, Shared,
 };
 use crate::identification::screen::{screen, SCREEN_MARGIN};
 use crate::model::family::{backlash, compliance, thermal, transmission};
-use crate::model::Robot;
+use crate::model::{Param, Robot};
 use crate::progress::{self, Observer};
 use rayon::prelude::*;
 
@@ -247,13 +247,19 @@ fn select_fitted(
         let shared = shared
             .same_tool_points(robot, data.calibration)
             .then_some(&shared);
-        let screened = from.and_then(|(current, judged)| {
-            screen_candidate(current, judged, robot, data, &fit_settings, shared)
-        });
-        if let Some(c) = screened {
-            return (c, None);
+        // Screened first when the model it extends stands: spared its fit, or fitted from the
+        // screen's start and identifiability steps (a failed step is the fit's to report).
+        let mut begun = None;
+        if let Some((current, judged)) = from {
+            if let Ok(b) = begin_for(robot, data, &fit_settings, shared) {
+                if let Some(c) = screen_candidate(current, judged, robot, b.params(), data) {
+                    return (c, None);
+                }
+                begun = Some(b);
+            }
         }
-        match calibrate_model_for(robot, data, &fit_settings, Purpose::Candidate, &(), shared) {
+        let purpose = Purpose::Candidate;
+        match calibrate_model_from(robot, data, &fit_settings, purpose, &(), shared, begun) {
             Err(e) => {
                 let mut cand = Candidate::new(robot, reference);
                 cand.rejected = Some(format!("the fit failed: {e}"));
@@ -273,21 +279,19 @@ fn select_fitted(
 }
 
 /// `robot`, a candidate with one family more than the model of `current` (its fit) and
-/// `judged` (its candidate), screened (see [`crate::identification::screen`]): the candidate
-/// with its estimated cross-validated error when that stays [`SCREEN_MARGIN`] standard errors of
-/// `judged` from lowering its error; `None` when it is to be fitted (it may lower the error, or
-/// the estimate cannot be made).
+/// `judged` (its candidate), identifying `params`, screened (see
+/// [`crate::identification::screen`]): the candidate with its estimated cross-validated error
+/// when that stays [`SCREEN_MARGIN`] standard errors of `judged` from lowering its error; `None`
+/// when it is to be fitted (it may lower the error, or the estimate cannot be made).
 fn screen_candidate(
     current: &Calibration,
     judged: &Candidate,
     robot: &Robot,
+    params: &[Param],
     data: CalibrationData,
-    settings: &CalibrationSettings,
-    shared: Option<&Shared>,
 ) -> Option<Candidate> {
     let (mean, se) = (judged.cv_mean_mm?, judged.cv_std_error_mm?);
-    let params = identified_params(robot, data, settings, shared).ok()?;
-    let cv = screen(current, robot, &params, data.calibration, FOLDS).ok()??;
+    let cv = screen(current, robot, params, data.calibration, FOLDS).ok()??;
     let far = cv.mean_mm + cv.std_error_mm >= mean + SCREEN_MARGIN * se;
     (far && cv.mean_mm.is_finite() && cv.std_error_mm.is_finite()).then(|| Candidate {
         identified: params.len(),

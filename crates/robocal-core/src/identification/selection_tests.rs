@@ -405,7 +405,7 @@ fn the_completed_candidate_is_the_chosen_models_own_calibration() {
 fn the_screen_estimates_the_candidates_own_cross_validation() {
     use crate::identification::cross_validation::cross_validate;
     use crate::identification::folds::FOLDS;
-    use crate::identification::pipeline::{calibrate_model_for, identified_params, Purpose};
+    use crate::identification::pipeline::{begin_for, calibrate_model_for, Purpose};
     use crate::identification::screen::{screen, SCREEN_MARGIN};
     use crate::model::family::compliance;
     let truth = preset("kuka-kr480-r3330-table3").unwrap();
@@ -436,7 +436,8 @@ fn the_screen_estimates_the_candidates_own_cross_validation() {
             "seed {seed}: {again:?} {own:?}"
         );
         for (name, model) in [("harmonics 1", &harmonic), ("compliance", &compliant)] {
-            let params = identified_params(model, data, &settings, None).unwrap();
+            let begun = begin_for(model, data, &settings, None).unwrap();
+            let params = begun.params().to_vec();
             let full = fit(model).unwrap();
             assert_eq!(
                 params, full.identifiability.identified,

@@ -15,7 +15,7 @@ use crate::model::Robot;
 use crate::progress::{self, Observer};
 
 /// The identifiable parameters, and why the covariance will be unavailable if it will.
-pub(super) struct Identified {
+pub(crate) struct Identified {
     /// Which parameters are identified, which fixed and why.
     pub identifiability: Identifiability,
     /// Set when the identified parameters are too nearly dependent for the covariance to have

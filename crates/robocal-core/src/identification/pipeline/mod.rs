@@ -234,6 +234,20 @@ pub(crate) fn calibrate_model_for(
     observer: &dyn Observer,
     shared: Option<&Shared>,
 ) -> Result<Calibration> {
+    calibrate_model_from(nominal, data, settings, purpose, observer, shared, None)
+}
+
+/// [`calibrate_model_for`] from its start and identifiability steps when they were taken
+/// already (`begun`, by [`begin_for`] with the same inputs: a screened candidate's).
+pub(crate) fn calibrate_model_from(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    purpose: Purpose,
+    observer: &dyn Observer,
+    shared: Option<&Shared>,
+    begun: Option<Begun>,
+) -> Result<Calibration> {
     inputs::check(nominal, &data, settings)?;
     let own;
     let registered = match shared {
@@ -243,9 +257,11 @@ pub(crate) fn calibrate_model_for(
             &own
         }
     };
-    let first = calibrate_once(
-        nominal, data, settings, purpose, observer, registered, shared,
-    )?;
+    let begun = match begun {
+        Some(b) => b,
+        None => begin(nominal, &data, settings, observer, registered, shared)?,
+    };
+    let first = calibrate_once(nominal, data, settings, purpose, observer, begun, shared)?;
     let start = if first.tool_fit.applied {
         first.tool_fit.apply(nominal)
     } else {
@@ -260,7 +276,8 @@ pub(crate) fn calibrate_model_for(
         .identifiability
         .fix
         .extend(held.iter().map(|h| h.param));
-    let mut c = calibrate_once(nominal, data, &again, purpose, observer, registered, shared)?;
+    let begun = begin(nominal, &data, &again, observer, registered, shared)?;
+    let mut c = calibrate_once(nominal, data, &again, purpose, observer, begun, shared)?;
     for f in &mut c.identifiability.fixed {
         if let Some(h) = held.iter().find(|h| h.param == f.param) {
             f.reason = FixReason::AtBound {
@@ -274,16 +291,32 @@ pub(crate) fn calibrate_model_for(
     Ok(c)
 }
 
-/// The parameters a calibration of `nominal` would identify (the start and identifiability steps
-/// of [`calibrate_model_for`], without the solve): what a model selection's screened candidate
-/// is estimated over ([`crate::identification::screen`]). `shared` as for
-/// [`calibrate_model_for`].
-pub(crate) fn identified_params(
+/// A calibration's first two steps taken: the start model and which parameters it identifies.
+pub(crate) struct Begun {
+    start: start::StartModel,
+    identified: identify::Identified,
+}
+
+impl Begun {
+    /// The parameters the calibration identifies.
+    pub fn params(&self) -> &[Param] {
+        &self.identified.identifiability.identified
+    }
+}
+
+/// The start and identifiability steps of a calibration of `nominal` (those of
+/// [`calibrate_model_for`] with the same inputs), for a model selection's candidate that is
+/// screened first ([`crate::identification::screen`]) and fitted from them when it is not
+/// spared ([`calibrate_model_from`]).
+pub(crate) fn begin_for(
     nominal: &Robot,
     data: CalibrationData,
     settings: &CalibrationSettings,
     shared: Option<&Shared>,
-) -> Result<Vec<Param>> {
+) -> Result<Begun> {
+    // The inputs are checked by the fit that uses these steps ([`calibrate_model_from`]): a
+    // step that fails here on unchecked inputs only means the candidate is fitted, and the fit
+    // reports them.
     let own;
     let registered = match shared {
         Some(s) => &s.registered,
@@ -292,36 +325,45 @@ pub(crate) fn identified_params(
             &own
         }
     };
-    let start = start::prepare(nominal, &data, settings, registered)?;
-    let identified = identify::identifiable(
-        nominal,
-        &start,
-        &settings.identifiability,
-        &(),
-        shared.and_then(|s| s.candidate(&start.robot)),
-    )?;
-    Ok(identified.identifiability.identified)
+    begin(nominal, &data, settings, &(), registered, shared)
 }
 
-/// One calibration of the model as given, from the frame and tools `registered` (and the start
-/// passes `shared`, when given): its steps, each a function of its own.
-fn calibrate_once(
+/// The start model from the frame and tools `registered`, and its identifiable parameters.
+fn begin(
     nominal: &Robot,
-    data: CalibrationData,
+    data: &CalibrationData,
     settings: &CalibrationSettings,
-    purpose: Purpose,
     observer: &dyn Observer,
     registered: &start::Registered,
     shared: Option<&Shared>,
-) -> Result<Calibration> {
-    let start = start::prepare(nominal, &data, settings, registered)?;
-    let mut identified = identify::identifiable(
+) -> Result<Begun> {
+    let start = start::prepare(nominal, data, settings, registered)?;
+    let identified = identify::identifiable(
         nominal,
         &start,
         &settings.identifiability,
         observer,
         shared.and_then(|s| s.candidate(&start.robot)),
     )?;
+    Ok(Begun { start, identified })
+}
+
+/// One calibration of the model as given, from its start model and identifiable parameters
+/// (`begun`; the gate's shape checks from `shared`, when given): its steps, each a function of
+/// its own.
+fn calibrate_once(
+    nominal: &Robot,
+    data: CalibrationData,
+    settings: &CalibrationSettings,
+    purpose: Purpose,
+    observer: &dyn Observer,
+    begun: Begun,
+    shared: Option<&Shared>,
+) -> Result<Calibration> {
+    let Begun {
+        start,
+        mut identified,
+    } = begun;
     let solved = {
         let problem = Problem::new(
             &start.robot,
