@@ -45,8 +45,7 @@ pub(crate) fn print_selection(
                 (Some(r), _) => format!("  not selectable: {r}"),
                 (None, true) => "  (reference: the families given are fixed)".into(),
                 (None, false) if c.screened => {
-                    "  (estimated from the fit it extends: far from lowering its error, not fitted)"
-                        .into()
+                    "  (screened: estimated from the model it extends, not fitted)".into()
                 }
                 (None, false) => String::new(),
             }

@@ -133,11 +133,39 @@ pub fn cross_validate(
             .groups
             .expect("a grouped Newton pass"),
     };
+    let cv = one_step_folds(
+        robot,
+        params,
+        &cal.frame,
+        &weighted,
+        &fold,
+        shares,
+        // Not positive definite (a fold whose removal leaves a parameter undetermined, or a
+        // loss whose curvature turns): the refit decides.
+        |f, test| refit_fold(cal, &weighted, &fold, f, test).map(Some),
+    )?;
+    Ok(cv.expect("every fold's errors"))
+}
+
+/// The cross-validation of one Newton step per fold from `robot` (over `params`): the points of
+/// `weighted` in fold `f` (`fold[i] == f`) evaluated under the step on the normal equations of
+/// the other folds (the sum of `shares`, each fold's, minus its own), the folds in parallel. A
+/// fold whose step cannot be solved goes to `unsolved`: its errors and whether they converged,
+/// or `None` to give the whole up (then `None`).
+pub(crate) fn one_step_folds(
+    robot: &Robot,
+    params: &[Param],
+    frame: &TrackerFrame,
+    weighted: &Observations,
+    fold: &[usize],
+    shares: Vec<(DMatrix<f64>, DVector<f64>)>,
+    unsolved: impl Fn(usize, &Observations) -> Result<Option<FoldErrors>> + Sync,
+) -> Result<Option<CrossValidation>> {
     let parts: Vec<Result<Option<Part>>> = shares
         .into_par_iter()
         .enumerate()
         .map(|(f, share)| {
-            let test = subset(&weighted, |i| fold[i] == f)?;
+            let test = subset(weighted, |i| fold[i] == f)?;
             Ok((!test.is_empty()).then_some((f, test, share)))
         })
         .collect();
@@ -154,25 +182,30 @@ pub fn cross_validate(
         h += hf;
         b += bf;
     }
-    let runs: Vec<Result<(Vec<f64>, bool)>> = (0..parts.len())
+    let runs: Vec<Result<Option<FoldErrors>>> = (0..parts.len())
         .into_par_iter()
         .map(|p| {
             let (f, test, share) = &parts[p];
-            match stepped_errors(robot, params, &cal.frame, test, (&h, &b), share) {
-                Some(errors) => Ok((errors, true)),
-                // Not positive definite (a fold whose removal leaves a parameter
-                // undetermined, or a loss whose curvature turns): the refit decides.
-                None => refit_fold(cal, &weighted, &fold, *f, test),
+            match stepped_errors(robot, params, frame, test, (&h, &b), share) {
+                Some(errors) => Ok(Some((errors, true))),
+                None => unsolved(*f, test),
             }
         })
         .collect();
-    summarize(runs)
+    let mut folds = Vec::with_capacity(runs.len());
+    for r in runs {
+        match r? {
+            Some(e) => folds.push(Ok(e)),
+            None => return Ok(None),
+        }
+    }
+    summarize(folds).map(Some)
 }
 
 /// The position errors of a fold's points `test` under one Newton step from `robot` (over
 /// `params`) on the normal equations of the other folds: the whole's `(h, b)` minus the fold's
 /// `share`. `None` when the step cannot be solved (not positive definite).
-pub(crate) fn stepped_errors(
+fn stepped_errors(
     robot: &Robot,
     params: &[Param],
     frame: &TrackerFrame,
@@ -186,6 +219,9 @@ pub(crate) fn stepped_errors(
     problem.apply(&mut stepped, &(problem.values(robot) + step));
     Some(Problem::new(&stepped, &[], test, frame).error_norms(&stepped))
 }
+
+/// A fold's left-out errors and whether its refit converged.
+type FoldErrors = (Vec<f64>, bool);
 
 /// A fold: its index, its points and their share of the objective's Hessian and gradient.
 type Part = (usize, Observations, (DMatrix<f64>, DVector<f64>));

@@ -44,7 +44,8 @@ impl Default for AutoFamilies {
 pub struct Candidate {
     /// Its non-geometric families, e.g. `["compliance", "harmonics 2"]` (empty: geometric).
     pub families: Vec<String>,
-    /// Parameters its full fit identified.
+    /// Parameters its full fit identified (a screened candidate's: those its fit would start
+    /// from, before any compliance held at its bound).
     pub identified: usize,
     /// Cross-validated mean position error (mm); `None` when the candidate was rejected before
     /// (its full fit failed, did not converge or failed the plausibility gate).

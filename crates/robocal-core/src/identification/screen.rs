@@ -13,27 +13,28 @@
 //! candidate is fitted.
 //!
 //! [`crate::identification::selection`] fits every candidate whose estimate comes within
-//! [`SCREEN_MARGIN`] of its standard error of lowering the current model's error, and any
-//! screened candidate the choice would pick: a screened candidate only ever loses, with its
-//! estimate in the table.
+//! [`SCREEN_MARGIN`] of the current model's standard errors of lowering its error. A screened
+//! candidate keeps its estimate in the table and takes part in the choice with it, as its fit
+//! would with its cross-validated error; it is never the choice, and one whose fit could turn the
+//! choice or the search (see `selection::search`) is fitted after all.
 
 use crate::error::Result;
 use crate::identification::cross_validation::{
-    pose_folds, stepped_errors, subset, summarize, weighted, CrossValidation,
+    one_step_folds, pose_folds, weighted, CrossValidation,
 };
+use crate::identification::folds::FOLDS;
+use crate::identification::model_choice::Candidate;
 use crate::identification::pipeline::Calibration;
 use crate::identification::system::{Level, Problem};
 use crate::model::{Param, Robot};
 use crate::observations::Observations;
-use nalgebra::{DMatrix, DVector};
-use rayon::prelude::*;
 
 /// How far (in the current model's standard errors) a candidate's estimate must stay from
 /// lowering the current model's error for the candidate to go unfitted: it is fitted when its
 /// estimated error plus its standard error is below the current model's error plus this many
-/// of its standard errors. The estimate's own error is a small fraction of this: measured, at
-/// most 3e-5 standard errors where the model fits the data, 0.03 to 0.06 where it misses them
-/// by far (harmonics on a sagging arm; the real WAM's 2 mm), and the tests hold it.
+/// of its standard errors. The estimate's own error is a small fraction of this: at most 3e-5
+/// standard errors where the model fits the data and 0.03 where it misses their sag (harmonics
+/// on a sagging arm; the tests hold both), 0.06 measured on the real WAM (a model 2 mm off).
 pub const SCREEN_MARGIN: f64 = 0.5;
 
 /// The cross-validated error of `candidate` (the model `current` was fitted with, one family
@@ -58,49 +59,48 @@ pub fn screen(
     else {
         return Ok(None);
     };
-    let k = params.len();
-    let mut h = DMatrix::zeros(k, k);
-    let mut b = DVector::zeros(k);
-    for (hf, bf) in &shares {
-        h += hf;
-        b += bf;
-    }
-    // Each fold's left-out errors; `None` for a fold whose step cannot be solved.
-    let runs: Vec<Result<Option<Vec<f64>>>> = shares
-        .par_iter()
-        .enumerate()
-        .map(|(f, share)| {
-            let test = subset(&weighted, |i| fold[i] == f)?;
-            if test.is_empty() {
-                return Ok(Some(Vec::new()));
-            }
-            Ok(stepped_errors(
-                &robot,
-                params,
-                &current.frame,
-                &test,
-                (&h, &b),
-                share,
-            ))
-        })
-        .collect();
-    let mut errors = Vec::with_capacity(runs.len());
-    for r in runs {
-        match r? {
-            Some(e) => errors.push(Ok((e, true))),
-            None => return Ok(None),
-        }
-    }
-    summarize(errors).map(Some)
+    one_step_folds(
+        &robot,
+        params,
+        &current.frame,
+        &weighted,
+        &fold,
+        shares,
+        |_, _| Ok(None),
+    )
+}
+
+/// `candidate` (identifying `params`) screened against `judged`, the candidate of the model it
+/// extends, whose fit is `current`: the candidate with its estimate ([`screen`]) and
+/// [`Candidate::screened`] when the estimate plus its standard error stays [`SCREEN_MARGIN`] of
+/// `judged`'s standard errors above `judged`'s error; `None` when it is to be fitted (it may
+/// lower that error, or the estimate cannot be made).
+pub(crate) fn screen_candidate(
+    current: &Calibration,
+    judged: &Candidate,
+    candidate: &Robot,
+    params: &[Param],
+    calibration: &Observations,
+) -> Option<Candidate> {
+    let (mean, se) = (judged.cv_mean_mm?, judged.cv_std_error_mm?);
+    let cv = screen(current, candidate, params, calibration, FOLDS).ok()??;
+    let far = cv.mean_mm + cv.std_error_mm >= mean + SCREEN_MARGIN * se;
+    (far && cv.mean_mm.is_finite() && cv.std_error_mm.is_finite()).then(|| Candidate {
+        identified: params.len(),
+        cv_mean_mm: Some(cv.mean_mm),
+        cv_std_error_mm: Some(cv.std_error_mm),
+        screened: true,
+        ..Candidate::new(candidate, false)
+    })
 }
 
 /// `candidate` with every parameter it shares with `fitted` at `fitted`'s value (its own
-/// others, the new family's, as they are: zero).
+/// others, the new family's, as they are: zero). Everything a calibration changes is a
+/// parameter (the tool fit's corrections included); the frame is the fit's own.
 fn at_fit(candidate: &Robot, fitted: &Robot) -> Robot {
     let mut robot = candidate.clone();
-    let own = candidate.param_list();
     for &p in fitted.param_list() {
-        if own.contains(&p) {
+        if candidate.has_param(p) {
             robot.set(p, fitted.get(p));
         }
     }

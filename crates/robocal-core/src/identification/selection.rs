@@ -4,7 +4,7 @@
 //! expansion (when they have temperatures; referred to their mean temperature), and their
 //! combinations.
 //!
-//! The candidates are found by a forward search: from the robot as given, each round fits every
+//! The candidates are found by a forward search: from the robot as given, each round judges every
 //! model with one family more than the current one (or the next harmonic order), and moves to
 //! the best of them when it lowers the current model's cross-validated error by more than its
 //! own standard error; the search stops where none does. Combinations are so tried only on top
@@ -13,9 +13,12 @@
 //!
 //! Each candidate is first screened ([`crate::identification::screen`]): its cross-validated
 //! error estimated by one Newton step from the fit of the model it extends, at the cost of one
-//! pass over the data. One whose estimate stays [`SCREEN_MARGIN`] of the current model's standard
+//! pass over the data. One whose estimate stays
+//! [`SCREEN_MARGIN`](crate::identification::screen::SCREEN_MARGIN) of the current model's standard
 //! errors away from lowering its error is not fitted: it keeps its estimate, marked
-//! [`Candidate::screened`], and is never the choice (one the choice would pick is fitted first).
+//! [`Candidate::screened`], and takes part in the search and the choice with it as its fit would
+//! with its error. It is never the choice: one whose fit could turn the search (the round's
+//! lowest error while a candidate would move the search) or the choice is fitted after all.
 //! Every other candidate is fitted once to all calibration points (the whole calibration,
 //! plausibility gate included) and cross-validated over [`FOLDS`] folds by pose (see
 //! [`super::cross_validation`]: one Newton step from the full fit on the other folds' normal
@@ -24,9 +27,9 @@
 //! under the fit that left it out; its standard error that mean's (per-point spread over the
 //! square root of the count).
 //!
-//! The choice (the one-standard-error rule): among the candidates fitted whose full fit
-//! converged and passed the plausibility gate, the one with the fewest identified parameters
-//! whose error is within one standard error of the lowest. The robot as given (the first
+//! The choice (the one-standard-error rule): among the candidates whose full fit converged and
+//! passed the plausibility gate (and the screened ones, by their estimates), the one with the
+//! fewest identified parameters whose error is within one standard error of the lowest. The robot as given (the first
 //! candidate) is part of every other: when its fit fails, does not converge or fails the gate,
 //! it is the choice, and its calibration reports why. A family therefore stays only when it
 //! lowers the cross-validated error by more than the best candidate's standard error, and the
@@ -42,13 +45,17 @@ use crate::identification::pipeline::{
     begin_for, calibrate_model, calibrate_model_for, calibrate_model_from, complete, Calibration,
     CalibrationData, CalibrationSettings, Purpose, Shared,
 };
-use crate::identification::screen::{screen, SCREEN_MARGIN};
+use crate::identification::screen::screen_candidate;
 use crate::model::family::{backlash, compliance, thermal, transmission};
-use crate::model::{Param, Robot};
+use crate::model::Robot;
 use crate::progress::{self, Observer};
 use rayon::prelude::*;
 
 pub use crate::identification::folds::FOLDS;
+
+#[path = "selection_families.rs"]
+mod families_set;
+use families_set::Families;
 
 /// Harmonics per joint the selection tries (besides none).
 pub const HARMONICS: [usize; 2] = [1, 2];
@@ -118,89 +125,8 @@ pub fn reference_temperature_c(data: &CalibrationData) -> Option<f64> {
     (!t.is_empty()).then(|| (t.iter().sum::<f64>() / t.len() as f64 * 10.0).round() / 10.0)
 }
 
-/// A candidate's non-geometric families, as the search builds them.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-struct Families {
-    compliance: bool,
-    /// Order of the transmission harmonics (0: none).
-    harmonics: usize,
-    backlash: bool,
-    thermal: bool,
-}
-
-impl Families {
-    /// The sets with one family more (the next harmonic order for the harmonics), among those
-    /// `auto` selects; `compliant`: whether the robot has joints compliance can take.
-    fn larger(self, auto: AutoFamilies, compliant: bool) -> Vec<Families> {
-        let mut out = Vec::new();
-        if auto.compliance && compliant && !self.compliance {
-            out.push(Families {
-                compliance: true,
-                ..self
-            });
-        }
-        if auto.harmonics && HARMONICS.contains(&(self.harmonics + 1)) {
-            out.push(Families {
-                harmonics: self.harmonics + 1,
-                ..self
-            });
-        }
-        if auto.backlash && !self.backlash {
-            out.push(Families {
-                backlash: true,
-                ..self
-            });
-        }
-        if auto.thermal && !self.thermal {
-            out.push(Families {
-                thermal: true,
-                ..self
-            });
-        }
-        out
-    }
-
-    /// Every family `auto` selects, the highest harmonic order: the widest candidate, whose
-    /// parameters every candidate's are among.
-    fn widest(auto: AutoFamilies, compliant: bool) -> Families {
-        Families {
-            compliance: auto.compliance && compliant,
-            harmonics: if auto.harmonics {
-                HARMONICS[HARMONICS.len() - 1]
-            } else {
-                0
-            },
-            backlash: auto.backlash,
-            thermal: auto.thermal,
-        }
-    }
-
-    /// `nominal` with these families (their parameters at zero); thermal expansion referred to
-    /// `reference_c`.
-    fn robot(self, nominal: &Robot, reference_c: Option<f64>) -> Result<Robot> {
-        let mut r = nominal.clone();
-        if self.compliance {
-            compliance::enable(&mut r, &compliance::auto_joints(nominal), None)?;
-        }
-        if self.harmonics > 0 {
-            let all: Vec<usize> = (0..nominal.dof()).collect();
-            transmission::enable(&mut r, &all, self.harmonics)?;
-        }
-        if self.backlash {
-            backlash::enable(&mut r, &(0..nominal.dof()).collect::<Vec<_>>())?;
-        }
-        if self.thermal {
-            thermal::enable(&mut r, thermal::DEFAULT_REFERENCE_C)?;
-        }
-        if let Some(t) = reference_c {
-            thermal::set_reference_c(&mut r, t)?;
-        }
-        Ok(r)
-    }
-}
-
 /// Chooses the model the calibration data support among the candidates of `nominal` (see
-/// the module docs). `settings.model` is ignored: each candidate is fitted as given.
+/// the module docs). `settings.model` is ignored: each candidate is judged as given.
 pub fn select(
     nominal: &Robot,
     data: CalibrationData,
@@ -240,33 +166,11 @@ fn select_fitted(
     let widest = Families::widest(auto, !compliance::auto_joints(nominal).is_empty())
         .robot(nominal, reference_c)?;
     let shared = Shared::new(&given, &widest, data, &fit_settings)?;
-    let fit = |robot: &Robot,
-               reference: bool,
-               from: Option<(&Calibration, &Candidate)>|
-     -> (Candidate, Option<Calibration>) {
+    let fit = |robot: &Robot, reference: bool, from: Option<Extends<'_, Calibration>>| {
         let shared = shared
             .same_tool_points(robot, data.calibration)
             .then_some(&shared);
-        // Screened first when the model it extends stands: spared its fit, or fitted from the
-        // screen's start and identifiability steps (a failed step is the fit's to report).
-        let mut begun = None;
-        if let Some((current, judged)) = from {
-            if let Ok(b) = begin_for(robot, data, &fit_settings, shared) {
-                if let Some(c) = screen_candidate(current, judged, robot, b.params(), data) {
-                    return (c, None);
-                }
-                begun = Some(b);
-            }
-        }
-        let purpose = Purpose::Candidate;
-        match calibrate_model_from(robot, data, &fit_settings, purpose, &(), shared, begun) {
-            Err(e) => {
-                let mut cand = Candidate::new(robot, reference);
-                cand.rejected = Some(format!("the fit failed: {e}"));
-                (cand, None)
-            }
-            Ok(cal) => assess(robot, reference, cal, data),
-        }
+        judge(robot, reference, from, data, &fit_settings, shared)
     };
     let given_fit = |robot: &Robot| -> Result<(Candidate, Option<Calibration>)> {
         let shared = shared
@@ -278,35 +182,66 @@ fn select_fitted(
     search(nominal, auto, reference_c, given_fit, &fit)
 }
 
-/// `robot`, a candidate with one family more than the model of `current` (its fit) and
-/// `judged` (its candidate), identifying `params`, screened (see
-/// [`crate::identification::screen`]): the candidate with its estimated cross-validated error
-/// when that stays [`SCREEN_MARGIN`] standard errors of `judged` from lowering its error; `None`
-/// when it is to be fitted (it may lower the error, or the estimate cannot be made).
-fn screen_candidate(
-    current: &Calibration,
-    judged: &Candidate,
+/// One candidate of [`select_fitted`] judged: screened first when the model it extends stands
+/// (`from`), then, unless spared, fitted (from the screen's start and identifiability steps; a
+/// step that failed there is the fit's to report) and assessed. `true`: the reference candidate.
+fn judge(
     robot: &Robot,
-    params: &[Param],
+    reference: bool,
+    from: Option<Extends<'_, Calibration>>,
     data: CalibrationData,
-) -> Option<Candidate> {
-    let (mean, se) = (judged.cv_mean_mm?, judged.cv_std_error_mm?);
-    let cv = screen(current, robot, params, data.calibration, FOLDS).ok()??;
-    let far = cv.mean_mm + cv.std_error_mm >= mean + SCREEN_MARGIN * se;
-    (far && cv.mean_mm.is_finite() && cv.std_error_mm.is_finite()).then(|| Candidate {
-        identified: params.len(),
-        cv_mean_mm: Some(cv.mean_mm),
-        cv_std_error_mm: Some(cv.std_error_mm),
-        screened: true,
-        ..Candidate::new(robot, false)
-    })
+    settings: &CalibrationSettings,
+    shared: Option<&Shared>,
+) -> (Candidate, Option<Calibration>) {
+    let mut begun = None;
+    if let Some(from) = from {
+        if let Ok(b) = begin_for(robot, data, settings, shared) {
+            let (fit, cand) = (from.fit, from.candidate);
+            if let Some(c) = screen_candidate(fit, cand, robot, b.params(), data.calibration) {
+                return (c, None);
+            }
+            begun = Some(b);
+        }
+    }
+    match calibrate_model_from(
+        robot,
+        data,
+        settings,
+        Purpose::Candidate,
+        &(),
+        shared,
+        begun,
+    ) {
+        Err(e) => {
+            let mut cand = Candidate::new(robot, reference);
+            cand.rejected = Some(format!("the fit failed: {e}"));
+            (cand, None)
+        }
+        Ok(cal) => assess(robot, reference, cal, data),
+    }
 }
+
+/// The model a candidate extends, for its screen: that model's fit and its candidate.
+pub(crate) struct Extends<'a, T> {
+    /// The model's fit.
+    pub fit: &'a T,
+    /// The model's candidate (its cross-validated error).
+    pub candidate: &'a Candidate,
+}
+
+impl<T> Clone for Extends<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for Extends<'_, T> {}
 
 /// Fits and judges one candidate model for [`search`] (`true`: the reference candidate). Given
 /// the fit and the candidate of the model it extends, it may screen it first: then the
 /// candidate with its estimated error ([`Candidate::screened`]) when it need not be fitted.
 pub(crate) type FitCandidate<'a, T> =
-    dyn Fn(&Robot, bool, Option<(&T, &Candidate)>) -> (Candidate, Option<T>) + Sync + 'a;
+    dyn Fn(&Robot, bool, Option<Extends<'_, T>>) -> (Candidate, Option<T>) + Sync + 'a;
 
 /// The forward search and the choice (see the module docs) over candidates that `fit` fits and
 /// judges (a [`Candidate`] with its cross-validated error, or rejected, and the fit when it
@@ -331,7 +266,7 @@ pub(crate) fn search<T: Send + Sync>(
     let mut robots = vec![given_robot];
     let mut candidates = vec![c0];
     let mut fits = vec![f0];
-    // Forward search: from the robot as given, each round fits every set with one family more
+    // Forward search: from the robot as given, each round judges every set with one family more
     // than the current one, and moves to the best if it lowers the error by more than its
     // standard error; the search stops where none does.
     let mut current = 0;
@@ -345,7 +280,10 @@ pub(crate) fn search<T: Send + Sync>(
             .iter()
             .map(|f| f.robot(nominal, reference_c))
             .collect::<Result<_>>()?;
-        let from = fits[current].as_ref().map(|f| (f, &candidates[current]));
+        let from = fits[current].as_ref().map(|fit| Extends {
+            fit,
+            candidate: &candidates[current],
+        });
         let outcomes: Vec<(Candidate, Option<T>)> =
             built.par_iter().map(|r| fit(r, false, from)).collect();
         let first = candidates.len();
@@ -356,9 +294,23 @@ pub(crate) fn search<T: Send + Sync>(
             candidates.push(c);
             fits.push(fitted);
         }
-        let best = (first..candidates.len())
-            .filter(|&i| candidates[i].rejected.is_none())
-            .min_by(|&a, &b| cv(&candidates[a]).total_cmp(&cv(&candidates[b])));
+        // The round's best, as if every candidate were fitted: a screened best stops the search
+        // (its estimate does not lower the error) unless it would move it or a fitted candidate
+        // of the round would, and then its fit decides (it may be rejected).
+        let round = first..candidates.len();
+        let best = loop {
+            let best = best_of(&candidates, round.clone(), true);
+            let moves = |i: usize| {
+                let c = &candidates[i];
+                c.rejected.is_none() && lowers(c, &candidates[current])
+            };
+            match best {
+                Some(b) if candidates[b].screened && round.clone().any(moves) => {
+                    (candidates[b], fits[b]) = fit(&robots[b], false, None);
+                }
+                _ => break best,
+            }
+        };
         match best {
             Some(b) if lowers(&candidates[b], &candidates[current]) => current = b,
             _ => break,
@@ -373,14 +325,26 @@ pub(crate) fn search<T: Send + Sync>(
         candidates.push(c);
         fits.push(None);
     }
-    // A screened candidate is only ever a loser: one the choice would pick is fitted first.
-    let mut chosen = choose(&candidates);
-    while candidates[chosen].screened {
-        let (c, f) = fit(&robots[chosen], false, None);
-        candidates[chosen] = c;
-        fits[chosen] = f;
-        chosen = choose(&candidates);
-    }
+    // Screened candidates take part in the choice with their estimates, as their fits would
+    // with their errors, but are never chosen: one the choice would pick is fitted first, and so
+    // is one whose estimate turns the choice (the lowest error, whose fit may be rejected).
+    // Each round fits one, so this ends. A candidate so fitted does not resume the search: its
+    // estimate, its error to a small fraction of the margin, did not lower its model's.
+    let chosen = loop {
+        let with = choose(&candidates, true);
+        let without = choose(&candidates, false);
+        let refit = if candidates[with].screened {
+            Some(with)
+        } else if with != without {
+            best_of(&candidates, 0..candidates.len(), true).filter(|&b| candidates[b].screened)
+        } else {
+            None
+        };
+        match refit {
+            Some(i) => (candidates[i], fits[i]) = fit(&robots[i], false, None),
+            None => break with,
+        }
+    };
     candidates[chosen].chosen = true;
     let selection = ModelSelection {
         folds: FOLDS,
@@ -491,16 +455,27 @@ fn lowers(larger: &Candidate, smaller: &Candidate) -> bool {
     cv(larger) + larger.cv_std_error_mm.unwrap_or(f64::INFINITY) < cv(smaller)
 }
 
-/// The one-standard-error rule over the selectable candidates (simplest first in `c`): the
-/// simplest whose error is within one standard error of the lowest. The first candidate (the
-/// robot as given) when none is selectable.
-fn choose(c: &[Candidate]) -> usize {
+/// The candidate among `range` with the lowest cross-validated error that was not rejected
+/// (screened ones counted when `screened`).
+fn best_of(c: &[Candidate], range: std::ops::Range<usize>, screened: bool) -> Option<usize> {
+    range
+        .filter(|&i| c[i].rejected.is_none() && (screened || !c[i].screened))
+        .min_by(|&a, &b| cv(&c[a]).total_cmp(&cv(&c[b])))
+}
+
+/// The one-standard-error rule over the selectable candidates (simplest first in `c`;
+/// screened ones counted when `screened`, with their estimates): the simplest whose error is
+/// within one standard error of the lowest. The first candidate (the robot as given) when none
+/// is selectable.
+fn choose(c: &[Candidate], screened: bool) -> usize {
     // The families refine the robot as given: on top of a fit that failed, did not converge or
     // is implausible they are not chosen, and its calibration says why.
     if c.first().map_or(true, |x| x.rejected.is_some()) {
         return 0;
     }
-    let ok = |x: &Candidate| !x.reference && x.rejected.is_none() && x.cv_mean_mm.is_some();
+    let ok = |x: &Candidate| {
+        !x.reference && x.rejected.is_none() && x.cv_mean_mm.is_some() && (screened || !x.screened)
+    };
     let Some(best) = c
         .iter()
         .filter(|x| ok(x))
@@ -537,24 +512,24 @@ mod tests {
     fn the_simplest_within_one_standard_error_of_the_best_is_chosen() {
         // A family that gains less than the standard error does not stay.
         let c = [cand(26, 0.050, 0.003, false), cand(36, 0.048, 0.003, false)];
-        assert_eq!(choose(&c), 0);
+        assert_eq!(choose(&c, true), 0);
         // One that gains more does.
         let c = [cand(26, 0.100, 0.002, false), cand(36, 0.088, 0.001, false)];
-        assert_eq!(choose(&c), 1);
+        assert_eq!(choose(&c, true), 1);
         // A rejected candidate is never chosen, however low its error.
         let c = [cand(26, 0.100, 0.002, false), cand(36, 0.010, 0.001, true)];
-        assert_eq!(choose(&c), 0);
+        assert_eq!(choose(&c, true), 0);
         // Nothing selectable: the robot as given.
         let c = [cand(26, 0.100, 0.002, true), cand(36, 0.010, 0.001, true)];
-        assert_eq!(choose(&c), 0);
+        assert_eq!(choose(&c, true), 0);
         // The robot as given rejected: no family on top of it.
         let c = [cand(26, 0.100, 0.002, true), cand(36, 0.010, 0.001, false)];
-        assert_eq!(choose(&c), 0);
+        assert_eq!(choose(&c, true), 0);
         // The reference (the geometric model beside explicit families) is never chosen.
         let mut r = cand(20, 0.010, 0.001, false);
         r.reference = true;
         let c = [cand(26, 0.100, 0.002, false), r];
-        assert_eq!(choose(&c), 0);
+        assert_eq!(choose(&c, true), 0);
     }
 
     #[test]

@@ -79,6 +79,9 @@ fn geometric_errors_choose_the_geometric_model() {
     for seed in [1, 2, 3] {
         let (families, c) = chosen(&truth, None, seed);
         assert!(families.is_empty(), "seed {seed}: {families:?}");
+        // The families, far from lowering the geometric model's error, are screened, not fitted.
+        let sel = c.model_selection.as_ref().unwrap();
+        assert!(sel.candidates.iter().skip(1).all(|c| c.screened), "{sel:?}");
         // The chosen model is the one calibrated, and the selection is recorded.
         assert!(selection::families(&c.nominal).is_empty());
         let r = c.to_result();
@@ -96,6 +99,10 @@ fn gravity_sag_chooses_compliance() {
             families.iter().any(|f| f == "compliance"),
             "seed {seed}: {families:?}"
         );
+        // Compliance lowers the error by far: its screen shows it, and it is fitted.
+        let sel = c.model_selection.as_ref().unwrap();
+        let comp = sel.candidates.iter().find(|c| c.families == ["compliance"]);
+        assert!(comp.is_some_and(|c| !c.screened), "{sel:?}");
         assert!(!compliance_joints(&c.nominal).is_empty());
     }
 }
@@ -464,4 +471,119 @@ fn the_screen_estimates_the_candidates_own_cross_validation() {
             assert!((est.std_error_mm - cv.std_error_mm).abs() <= 0.02 * cv.std_error_mm);
         }
     }
+}
+
+/// The search and the choice with screened candidates, as if every candidate were fitted: a
+/// screened candidate is never chosen, and one whose fit could turn the search (the round's
+/// lowest error while it or a fitted one would move it) is fitted after all. A fake fit plays
+/// the candidates, its screens more generous than the selection's margin where a case needs it.
+#[test]
+fn screened_candidates_turn_nothing_their_fits_would_not() {
+    use crate::identification::selection::{search, Extends};
+    use std::sync::Mutex;
+    let nominal = preset("kuka-kr480-r3330").unwrap();
+    let auto = AutoFamilies {
+        backlash: false,
+        thermal: false,
+        ..AutoFamilies::default()
+    };
+    // (families, identified, screened estimate when screened, the fit's outcome: error or None
+    // for rejected).
+    type Play = (&'static str, usize, Option<(f64, f64)>, Option<(f64, f64)>);
+    let run = |plays: &[Play]| {
+        let fitted = Mutex::new(Vec::new());
+        let play = |robot: &Robot, from: bool| {
+            let name = selection::families(robot).join(" + ");
+            let p = plays
+                .iter()
+                .find(|p| p.0 == name)
+                .unwrap_or_else(|| panic!("{name}"));
+            let mut c = Candidate::new(robot, false);
+            c.identified = p.1;
+            if let (true, Some((m, se))) = (from, p.2) {
+                (c.cv_mean_mm, c.cv_std_error_mm, c.screened) = (Some(m), Some(se), true);
+                return (c, None);
+            }
+            fitted.lock().unwrap().push(name);
+            match p.3 {
+                Some((m, se)) => {
+                    (c.cv_mean_mm, c.cv_std_error_mm) = (Some(m), Some(se));
+                    (c, Some(()))
+                }
+                None => {
+                    c.rejected = Some("failed the plausibility gate".into());
+                    (c, None)
+                }
+            }
+        };
+        let fit = |r: &Robot, _: bool, from: Option<Extends<'_, ()>>| play(r, from.is_some());
+        let (sel, _) = search(&nominal, auto, None, |r| Ok(play(r, false)), &fit).unwrap();
+        let fitted = fitted.into_inner().unwrap();
+        (sel, fitted)
+    };
+    let find = |sel: &ModelSelection, name: &str| -> Candidate {
+        let fam: Vec<String> = if name.is_empty() {
+            vec![]
+        } else {
+            name.split(" + ").map(String::from).collect()
+        };
+        sel.candidates
+            .iter()
+            .find(|c| c.families == fam)
+            .unwrap()
+            .clone()
+    };
+    // The round's lowest error is screened while harmonics, fitted, would move the search: the
+    // screened candidate is fitted, rejected, and the search moves to harmonics.
+    let (sel, fitted) = run(&[
+        ("", 26, None, Some((0.100, 0.002))),
+        ("compliance", 33, Some((0.094, 0.010)), None),
+        ("harmonics 1", 38, None, Some((0.095, 0.001))),
+        ("compliance + harmonics 1", 45, Some((0.097, 0.001)), None),
+        ("harmonics 2", 50, Some((0.097, 0.001)), None),
+    ]);
+    assert_eq!(sel.chosen().families, ["harmonics 1"]);
+    assert!(find(&sel, "compliance").rejected.is_some());
+    assert!(find(&sel, "harmonics 2").screened);
+    assert_eq!(fitted, ["", "harmonics 1", "compliance"]);
+    // A screened estimate that would move the search itself (a screen more generous than the
+    // selection's margin): it is fitted first, rejected, and the search stays.
+    let (sel, fitted) = run(&[
+        ("", 26, None, Some((0.0955, 0.005))),
+        ("compliance", 33, None, Some((0.095, 0.001))),
+        ("harmonics 1", 38, Some((0.090, 0.005)), None),
+    ]);
+    assert!(sel.chosen().families.is_empty(), "{sel:?}");
+    assert!(find(&sel, "harmonics 1").rejected.is_some());
+    assert_eq!(fitted, ["", "compliance", "harmonics 1"]);
+    // The same in a later round, the fit standing: the search goes on from it, and it is chosen.
+    let (sel, fitted) = run(&[
+        ("", 26, None, Some((0.100, 0.001))),
+        ("compliance", 33, None, Some((0.090, 0.001))),
+        ("harmonics 1", 38, None, Some((0.099, 0.001))),
+        (
+            "compliance + harmonics 1",
+            45,
+            Some((0.080, 0.001)),
+            Some((0.080, 0.001)),
+        ),
+        ("compliance + harmonics 2", 57, Some((0.0805, 0.001)), None),
+    ]);
+    assert_eq!(sel.chosen().families, ["compliance", "harmonics 1"]);
+    assert!(!sel.chosen().screened);
+    assert!(find(&sel, "compliance + harmonics 2").screened);
+    // (The round's two fits run in parallel: in either order.)
+    let mut round = fitted[1..3].to_vec();
+    round.sort();
+    assert_eq!(round, ["compliance", "harmonics 1"]);
+    assert_eq!(fitted[3..], ["compliance + harmonics 1"]);
+    // Nothing turns: the screened candidates stay screened, unfitted.
+    let (sel, fitted) = run(&[
+        ("", 26, None, Some((0.100, 0.002))),
+        ("compliance", 33, Some((0.101, 0.002)), None),
+        ("harmonics 1", 38, Some((0.099, 0.002)), None),
+    ]);
+    assert!(sel.chosen().families.is_empty());
+    assert_eq!(fitted, [""]);
+    assert_eq!(sel.candidates.iter().filter(|c| c.screened).count(), 2);
 }

@@ -9,7 +9,8 @@ use serde::{Deserialize, Serialize};
 pub struct CandidateEntry {
     /// Its non-geometric families (empty: the geometric model), e.g. `["harmonics 2"]`.
     pub families: Vec<String>,
-    /// Parameters its fit to all calibration points identified.
+    /// Parameters its fit to all calibration points identified (when `screened`, those its fit
+    /// would start from).
     pub identified: usize,
     /// Cross-validated mean position error (mm); null when it could not be fitted.
     #[serde(default)]

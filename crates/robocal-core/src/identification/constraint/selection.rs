@@ -22,7 +22,7 @@ use super::result::row_residuals;
 use super::{calibrate_constraints, ConstraintCalibration, ConstraintOptions};
 use crate::error::{Error, Result};
 use crate::identification::cross_validation::{pose_folds, summarize, CrossValidation};
-use crate::identification::selection::{search, FOLDS};
+use crate::identification::selection::{search, Extends, FOLDS};
 use crate::identification::{AutoFamilies, Candidate, ModelSelection};
 use crate::model::Robot;
 use crate::observations::constraint::ConstraintData;
@@ -50,7 +50,7 @@ pub fn select(
     // Constraint candidates are fitted, none screened.
     let fit = |robot: &Robot,
                reference: bool,
-               _from: Option<(&ConstraintCalibration, &Candidate)>|
+               _from: Option<Extends<'_, ConstraintCalibration>>|
      -> (Candidate, Option<ConstraintCalibration>) {
         match calibrate_constraints(robot, data, opts) {
             Err(e) => {

@@ -238,7 +238,8 @@ pub(crate) fn calibrate_model_for(
 }
 
 /// [`calibrate_model_for`] from its start and identifiability steps when they were taken
-/// already (`begun`, by [`begin_for`] with the same inputs: a screened candidate's).
+/// already (`begun`, by [`begin_for`] with the same inputs: a screened candidate's). `observer`
+/// then hears no identifiability stage ([`begin_for`] took it silently).
 pub(crate) fn calibrate_model_from(
     nominal: &Robot,
     data: CalibrationData,
