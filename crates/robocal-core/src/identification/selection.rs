@@ -328,8 +328,11 @@ pub(crate) fn search<T: Send + Sync>(
     // Screened candidates take part in the choice with their estimates, as their fits would
     // with their errors, but are never chosen: one the choice would pick is fitted first, and so
     // is one whose estimate turns the choice (the lowest error, whose fit may be rejected).
-    // Each round fits one, so this ends. A candidate so fitted does not resume the search: its
-    // estimate, its error to a small fraction of the margin, did not lower its model's.
+    // Each round fits one, so this ends. (With the selection's screen only the pick can happen:
+    // a screened candidate does not lower the model it extends, so its limit takes that model
+    // in. The limit's case guards `search` for any screen.) A candidate so fitted does not
+    // resume the search: its estimate, its error to a small fraction of the margin, did not
+    // lower its model's.
     let chosen = loop {
         let with = choose(&candidates, true);
         let without = choose(&candidates, false);

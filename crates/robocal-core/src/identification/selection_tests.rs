@@ -475,8 +475,9 @@ fn the_screen_estimates_the_candidates_own_cross_validation() {
 
 /// The search and the choice with screened candidates, as if every candidate were fitted: a
 /// screened candidate is never chosen, and one whose fit could turn the search (the round's
-/// lowest error while it or a fitted one would move it) is fitted after all. A fake fit plays
-/// the candidates, its screens more generous than the selection's margin where a case needs it.
+/// lowest error while it or a fitted one would move it) or the choice (the pick) is fitted
+/// after all. A fake fit plays the candidates, its screens more generous than the selection's
+/// margin where a case needs it.
 #[test]
 fn screened_candidates_turn_nothing_their_fits_would_not() {
     use crate::identification::selection::{search, Extends};
@@ -577,6 +578,23 @@ fn screened_candidates_turn_nothing_their_fits_would_not() {
     round.sort();
     assert_eq!(round, ["compliance", "harmonics 1"]);
     assert_eq!(fitted[3..], ["compliance + harmonics 1"]);
+    // The choice would pick a screened candidate (simpler than the best, within its standard
+    // error): it is fitted first and, standing, chosen, as if every candidate had been fitted.
+    let (sel, fitted) = run(&[
+        ("", 26, None, Some((0.100, 0.001))),
+        (
+            "compliance",
+            33,
+            Some((0.0855, 0.002)),
+            Some((0.0855, 0.002)),
+        ),
+        ("harmonics 1", 38, None, Some((0.085, 0.001))),
+        ("compliance + harmonics 1", 45, Some((0.086, 0.001)), None),
+        ("harmonics 2", 50, Some((0.086, 0.001)), None),
+    ]);
+    assert_eq!(sel.chosen().families, ["compliance"]);
+    assert!(!sel.chosen().screened);
+    assert_eq!(fitted, ["", "harmonics 1", "compliance"]);
     // Nothing turns: the screened candidates stay screened, unfitted.
     let (sel, fitted) = run(&[
         ("", 26, None, Some((0.100, 0.002))),
