@@ -39,6 +39,7 @@ mod cli_interrupted;
 mod cli_iso9283;
 mod cli_iso9283_plan;
 mod cli_joints;
+mod cli_model_screen;
 mod cli_plan;
 mod cli_programs;
 mod cli_programs_uses;
