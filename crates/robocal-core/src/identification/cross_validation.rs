@@ -15,6 +15,7 @@
 
 use crate::error::Result;
 use crate::frame::TrackerFrame;
+use crate::identification::objective::Loss;
 use crate::identification::pipeline::Calibration;
 use crate::identification::solver::{solve, undamped_step, SolverOptions};
 use crate::identification::system::{Level, Problem};
@@ -127,11 +128,7 @@ pub fn cross_validate(
         .filter(|p| p.len() == folds && p.iter().all(|(h, _)| h.nrows() == params.len()))
     {
         Some(p) => p.clone(),
-        None => Problem::new(robot, params, &weighted, &cal.frame)
-            .grouped(&fold, folds)
-            .accumulate(robot, &loss, Level::Newton)
-            .groups
-            .expect("a grouped Newton pass"),
+        None => newton_shares(robot, params, &weighted, &cal.frame, &fold, folds, &loss),
     };
     let cv = one_step_folds(
         robot,
@@ -145,6 +142,24 @@ pub fn cross_validate(
         |f, test| refit_fold(cal, &weighted, &fold, f, test).map(Some),
     )?;
     Ok(cv.expect("every fold's errors"))
+}
+
+/// Each fold's share of the objective's Newton Hessian and gradient at `robot` (over `params`,
+/// the points of `weighted` weighted as they are, under `loss`): one grouped pass over the data.
+pub(crate) fn newton_shares(
+    robot: &Robot,
+    params: &[Param],
+    weighted: &Observations,
+    frame: &TrackerFrame,
+    fold: &[usize],
+    folds: usize,
+    loss: &Loss,
+) -> Vec<(DMatrix<f64>, DVector<f64>)> {
+    Problem::new(robot, params, weighted, frame)
+        .grouped(fold, folds)
+        .accumulate(robot, loss, Level::Newton)
+        .groups
+        .expect("a grouped Newton pass")
 }
 
 /// The cross-validation of one Newton step per fold from `robot` (over `params`): the points of

@@ -20,12 +20,11 @@
 
 use crate::error::Result;
 use crate::identification::cross_validation::{
-    one_step_folds, pose_folds, weighted, CrossValidation,
+    newton_shares, one_step_folds, pose_folds, weighted, CrossValidation,
 };
 use crate::identification::folds::FOLDS;
 use crate::identification::model_choice::Candidate;
 use crate::identification::pipeline::Calibration;
-use crate::identification::system::{Level, Problem};
 use crate::model::{Param, Robot};
 use crate::observations::Observations;
 
@@ -53,13 +52,15 @@ pub fn screen(
     let fold = pose_folds(&weighted, folds);
     let loss = current.stages.last().expect("at least one stage").loss;
     let robot = at_fit(candidate, &current.calibrated);
-    let Some(shares) = Problem::new(&robot, params, &weighted, &current.frame)
-        .grouped(&fold, folds)
-        .accumulate(&robot, &loss, Level::Newton)
-        .groups
-    else {
-        return Ok(None);
-    };
+    let shares = newton_shares(
+        &robot,
+        params,
+        &weighted,
+        &current.frame,
+        &fold,
+        folds,
+        &loss,
+    );
     one_step_folds(
         &robot,
         params,

@@ -299,7 +299,7 @@ pub(crate) fn search<T: Send + Sync>(
         // of the round would, and then its fit decides (it may be rejected).
         let round = first..candidates.len();
         let best = loop {
-            let best = best_of(&candidates, round.clone(), true);
+            let best = lowest(&candidates, round.clone(), |c| c.rejected.is_none());
             let moves = |i: usize| {
                 let c = &candidates[i];
                 c.rejected.is_none() && lowers(c, &candidates[current])
@@ -334,12 +334,12 @@ pub(crate) fn search<T: Send + Sync>(
     // resume the search: its estimate, its error to a small fraction of the margin, did not
     // lower its model's.
     let chosen = loop {
-        let with = choose(&candidates, true);
-        let without = choose(&candidates, false);
+        let (with, limit) = choose(&candidates, true);
+        let (without, _) = choose(&candidates, false);
         let refit = if candidates[with].screened {
             Some(with)
         } else if with != without {
-            best_of(&candidates, 0..candidates.len(), true).filter(|&b| candidates[b].screened)
+            limit.filter(|&b| candidates[b].screened)
         } else {
             None
         };
@@ -458,40 +458,41 @@ fn lowers(larger: &Candidate, smaller: &Candidate) -> bool {
     cv(larger) + larger.cv_std_error_mm.unwrap_or(f64::INFINITY) < cv(smaller)
 }
 
-/// The candidate among `range` with the lowest cross-validated error that was not rejected
-/// (screened ones counted when `screened`).
-fn best_of(c: &[Candidate], range: std::ops::Range<usize>, screened: bool) -> Option<usize> {
+/// The candidate among `range` with the lowest cross-validated error, of those `keep` takes.
+fn lowest(
+    c: &[Candidate],
+    range: std::ops::Range<usize>,
+    keep: impl Fn(&Candidate) -> bool,
+) -> Option<usize> {
     range
-        .filter(|&i| c[i].rejected.is_none() && (screened || !c[i].screened))
+        .filter(|&i| keep(&c[i]))
         .min_by(|&a, &b| cv(&c[a]).total_cmp(&cv(&c[b])))
 }
 
 /// The one-standard-error rule over the selectable candidates (simplest first in `c`;
 /// screened ones counted when `screened`, with their estimates): the simplest whose error is
-/// within one standard error of the lowest. The first candidate (the robot as given) when none
-/// is selectable.
-fn choose(c: &[Candidate], screened: bool) -> usize {
+/// within one standard error of the lowest, and the lowest (which set that limit). The first
+/// candidate (the robot as given) when none is selectable.
+fn choose(c: &[Candidate], screened: bool) -> (usize, Option<usize>) {
     // The families refine the robot as given: on top of a fit that failed, did not converge or
     // is implausible they are not chosen, and its calibration says why.
     if c.first().map_or(true, |x| x.rejected.is_some()) {
-        return 0;
+        return (0, None);
     }
     let ok = |x: &Candidate| {
         !x.reference && x.rejected.is_none() && x.cv_mean_mm.is_some() && (screened || !x.screened)
     };
-    let Some(best) = c
-        .iter()
-        .filter(|x| ok(x))
-        .min_by(|a, b| a.cv_mean_mm.unwrap().total_cmp(&b.cv_mean_mm.unwrap()))
-    else {
-        return 0;
+    let Some(best) = lowest(c, 0..c.len(), ok) else {
+        return (0, None);
     };
-    let limit = best.cv_mean_mm.unwrap() + best.cv_std_error_mm.unwrap_or(0.0);
-    c.iter()
+    let limit = cv(&c[best]) + c[best].cv_std_error_mm.unwrap_or(0.0);
+    let chosen = c
+        .iter()
         .enumerate()
-        .filter(|(_, x)| ok(x) && x.cv_mean_mm.unwrap() <= limit)
+        .filter(|(_, x)| ok(x) && cv(x) <= limit)
         .min_by_key(|(i, x)| (x.identified, *i))
-        .map_or(0, |(i, _)| i)
+        .map_or(0, |(i, _)| i);
+    (chosen, Some(best))
 }
 
 #[cfg(test)]
@@ -515,24 +516,24 @@ mod tests {
     fn the_simplest_within_one_standard_error_of_the_best_is_chosen() {
         // A family that gains less than the standard error does not stay.
         let c = [cand(26, 0.050, 0.003, false), cand(36, 0.048, 0.003, false)];
-        assert_eq!(choose(&c, true), 0);
+        assert_eq!(choose(&c, true).0, 0);
         // One that gains more does.
         let c = [cand(26, 0.100, 0.002, false), cand(36, 0.088, 0.001, false)];
-        assert_eq!(choose(&c, true), 1);
+        assert_eq!(choose(&c, true).0, 1);
         // A rejected candidate is never chosen, however low its error.
         let c = [cand(26, 0.100, 0.002, false), cand(36, 0.010, 0.001, true)];
-        assert_eq!(choose(&c, true), 0);
+        assert_eq!(choose(&c, true).0, 0);
         // Nothing selectable: the robot as given.
         let c = [cand(26, 0.100, 0.002, true), cand(36, 0.010, 0.001, true)];
-        assert_eq!(choose(&c, true), 0);
+        assert_eq!(choose(&c, true).0, 0);
         // The robot as given rejected: no family on top of it.
         let c = [cand(26, 0.100, 0.002, true), cand(36, 0.010, 0.001, false)];
-        assert_eq!(choose(&c, true), 0);
+        assert_eq!(choose(&c, true).0, 0);
         // The reference (the geometric model beside explicit families) is never chosen.
         let mut r = cand(20, 0.010, 0.001, false);
         r.reference = true;
         let c = [cand(26, 0.100, 0.002, false), r];
-        assert_eq!(choose(&c, true), 0);
+        assert_eq!(choose(&c, true).0, 0);
     }
 
     #[test]

@@ -41,6 +41,7 @@ use crate::observations::Observations;
 use crate::observations::Weighting;
 use crate::progress::Observer;
 use crate::registration::{Registration, ToolFit};
+use std::borrow::Cow;
 
 /// Everything that steers a calibration.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -250,14 +251,7 @@ pub(crate) fn calibrate_model_from(
     begun: Option<Begun>,
 ) -> Result<Calibration> {
     inputs::check(nominal, &data, settings)?;
-    let own;
-    let registered = match shared {
-        Some(s) => &s.registered,
-        None => {
-            own = start::register_nominal(nominal, &data, settings, observer)?;
-            &own
-        }
-    };
+    let registered = &*registration(nominal, &data, settings, observer, shared)?;
     let begun = match begun {
         Some(b) => b,
         None => begin(nominal, &data, settings, observer, registered, shared)?,
@@ -318,15 +312,23 @@ pub(crate) fn begin_for(
     // The inputs are checked by the fit that uses these steps ([`calibrate_model_from`]): a
     // step that fails here on unchecked inputs only means the candidate is fitted, and the fit
     // reports them.
-    let own;
-    let registered = match shared {
-        Some(s) => &s.registered,
-        None => {
-            own = start::register_nominal(nominal, &data, settings, &())?;
-            &own
-        }
-    };
-    begin(nominal, &data, settings, &(), registered, shared)
+    let registered = registration(nominal, &data, settings, &(), shared)?;
+    begin(nominal, &data, settings, &(), &registered, shared)
+}
+
+/// The frame and tools a calibration of `nominal` starts from: `shared`'s, when given, else
+/// registered to `nominal` (`observer` hears it).
+fn registration<'s>(
+    nominal: &Robot,
+    data: &CalibrationData,
+    settings: &CalibrationSettings,
+    observer: &dyn Observer,
+    shared: Option<&'s Shared>,
+) -> Result<Cow<'s, start::Registered>> {
+    Ok(match shared {
+        Some(s) => Cow::Borrowed(&s.registered),
+        None => Cow::Owned(start::register_nominal(nominal, data, settings, observer)?),
+    })
 }
 
 /// The start model from the frame and tools `registered`, and its identifiable parameters.
