@@ -26,29 +26,40 @@ fn long_compensation(d: &Path, out: &Path) -> Vec<String> {
     .collect()
 }
 
-/// Whether process `pid` has a complete record of a temporary (`$TMPDIR/robocal-UID/
-/// temporaries/PID-*`: device and inode, then the temporary's path).
-fn record_written(pid: u32) -> bool {
+/// The records of temporaries process `pid` has (`$TMPDIR/robocal-UID/temporaries/PID-*`), and
+/// whether one of them is complete (device and inode, then the temporary's path).
+fn records(pid: u32) -> (usize, bool) {
     // SAFETY: getuid has no preconditions and cannot fail.
     let uid = unsafe { libc::getuid() };
     let dir = std::env::temp_dir()
         .join(format!("robocal-{uid}"))
         .join("temporaries");
     let Ok(entries) = std::fs::read_dir(dir) else {
-        return false;
+        return (0, false);
     };
-    entries.flatten().any(|e| {
-        e.file_name()
-            .to_string_lossy()
-            .starts_with(&format!("{pid}-"))
-            && std::fs::read_to_string(e.path())
-                .is_ok_and(|t| t.split_once('\n').is_some_and(|(_, p)| p.ends_with(".tmp")))
-    })
+    let mine: Vec<_> = entries
+        .flatten()
+        .filter(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .starts_with(&format!("{pid}-"))
+        })
+        .collect();
+    let complete = mine.iter().any(|e| {
+        std::fs::read_to_string(e.path())
+            .is_ok_and(|t| t.split_once('\n').is_some_and(|(_, p)| p.ends_with(".tmp")))
+    });
+    (mine.len(), complete)
 }
 
-/// Starts `args`, waits until its temporary file for `out` and its record exist, sends
-/// `signal`; gives the exit status and stderr.
-fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i32>, String) {
+/// Starts `args`, waits until its temporary file for `out` exists (and its record, when
+/// `recorded`), sends `signal`; gives the exit status, stderr and the process id.
+fn interrupt_when(
+    args: &[String],
+    out: &Path,
+    signal: i32,
+    recorded: bool,
+) -> (Option<i32>, Option<i32>, String, u32) {
     use std::os::unix::process::ExitStatusExt;
     let child = command()
         .args(args)
@@ -67,9 +78,8 @@ fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i
         );
         std::thread::sleep(std::time::Duration::from_millis(2));
     }
-    // The record that proves the temporary robocal's is written just after it: a signal in
-    // between leaves a temporary nothing proves (kept, as a user's file would be).
-    while !record_written(child.id()) {
+    // The record that proves the temporary robocal's is written just after it.
+    while recorded && !records(child.id()).1 {
         assert!(
             start.elapsed() < std::time::Duration::from_secs(60),
             "no complete record of the temporary of process {}",
@@ -77,12 +87,19 @@ fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i
         );
         std::thread::sleep(std::time::Duration::from_millis(2));
     }
+    let pid = child.id();
     // SAFETY: sends a signal to the child started above.
-    let r = unsafe { libc::kill(child.id() as i32, signal) };
+    let r = unsafe { libc::kill(pid as i32, signal) };
     assert_eq!(r, 0);
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
-    (o.status.code(), o.status.signal(), err)
+    (o.status.code(), o.status.signal(), err, pid)
+}
+
+/// [`interrupt_when`] its temporary and the temporary's record exist.
+fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i32>, String) {
+    let (code, sig, err, _) = interrupt_when(args, out, signal, true);
+    (code, sig, err)
 }
 
 #[test]
@@ -105,6 +122,75 @@ fn sigint_and_sigterm_remove_the_temporary_and_keep_the_old_output() {
         assert_eq!(std::fs::read_to_string(&out).unwrap(), "old output\n");
         assert_eq!(temporaries(d), Vec::<String>::new(), "{name}");
     }
+}
+
+/// The handler waits for a temporary being created: a signal that comes as soon as the file
+/// exists, before its record may, removes both.
+#[test]
+fn a_signal_as_the_temporary_is_created_removes_it_and_its_record() {
+    let dir = inputs();
+    let d = dir.path();
+    let out = d.join("out.csv");
+    std::fs::write(&out, "old output\n").unwrap();
+    let args = long_compensation(d, &out);
+    for _ in 0..3 {
+        for (signal, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
+            let (code, _, err, pid) = interrupt_when(&args, &out, signal, false);
+            assert_eq!(code, Some(130), "{name}: {err}");
+            assert!(
+                err.contains(&format!(
+                    "error: interrupted by {name}; 1 unfinished temporary file(s) removed"
+                )),
+                "{err}"
+            );
+            assert_eq!(std::fs::read_to_string(&out).unwrap(), "old output\n");
+            assert_eq!(temporaries(d), Vec::<String>::new(), "{name}");
+            assert_eq!(records(pid).0, 0, "{name}: the temporary's record is left");
+        }
+    }
+}
+
+/// A signal while nothing is being written (a calibration of 200,000 poses, after its first
+/// line) ends the run at once, from whichever thread it reaches.
+#[test]
+fn a_signal_while_computing_ends_the_run_and_writes_nothing() {
+    use std::io::BufRead;
+    let dir = inputs();
+    let d = dir.path();
+    let out = d.join("res.json");
+    let old = std::fs::read_to_string(&out).unwrap();
+    let mut child = command()
+        .args([
+            "calibrate",
+            "--robot",
+            KUKA,
+            "--data",
+            p(many_poses()),
+            "--model",
+            "geometric",
+            "--out",
+            p(&out),
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    std::io::BufReader::new(child.stdout.take().unwrap())
+        .read_line(&mut first)
+        .unwrap();
+    assert!(first.contains("200000 calibration point(s)"), "{first}");
+    // SAFETY: sends a signal to the child started above.
+    assert_eq!(unsafe { libc::kill(child.id() as i32, libc::SIGTERM) }, 0);
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(
+        err.contains("error: interrupted by SIGTERM; 0 unfinished temporary file(s) removed"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(&out).unwrap(), old);
+    assert_eq!(temporaries(d), Vec::<String>::new());
 }
 
 #[test]

@@ -3,15 +3,16 @@
 //! a temporary file `.robocal-PID-RANDOM.tmp` beside the target, which is renamed over it only
 //! once complete. A symbolic link to a regular file is written through (see [`resolve_output`]).
 //!
-//! Temporary files are registered while open, so that a signal handler can remove them all
+//! Temporary files are in a table while open, so that a signal handler can remove them all
 //! ([`remove_temporaries`]), and recorded in robocal's private directory; those a killed run left
 //! behind are removed by the next run that writes a file (only files a record proves are
 //! robocal's: never a user's file, whatever its name).
 
 use crate::error::{Error, Result};
+pub use crate::io::open_temporaries::remove_temporaries;
+use crate::io::open_temporaries::{interrupted, retiring, Open};
 pub use crate::io::target::resolve_output;
-pub use crate::io::temporaries::remove_temporaries;
-use crate::io::temporaries::{registry, remove_stale, temporary_name, Record};
+use crate::io::temporaries::{remove_stale, temporary_name, Record};
 use std::fs::File;
 use std::io::{BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
@@ -21,17 +22,6 @@ fn io_err(path: &Path, e: std::io::Error) -> Error {
         path: path.to_owned(),
         source: e,
     }
-}
-
-/// The error of a writer whose temporary file [`remove_temporaries`] removed.
-fn interrupted(path: &Path) -> Error {
-    io_err(
-        path,
-        std::io::Error::new(
-            std::io::ErrorKind::Interrupted,
-            "interrupted: the file being written was removed",
-        ),
-    )
 }
 
 /// Where the content of an [`AtomicFile`] goes on commit.
@@ -53,6 +43,9 @@ pub struct AtomicFile {
     target: PathBuf,
     dest: Dest,
     file: Option<BufWriter<File>>,
+    /// The temporary file's place in the table of open temporaries, until it is renamed or
+    /// removed (none for a spool without a name).
+    open: Option<Open>,
 }
 
 impl AtomicFile {
@@ -65,14 +58,10 @@ impl AtomicFile {
             Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
             _ => PathBuf::from("."),
         };
-        let (tmp, file) = {
-            // Created and registered under the lock: a signal handler removing the temporaries
-            // sees it, or this sees that the run is being interrupted.
-            let mut reg = registry();
-            if reg.closed() {
-                return Err(interrupted(target));
-            }
-            remove_stale(&reg);
+        // Created in the table of open temporaries: a signal handler removing them sees it, or
+        // this sees that the run is being interrupted.
+        let ((tmp, file), open) = crate::io::open_temporaries::add(target, || {
+            remove_stale();
             let mut attempt = 0;
             let (tmp, file) = loop {
                 let tmp = dir.join(temporary_name());
@@ -86,9 +75,8 @@ impl AtomicFile {
                 }
             };
             let record = Record::write(&tmp, &file);
-            reg.add(tmp.clone(), record);
-            (tmp, file)
-        };
+            Ok(((tmp.clone(), file), Some((tmp, record))))
+        })?;
         if let Ok(m) = std::fs::metadata(&path) {
             let _ = file.set_permissions(m.permissions());
         }
@@ -96,6 +84,7 @@ impl AtomicFile {
             target: target.to_owned(),
             dest: Dest::Rename { path, tmp },
             file: Some(BufWriter::new(file)),
+            open,
         })
     }
 
@@ -107,29 +96,26 @@ impl AtomicFile {
         let k = SPOOLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let tmp =
             std::env::temp_dir().join(format!(".robocal-spool.{}.{k}.tmp", std::process::id()));
-        let mut reg = registry();
-        if reg.closed() {
-            return Err(interrupted(label));
-        }
-        let file = File::options()
-            .read(true)
-            .write(true)
-            .create_new(true)
-            .open(&tmp)
-            .map_err(|e| io_err(&tmp, e))?;
-        // Unix keeps an open file's content after its name is removed: then nothing can be left
-        // behind, whatever ends the process.
-        let tmp = if std::fs::remove_file(&tmp).is_ok() {
-            None
-        } else {
+        let ((file, tmp), open) = crate::io::open_temporaries::add(label, || {
+            let file = File::options()
+                .read(true)
+                .write(true)
+                .create_new(true)
+                .open(&tmp)
+                .map_err(|e| io_err(&tmp, e))?;
+            // Unix keeps an open file's content after its name is removed: then nothing can be
+            // left behind, whatever ends the process.
+            if std::fs::remove_file(&tmp).is_ok() {
+                return Ok(((file, None), None));
+            }
             let record = Record::write(&tmp, &file);
-            reg.add(tmp.clone(), record);
-            Some(tmp)
-        };
+            Ok(((file, Some(tmp.clone())), Some((tmp, record))))
+        })?;
         Ok(AtomicFile {
             target: label.to_owned(),
             dest: Dest::Stream { sink, tmp },
             file: Some(BufWriter::new(file)),
+            open,
         })
     }
 
@@ -168,11 +154,13 @@ impl AtomicFile {
             Dest::Rename { tmp, .. } => Some(tmp),
             Dest::Stream { tmp, .. } => tmp.as_ref(),
         };
-        if let Some(tmp) = tmp {
-            let mut reg = registry();
-            if reg.forget(tmp) {
-                let _ = std::fs::remove_file(tmp);
-            }
+        let (Some(tmp), Some(open)) = (tmp, self.open.take()) else {
+            return;
+        };
+        // None: the signal handler has it (and removes it).
+        if let Some(mut r) = retiring([open.slot()], false) {
+            let _ = std::fs::remove_file(tmp);
+            r.done(0, open);
         }
     }
 }
@@ -197,14 +185,23 @@ pub fn commit_all(mut files: Vec<AtomicFile>) -> Result<()> {
         spooled.push(f.finish()?);
     }
     {
-        let mut reg = registry();
-        for f in &files {
+        // Renamed as one step a signal handler waits for; none once the run is being
+        // interrupted.
+        let renamed = |f: &&mut AtomicFile| matches!(f.dest, Dest::Rename { .. });
+        let slots: Vec<Option<usize>> = files
+            .iter_mut()
+            .filter(renamed)
+            .map(|f| f.open.as_ref().and_then(Open::slot))
+            .collect();
+        let Some(mut r) = retiring(slots, true) else {
+            return Err(interrupted(&files[0].target));
+        };
+        for (k, f) in files.iter_mut().filter(renamed).enumerate() {
             if let Dest::Rename { path, tmp } = &f.dest {
-                if reg.closed() || !reg.contains(tmp) {
-                    return Err(interrupted(&f.target));
-                }
                 std::fs::rename(tmp, path).map_err(|e| io_err(&f.target, e))?;
-                reg.forget(tmp);
+                if let Some(open) = f.open.take() {
+                    r.done(k, open);
+                }
             }
         }
     }

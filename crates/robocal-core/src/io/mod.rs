@@ -14,6 +14,7 @@ pub mod joint_limits;
 pub mod json_keys;
 pub mod measurements;
 mod measurements_write;
+mod open_temporaries;
 mod plain_decimal;
 pub mod result;
 pub mod result_cell;

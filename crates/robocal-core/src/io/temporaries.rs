@@ -1,78 +1,9 @@
-//! The temporary files of [`crate::io::AtomicFile`]: their names (`.robocal-PID-RANDOM.tmp`), a
-//! registry of those this process has open, so that an interrupted run can remove them
-//! ([`remove_temporaries`]), and records that prove which files are robocal's temporaries, so
-//! that those a killed run left behind are removed later ([`remove_stale`]) and nothing else is.
+//! The temporary files of [`crate::io::AtomicFile`]: their names (`.robocal-PID-RANDOM.tmp`) and
+//! the records that prove which files are robocal's temporaries, so that those a killed run left
+//! behind are removed later ([`remove_stale`]) and nothing else is. Those this process has open
+//! are in `io::open_temporaries`, which an interrupted run empties.
 
 use std::path::{Path, PathBuf};
-use std::sync::{Mutex, MutexGuard, PoisonError};
-
-/// The temporary files this process has open. Every creation, rename and removal of one happens
-/// under this lock, so that [`remove_temporaries`] (called from a signal-handling thread) sees a
-/// consistent set and no new file can appear after it.
-pub(crate) struct Registry {
-    open: Vec<(PathBuf, Record)>,
-    /// Set by [`remove_temporaries`]: the run is being interrupted, no new temporary file is
-    /// started and none is renamed into place.
-    closed: bool,
-}
-
-static REGISTRY: Mutex<Registry> = Mutex::new(Registry {
-    open: Vec::new(),
-    closed: false,
-});
-
-/// The registry, locked. A panic while it was held leaves it usable: its content is always
-/// consistent (single pushes and removals).
-pub(crate) fn registry() -> MutexGuard<'static, Registry> {
-    REGISTRY.lock().unwrap_or_else(PoisonError::into_inner)
-}
-
-impl Registry {
-    /// Whether [`remove_temporaries`] has run.
-    pub(crate) fn closed(&self) -> bool {
-        self.closed
-    }
-
-    /// Whether `tmp` is one of this process's open temporary files.
-    pub(crate) fn contains(&self, tmp: &Path) -> bool {
-        self.open.iter().any(|(p, _)| p == tmp)
-    }
-
-    /// Registers `tmp` and the record that proves it is robocal's.
-    pub(crate) fn add(&mut self, tmp: PathBuf, record: Record) {
-        self.open.push((tmp, record));
-    }
-
-    /// Forgets `tmp` (renamed into place or removed) and removes its record; whether it was
-    /// registered.
-    pub(crate) fn forget(&mut self, tmp: &Path) -> bool {
-        match self.open.iter().position(|(p, _)| p == tmp) {
-            Some(k) => {
-                self.open.swap_remove(k).1.remove();
-                true
-            }
-            None => false,
-        }
-    }
-}
-
-/// Removes every temporary file this process has open (the files being written, not yet renamed
-/// into place) and stops any new one from being started or renamed: what a handler of SIGINT or
-/// SIGTERM calls before the process exits, so that an interrupted run leaves nothing behind and
-/// every earlier output as it was. Returns how many files were removed. Writers still running
-/// afterwards fail with an "interrupted" I/O error.
-pub fn remove_temporaries() -> usize {
-    let mut reg = registry();
-    reg.closed = true;
-    let mut removed = 0;
-    for (tmp, record) in reg.open.drain(..) {
-        if std::fs::remove_file(&tmp).is_ok() {
-            removed += 1;
-        }
-        record.remove();
-    }
-    removed
-}
 
 /// The longest name a temporary file gets (`.robocal-PID-RANDOM.tmp`): short whatever the
 /// output's name, so that any legal output name can be written.
@@ -108,6 +39,11 @@ impl Record {
         }
     }
 
+    /// The record's path; none when nothing was recorded.
+    pub(crate) fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+
     /// Removes the record (the temporary was renamed into place or removed).
     pub(crate) fn remove(&self) {
         if let Some(p) = &self.path {
@@ -119,15 +55,14 @@ impl Record {
 /// Removes the temporary files that runs which no longer exist left behind (killed by SIGKILL
 /// or a power cut, which no handler can catch), as their records name them: only a regular file
 /// with the recorded device and inode. Records of live processes (or when that cannot be told)
-/// are left alone. Called with the registry held, so that this process's own temporaries are
-/// known.
-pub(crate) fn remove_stale(reg: &Registry) {
-    imp::remove_stale(reg);
+/// are left alone, this process's own among them.
+pub(crate) fn remove_stale() {
+    imp::remove_stale();
 }
 
 #[cfg(unix)]
 mod imp {
-    use super::{process_alive, Registry};
+    use super::process_alive;
     use std::os::unix::ffi::OsStrExt;
     use std::os::unix::fs::MetadataExt;
     use std::path::{Path, PathBuf};
@@ -160,7 +95,7 @@ mod imp {
         Some(rec)
     }
 
-    pub(super) fn remove_stale(reg: &Registry) {
+    pub(super) fn remove_stale() {
         let Some(dir) = records_dir() else {
             return;
         };
@@ -197,7 +132,7 @@ mod imp {
             if let (Some(Some(dev)), Some(Some(ino))) = (ids.next(), ids.next()) {
                 let same = std::fs::symlink_metadata(path)
                     .is_ok_and(|m| m.is_file() && m.dev() == dev && m.ino() == ino);
-                if same && !reg.contains(path) {
+                if same {
                     let _ = std::fs::remove_file(path);
                 }
             }
@@ -208,14 +143,13 @@ mod imp {
 
 #[cfg(not(unix))]
 mod imp {
-    use super::Registry;
     use std::path::{Path, PathBuf};
 
     pub(super) fn write_record(_tmp: &Path, _file: &std::fs::File) -> Option<PathBuf> {
         None
     }
 
-    pub(super) fn remove_stale(_reg: &Registry) {}
+    pub(super) fn remove_stale() {}
 }
 
 /// Whether a process with id `pid` exists (`kill(pid, 0)`: it does if the call succeeds or is
