@@ -86,11 +86,15 @@ fn fnv1a(bytes: &[u8]) -> u64 {
 mod imp {
     use super::{fnv1a, key, Error, Result};
     use std::fs::File;
-    use std::io::{Read, Seek, Write};
+    use std::io::Read;
     use std::os::fd::AsRawFd;
     use std::os::unix::ffi::OsStrExt;
+    use std::os::unix::fs::FileExt;
     use std::path::{Path, PathBuf};
     use std::sync::Mutex;
+
+    /// The width of the process id in a lock file (a `u32` has at most 10 digits).
+    const ID_WIDTH: usize = 10;
 
     /// The claims this process holds: the output's key and its open, locked lock file.
     static HELD: Mutex<Vec<(PathBuf, File)>> = Mutex::new(Vec::new());
@@ -158,9 +162,14 @@ mod imp {
                      again once it has finished, or give another output"
             )));
         }
-        f.set_len(0)?;
-        f.rewind()?;
-        write!(f, "{}", std::process::id())?;
+        // The id padded to a fixed width, written over the last holder's: the file keeps its
+        // length and its block (truncating it first cost a block's release and allocation in
+        // every run). Readers trim the padding.
+        let id = format!("{:<ID_WIDTH$}", std::process::id());
+        if f.metadata()?.len() != ID_WIDTH as u64 {
+            f.set_len(0)?;
+        }
+        f.write_all_at(id.as_bytes(), 0)?;
         Ok(f)
     }
 }
@@ -205,6 +214,31 @@ mod tests {
             e.contains(&format!("process {}", std::process::id())),
             "{e}"
         );
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// A lock file keeps this process's id alone, whatever an earlier holder (or an older
+    /// robocal, which wrote the id unpadded) left in it.
+    #[cfg(unix)]
+    #[test]
+    fn a_lock_file_holds_the_holders_id_alone() {
+        use std::os::unix::ffi::OsStrExt;
+        let d = std::env::temp_dir().join(format!("robocal-claims-id-{}", std::process::id()));
+        std::fs::create_dir_all(&d).unwrap();
+        for (k, before) in ["", "123", "4294967295 and more"].iter().enumerate() {
+            let out = key(&d.join(format!("{k}.csv")));
+            let file = private_dir()
+                .unwrap()
+                .join("claims")
+                .join(format!("{:016x}.lock", fnv1a(out.as_os_str().as_bytes())));
+            std::fs::create_dir_all(file.parent().unwrap()).unwrap();
+            std::fs::write(&file, before).unwrap();
+            let held = imp_other_lock(&out).unwrap();
+            let text = std::fs::read_to_string(&file).unwrap();
+            assert_eq!(text.trim(), std::process::id().to_string(), "{before:?}");
+            assert_eq!(text.len(), 10, "{text:?}");
+            drop(held);
+        }
         std::fs::remove_dir_all(&d).unwrap();
     }
 

@@ -304,11 +304,17 @@ impl CalibrationResult {
     fn serialized_text(&self) -> Result<String> {
         // Sized for the per-point entries (one line of at most about 90 bytes each: two errors
         // written to the last digit and a line number), so that a million points' text is
-        // neither copied as it grows nor given twice the room it needs.
-        let points = self.points.as_ref().map_or(0, |p| {
-            p.calibration.len() + p.validation.as_ref().map_or(0, Vec::len)
-        });
-        let mut buf = Vec::with_capacity((1 << 17) + 92 * points);
+        // neither copied as it grows nor given twice the room it needs. A skeleton
+        // (`io::result_deferred`) has none, and its other sections take a few tens of kB.
+        let capacity = if deferred::deferring() {
+            1 << 16
+        } else {
+            let points = self.points.as_ref().map_or(0, |p| {
+                p.calibration.len() + p.validation.as_ref().map_or(0, Vec::len)
+            });
+            (1 << 17) + 92 * points
+        };
+        let mut buf = Vec::with_capacity(capacity);
         let mut ser = serde_json::Serializer::with_formatter(
             &mut buf,
             crate::io::result_format::ResultFormatter::new(),

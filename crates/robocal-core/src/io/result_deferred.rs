@@ -44,7 +44,8 @@ thread_local! {
     static DEFERRING: Cell<bool> = const { Cell::new(false) };
 }
 
-fn deferring() -> bool {
+/// Whether this thread is serializing a result's skeleton.
+pub(super) fn deferring() -> bool {
     DEFERRING.with(Cell::get)
 }
 
