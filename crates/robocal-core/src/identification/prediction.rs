@@ -75,14 +75,7 @@ pub fn point_jacobian(
     jp: &mut [Vector3<f64>],
     out: &mut [f64],
 ) -> Vector3<f64> {
-    let k = index.len();
-    let p = robot.tool_screw_jacobians(q, None, Some(jp), None);
-    for (c, &i) in index.iter().enumerate() {
-        for r in 0..3 {
-            out[r * k + c] = jp[i][r];
-        }
-    }
-    p
+    target_jacobian(robot, index, q, 0, &Conditions::UNKNOWN, jp, out)
 }
 
 #[path = "prediction_norms.rs"]
@@ -188,17 +181,27 @@ impl<'a> Predictor<'a> {
             Some(l) => (l, 0),
             None => (&self.cov, k),
         };
-        for r in 0..3 {
-            let jr = &j[r * k..(r + 1) * k];
-            let xr = &mut x[r * k..(r + 1) * k];
-            xr.fill(0.0);
-            for (a, &ja) in jr.iter().enumerate() {
-                if ja != 0.0 {
-                    let n = (a + 1).max(width);
-                    for (xv, mv) in xr[..n].iter_mut().zip(&m[a * k..a * k + n]) {
-                        *xv += ja * mv;
-                    }
-                }
+        // The three rows together: each row of `m` is read once for the three (the same sums,
+        // term by term in the same order, as row by row).
+        x.fill(0.0);
+        let (x0, rest) = x.split_at_mut(k);
+        let (x1, x2) = rest.split_at_mut(k);
+        for a in 0..k {
+            let (j0, j1, j2) = (j[a], j[k + a], j[2 * k + a]);
+            if j0 == 0.0 && j1 == 0.0 && j2 == 0.0 {
+                continue;
+            }
+            let n = (a + 1).max(width);
+            let row = &m[a * k..a * k + n];
+            for (((v0, v1), v2), mv) in x0[..n]
+                .iter_mut()
+                .zip(&mut x1[..n])
+                .zip(&mut x2[..n])
+                .zip(row)
+            {
+                *v0 += j0 * mv;
+                *v1 += j1 * mv;
+                *v2 += j2 * mv;
             }
         }
         let y = if self.factor.is_some() { &*x } else { j };
@@ -314,6 +317,7 @@ impl<'a> Predictor<'a> {
 }
 
 /// [`point_jacobian`] for target `t` (0-based) of the robot's targets, under conditions `c`.
+#[inline(always)]
 fn target_jacobian(
     robot: &Robot,
     index: &[usize],
@@ -329,10 +333,11 @@ fn target_jacobian(
     } else {
         robot.target_screws_in(q, t, c, None, Some(jp), None)
     };
-    for (c, &i) in index.iter().enumerate() {
-        for r in 0..3 {
-            out[r * k + c] = jp[i][r];
-        }
+    let (o0, rest) = out[..3 * k].split_at_mut(k);
+    let (o1, o2) = rest.split_at_mut(k);
+    for (((v0, v1), v2), &i) in o0.iter_mut().zip(o1).zip(o2).zip(index) {
+        let col = &jp[i];
+        (*v0, *v1, *v2) = (col.x, col.y, col.z);
     }
     p
 }
