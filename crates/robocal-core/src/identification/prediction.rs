@@ -86,9 +86,10 @@ use norms::{gauss_legendre, sym3_eigenvalues};
 
 /// From this many poses, the per-pose work of a prediction runs on several threads (each pose's
 /// figures are computed on their own and summed in order: the same bits on any thread count).
-/// Below it one thread does it: for the workspace map's [`MAP_POSES`] (3.6 M instructions in
-/// callgrind) starting the thread pool and handing the work over cost more CPU time than they
-/// save (measured on the paper's 75 poses with `--model geometric`, whose map was then the run's
+/// Below it one thread does it: for the workspace map's [`MAP_POSES`] (4.1 M instructions in
+/// callgrind, its text in the result included: the run with no map takes that many fewer)
+/// starting the thread pool and handing the work over cost more CPU time than they save
+/// (measured on the paper's 75 poses with `--model geometric`, whose map was then the run's
 /// only parallel work: 4.7-5.3 ms of CPU on one thread against 5.3-5.5 ms, 8 context switches
 /// against 13-17).
 const PARALLEL_MIN_POSES: usize = 512;
