@@ -124,8 +124,9 @@ fn sigint_and_sigterm_remove_the_temporary_and_keep_the_old_output() {
     }
 }
 
-/// The handler waits for a temporary being created: a signal that comes as soon as the file
-/// exists, before its record may, removes both.
+/// A signal that comes as soon as the temporary exists, before its record may, removes both
+/// (the handler waits for the step that creates them; a unit test of `io::open_temporaries`
+/// holds such a step open to show the wait, which signals from here seldom hit).
 #[test]
 fn a_signal_as_the_temporary_is_created_removes_it_and_its_record() {
     let dir = inputs();

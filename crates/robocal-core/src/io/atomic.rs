@@ -58,10 +58,11 @@ impl AtomicFile {
             Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
             _ => PathBuf::from("."),
         };
+        // Before the step below, which blocks SIGINT and SIGTERM on this thread while it runs.
+        remove_stale();
         // Created in the table of open temporaries: a signal handler removing them sees it, or
         // this sees that the run is being interrupted.
         let ((tmp, file), open) = crate::io::open_temporaries::add(target, || {
-            remove_stale();
             let mut attempt = 0;
             let (tmp, file) = loop {
                 let tmp = dir.join(temporary_name());
@@ -130,7 +131,8 @@ impl AtomicFile {
         commit_all(vec![self])
     }
 
-    /// The writer, flushed and taken out (the temporary stays registered until renamed).
+    /// The writer, flushed and taken out (the temporary stays in the table of open temporaries
+    /// until renamed).
     fn finish(&mut self) -> Result<File> {
         let Some(w) = self.file.take() else {
             return Err(io_err(
@@ -171,6 +173,9 @@ impl AtomicFile {
 /// calling [`remove_temporaries`] waits for the renames). Streams are copied last. On a failure
 /// before the renames nothing is replaced and every temporary file is removed.
 pub fn commit_all(mut files: Vec<AtomicFile>) -> Result<()> {
+    if files.is_empty() {
+        return Ok(());
+    }
     // Another process writing one of these outputs now would interleave its set with this one.
     let targets: Vec<&Path> = files
         .iter()
