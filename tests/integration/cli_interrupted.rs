@@ -102,6 +102,20 @@ fn interrupt(args: &[String], out: &Path, signal: i32) -> (Option<i32>, Option<i
     (code, sig, err)
 }
 
+/// An interrupted compensation: exit 130, the message naming `signal` and the one temporary
+/// removed, `out` as it was ("old output") and no temporary left in `d`.
+fn assert_interrupted(code: Option<i32>, err: &str, signal: &str, out: &Path, d: &Path) {
+    assert_eq!(code, Some(130), "{signal}: {err}");
+    assert!(
+        err.contains(&format!(
+            "error: interrupted by {signal}; 1 unfinished temporary file(s) removed"
+        )),
+        "{err}"
+    );
+    assert_eq!(std::fs::read_to_string(out).unwrap(), "old output\n");
+    assert_eq!(temporaries(d), Vec::<String>::new(), "{signal}");
+}
+
 #[test]
 fn sigint_and_sigterm_remove_the_temporary_and_keep_the_old_output() {
     let dir = inputs();
@@ -111,16 +125,8 @@ fn sigint_and_sigterm_remove_the_temporary_and_keep_the_old_output() {
     let args = long_compensation(d, &out);
     for (signal, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
         let (code, _, err) = interrupt(&args, &out, signal);
-        assert_eq!(code, Some(130), "{name}: {err}");
         assert!(!err.contains("panicked"), "{err}");
-        assert!(
-            err.contains(&format!(
-                "error: interrupted by {name}; 1 unfinished temporary file(s) removed"
-            )),
-            "{err}"
-        );
-        assert_eq!(std::fs::read_to_string(&out).unwrap(), "old output\n");
-        assert_eq!(temporaries(d), Vec::<String>::new(), "{name}");
+        assert_interrupted(code, &err, name, &out, d);
     }
 }
 
@@ -137,15 +143,7 @@ fn a_signal_as_the_temporary_is_created_removes_it_and_its_record() {
     for _ in 0..3 {
         for (signal, name) in [(libc::SIGINT, "SIGINT"), (libc::SIGTERM, "SIGTERM")] {
             let (code, _, err, pid) = interrupt_when(&args, &out, signal, false);
-            assert_eq!(code, Some(130), "{name}: {err}");
-            assert!(
-                err.contains(&format!(
-                    "error: interrupted by {name}; 1 unfinished temporary file(s) removed"
-                )),
-                "{err}"
-            );
-            assert_eq!(std::fs::read_to_string(&out).unwrap(), "old output\n");
-            assert_eq!(temporaries(d), Vec::<String>::new(), "{name}");
+            assert_interrupted(code, &err, name, &out, d);
             assert_eq!(records(pid).0, 0, "{name}: the temporary's record is left");
         }
     }

@@ -317,7 +317,8 @@ impl<'a> Predictor<'a> {
     }
 }
 
-/// [`point_jacobian`] for target `t` (0-based) of the robot's targets, under conditions `c`.
+/// The Jacobian rows of target `t` (0-based) of the robot's targets under conditions `c`, as
+/// [`point_jacobian`] gives them for the tool point.
 #[inline(always)]
 fn target_jacobian(
     robot: &Robot,

@@ -10,7 +10,7 @@
 
 use crate::error::{Error, Result};
 pub use crate::io::open_temporaries::remove_temporaries;
-use crate::io::open_temporaries::{interrupted, retiring, Open};
+use crate::io::open_temporaries::{add, interrupted, retiring, Open};
 pub use crate::io::target::resolve_output;
 use crate::io::temporaries::{remove_stale, temporary_name, Record};
 use std::fs::File;
@@ -26,14 +26,10 @@ fn io_err(path: &Path, e: std::io::Error) -> Error {
 
 /// Where the content of an [`AtomicFile`] goes on commit.
 enum Dest {
-    /// `tmp` is renamed over `path` (the target with its symbolic links resolved).
-    Rename { path: PathBuf, tmp: PathBuf },
-    /// The spool file is copied to `sink`. `tmp` is the spool's name while it still has one
-    /// (on Unix it is removed as soon as it is open).
-    Stream {
-        sink: Box<dyn Write + Send>,
-        tmp: Option<PathBuf>,
-    },
+    /// The temporary file is renamed over `path` (the target with its symbolic links resolved).
+    Rename { path: PathBuf },
+    /// The spool file is copied to `sink`.
+    Stream { sink: Box<dyn Write + Send> },
 }
 
 /// A file being written; becomes visible under its final name only on [`AtomicFile::commit`].
@@ -43,8 +39,9 @@ pub struct AtomicFile {
     target: PathBuf,
     dest: Dest,
     file: Option<BufWriter<File>>,
-    /// The temporary file's place in the table of open temporaries, until it is renamed or
-    /// removed (none for a spool without a name).
+    /// The temporary file (its path and its place in the table of open temporaries), until it
+    /// is renamed or removed. None for a spool without a name (on Unix it is removed as soon as
+    /// it is open).
     open: Option<Open>,
 }
 
@@ -62,7 +59,7 @@ impl AtomicFile {
         remove_stale();
         // Created in the table of open temporaries: a signal handler removing them sees it, or
         // this sees that the run is being interrupted.
-        let ((tmp, file), open) = crate::io::open_temporaries::add(target, || {
+        let (file, open) = add(target, || {
             let mut attempt = 0;
             let (tmp, file) = loop {
                 let tmp = dir.join(temporary_name());
@@ -76,14 +73,14 @@ impl AtomicFile {
                 }
             };
             let record = Record::write(&tmp, &file);
-            Ok(((tmp.clone(), file), Some((tmp, record))))
+            Ok((file, Some((tmp, record))))
         })?;
         if let Ok(m) = std::fs::metadata(&path) {
             let _ = file.set_permissions(m.permissions());
         }
         Ok(AtomicFile {
             target: target.to_owned(),
-            dest: Dest::Rename { path, tmp },
+            dest: Dest::Rename { path },
             file: Some(BufWriter::new(file)),
             open,
         })
@@ -97,7 +94,7 @@ impl AtomicFile {
         let k = SPOOLS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let tmp =
             std::env::temp_dir().join(format!(".robocal-spool.{}.{k}.tmp", std::process::id()));
-        let ((file, tmp), open) = crate::io::open_temporaries::add(label, || {
+        let (file, open) = add(label, || {
             let file = File::options()
                 .read(true)
                 .write(true)
@@ -107,14 +104,14 @@ impl AtomicFile {
             // Unix keeps an open file's content after its name is removed: then nothing can be
             // left behind, whatever ends the process.
             if std::fs::remove_file(&tmp).is_ok() {
-                return Ok(((file, None), None));
+                return Ok((file, None));
             }
             let record = Record::write(&tmp, &file);
-            Ok(((file, Some(tmp.clone())), Some((tmp, record))))
+            Ok((file, Some((tmp, record))))
         })?;
         Ok(AtomicFile {
             target: label.to_owned(),
-            dest: Dest::Stream { sink, tmp },
+            dest: Dest::Stream { sink },
             file: Some(BufWriter::new(file)),
             open,
         })
@@ -152,16 +149,12 @@ impl AtomicFile {
     /// Removes the temporary file if it is still this writer's (not renamed, not removed by
     /// [`remove_temporaries`]).
     fn discard(&mut self) {
-        let tmp = match &self.dest {
-            Dest::Rename { tmp, .. } => Some(tmp),
-            Dest::Stream { tmp, .. } => tmp.as_ref(),
-        };
-        let (Some(tmp), Some(open)) = (tmp, self.open.take()) else {
+        let Some(open) = self.open.take() else {
             return;
         };
         // None: the signal handler has it (and removes it).
-        if let Some(mut r) = retiring([open.slot()], false) {
-            let _ = std::fs::remove_file(tmp);
+        if let Some(mut r) = retiring([&open], false) {
+            let _ = std::fs::remove_file(open.tmp());
             r.done(0, open);
         }
     }
@@ -180,7 +173,7 @@ pub fn commit_all(mut files: Vec<AtomicFile>) -> Result<()> {
     let targets: Vec<&Path> = files
         .iter()
         .filter_map(|f| match &f.dest {
-            Dest::Rename { path, .. } => Some(path.as_path()),
+            Dest::Rename { path } => Some(path.as_path()),
             Dest::Stream { .. } => None,
         })
         .collect();
@@ -192,22 +185,28 @@ pub fn commit_all(mut files: Vec<AtomicFile>) -> Result<()> {
     {
         // Renamed as one step a signal handler waits for; none once the run is being
         // interrupted.
-        let renamed = |f: &&mut AtomicFile| matches!(f.dest, Dest::Rename { .. });
-        let slots: Vec<Option<usize>> = files
-            .iter_mut()
-            .filter(renamed)
-            .map(|f| f.open.as_ref().and_then(Open::slot))
-            .collect();
-        let Some(mut r) = retiring(slots, true) else {
+        let renamed = files.iter().filter_map(|f| match (&f.dest, &f.open) {
+            (Dest::Rename { .. }, Some(open)) => Some(open),
+            _ => None,
+        });
+        let Some(mut r) = retiring(renamed, true) else {
             return Err(interrupted(&files[0].target));
         };
-        for (k, f) in files.iter_mut().filter(renamed).enumerate() {
-            if let Dest::Rename { path, tmp } = &f.dest {
-                std::fs::rename(tmp, path).map_err(|e| io_err(&f.target, e))?;
-                if let Some(open) = f.open.take() {
-                    r.done(k, open);
-                }
+        let mut k = 0;
+        for f in &mut files {
+            let Dest::Rename { path } = &f.dest else {
+                continue;
+            };
+            let Some(open) = f.open.take() else {
+                continue;
+            };
+            if let Err(e) = std::fs::rename(open.tmp(), path) {
+                // Still this writer's: removed when it is dropped.
+                f.open = Some(open);
+                return Err(io_err(&f.target, e));
             }
+            r.done(k, open);
+            k += 1;
         }
     }
     for (f, mut spool) in files.iter_mut().zip(spooled) {

@@ -134,13 +134,14 @@ pub(crate) fn interrupted(path: &Path) -> Error {
 pub(crate) struct Open {
     /// Its slot; none when the table was full.
     slot: Option<usize>,
+    tmp: PathBuf,
     record: Record,
 }
 
 impl Open {
-    /// Its slot in the table, if it has one.
-    pub(crate) fn slot(&self) -> Option<usize> {
-        self.slot
+    /// The temporary file's path.
+    pub(crate) fn tmp(&self) -> &Path {
+        &self.tmp
     }
 }
 
@@ -171,7 +172,7 @@ pub(crate) fn add<T>(
     if let Some(k) = slot {
         publish(&TABLE[k], &tmp, &record);
     }
-    Ok((made, Some(Open { slot, record })))
+    Ok((made, Some(Open { slot, tmp, record })))
 }
 
 /// Puts the paths in the busy slot `s` and opens it.
@@ -194,20 +195,20 @@ pub(crate) struct Retiring {
     _step: Step,
 }
 
-/// Starts retiring the files in `slots` ([`Open::slot`], in the order [`Retiring::done`] counts
-/// them): `None` when the handler has taken one of them (it removes them: the writer has nothing
-/// left to do) or, when `renaming`, when the run is being interrupted (no file is renamed into
-/// place after that; removing one still is).
-pub(crate) fn retiring(
-    slots: impl IntoIterator<Item = Option<usize>>,
+/// Starts retiring `files` (in the order [`Retiring::done`] counts them): `None` when the
+/// handler has taken one of them (it removes them: the writer has nothing left to do) or, when
+/// `renaming`, when the run is being interrupted (no file is renamed into place after that;
+/// removing one still is).
+pub(crate) fn retiring<'a>(
+    files: impl IntoIterator<Item = &'a Open>,
     renaming: bool,
 ) -> Option<Retiring> {
     let mut r = Retiring {
         slots: Vec::new(),
         _step: Step::begin(),
     };
-    for slot in slots {
-        match slot {
+    for f in files {
+        match f.slot {
             Some(k)
                 if TABLE[k]
                     .state
@@ -375,7 +376,7 @@ mod tests {
     use super::*;
 
     fn state(open: &Open) -> u8 {
-        TABLE[open.slot().expect("a slot")].state.load(SeqCst)
+        TABLE[open.slot.expect("a slot")].state.load(SeqCst)
     }
 
     /// A temporary file `path` made through [`add`], with its record.
@@ -402,7 +403,7 @@ mod tests {
         let dir = scratch_dir("open-tmp");
         let tmp = dir.join(".robocal-test.tmp");
         let (file, open) = temporary(&tmp);
-        let k = open.slot().unwrap();
+        let k = open.slot.unwrap();
         assert_eq!(state(&open), OPEN);
         // SAFETY: the slot is this test's and open: its paths stay allocated.
         let path = unsafe { std::ffi::CStr::from_ptr(TABLE[k].tmp.load(SeqCst)) };
@@ -412,7 +413,7 @@ mod tests {
             assert!(r.exists(), "{}", r.display());
         }
 
-        let r = retiring([open.slot()], true).expect("not interrupted");
+        let r = retiring([&open], true).expect("not interrupted");
         assert_eq!(state(&open), BUSY);
         drop(r);
         assert_eq!(
@@ -421,7 +422,7 @@ mod tests {
             "retiring stopped short gives the slot back"
         );
 
-        let mut r = retiring([open.slot()], false).unwrap();
+        let mut r = retiring([&open], false).unwrap();
         drop(file);
         std::fs::remove_file(&tmp).unwrap();
         r.done(0, open);
@@ -498,7 +499,7 @@ mod tests {
             .iter()
             .filter_map(|o| o.record.path().map(Path::to_owned))
             .collect();
-        let mut r = retiring([open_a.slot()], true).unwrap();
+        let mut r = retiring([&open_a], true).unwrap();
         let handler = std::thread::spawn(remove_temporaries);
         std::thread::sleep(std::time::Duration::from_millis(200));
         assert!(
@@ -519,14 +520,8 @@ mod tests {
             panic!("a temporary created after the handler");
         };
         assert!(e.to_string().contains("interrupted"), "{e}");
-        assert!(
-            retiring([None], true).is_none(),
-            "a rename after the handler"
-        );
-        assert!(
-            retiring([None], false).is_some(),
-            "a removal after the handler"
-        );
+        assert!(retiring([], true).is_none(), "a rename after the handler");
+        assert!(retiring([], false).is_some(), "a removal after the handler");
         drop((fb, open_b));
         std::fs::remove_dir_all(&dir).unwrap();
     }
