@@ -178,215 +178,328 @@ fn solve_inner(
     observer: &dyn Observer,
     first: Option<Accumulated>,
 ) -> (SolverReport, Accumulated, bool) {
-    let k = problem.params().len();
-    let n = problem.len().max(1) as f64;
-    let mut x = problem.values(robot);
-    // Newton steps need the objective's Hessian; for least squares it is A itself.
-    let level = if matches!(loss, Loss::Squared) {
-        Level::Normal
-    } else {
-        Level::Newton
-    };
-    let first = first
-        .filter(|f| f.s.is_some() && f.h.is_some() && f.a.nrows() == k)
-        .unwrap_or_else(|| problem.accumulate(robot, loss, Level::Full));
-    // RMS tool displacement per unit change of each parameter, for the step test.
-    let s = first.s.as_ref().expect("full pass");
-    let col_rms: Vec<f64> = (0..k).map(|j| (s[(j, j)] / n).sqrt()).collect();
-    let mut acc = first;
-    // The objective at `robot`'s current values.
-    let mut f_cur = acc.objective;
-    let mut report = SolverReport {
-        termination: Termination::MaxIterations,
-        iterations: 0,
-        evaluations: 1,
-        initial_objective: acc.objective,
-        final_objective: acc.objective,
-        final_gradient: f64::NAN,
-        last_step_mm: f64::NAN,
-    };
-    if k == 0 {
-        report.termination = Termination::ConvergedGradient;
-        report.final_gradient = 0.0;
-        return (report, acc, true);
+    let mut state = Iterate::start(problem, robot, loss, opts, first);
+    let termination = state.run(robot, observer);
+    let Iterate {
+        mut report,
+        acc,
+        current,
+        f_cur,
+        ..
+    } = state;
+    report.termination = termination;
+    report.final_objective = f_cur;
+    (report, acc, current)
+}
+
+/// What a part of an iteration decided.
+enum Next {
+    /// A step was taken: on to the next iteration.
+    Iterate,
+    /// The solve ends, for this reason.
+    Stop(Termination),
+    /// The undamped step was not tried or not taken: the damped steps follow.
+    Damped,
+}
+
+/// The solver's state from one iteration to the next: the parameters, the pass at them, the
+/// damping, and the storage the steps reuse.
+struct Iterate<'a, 'p> {
+    problem: &'a Problem<'p>,
+    loss: &'a Loss,
+    opts: &'a SolverOptions,
+    /// The pass made at a point the trial did not make one at: Newton steps need the
+    /// objective's Hessian; for least squares it is `A` itself.
+    level: Level,
+    /// RMS tool displacement per unit change of each parameter, for the step test.
+    col_rms: Vec<f64>,
+    x: DVector<f64>,
+    acc: Accumulated,
+    /// The objective at `robot`'s current values.
+    f_cur: f64,
+    report: SolverReport,
+    /// Marquardt's scaling: the running maximum of `diag(A)`.
+    d: DVector<f64>,
+    lambda: f64,
+    nu: f64,
+    trial: Robot,
+    m: DMatrix<f64>,
+    delta: DVector<f64>,
+    x_new: DVector<f64>,
+    /// Whether `acc` is the pass at `robot`'s current values.
+    current: bool,
+}
+
+impl<'a, 'p> Iterate<'a, 'p> {
+    /// The state at `robot`'s values, with `first` as the full pass there when it is one.
+    fn start(
+        problem: &'a Problem<'p>,
+        robot: &Robot,
+        loss: &'a Loss,
+        opts: &'a SolverOptions,
+        first: Option<Accumulated>,
+    ) -> Self {
+        let k = problem.params().len();
+        let n = problem.len().max(1) as f64;
+        let level = if matches!(loss, Loss::Squared) {
+            Level::Normal
+        } else {
+            Level::Newton
+        };
+        let acc = first
+            .filter(|f| f.s.is_some() && f.h.is_some() && f.a.nrows() == k)
+            .unwrap_or_else(|| problem.accumulate(robot, loss, Level::Full));
+        let s = acc.s.as_ref().expect("full pass");
+        let col_rms: Vec<f64> = (0..k).map(|j| (s[(j, j)] / n).sqrt()).collect();
+        let report = SolverReport {
+            termination: Termination::MaxIterations,
+            iterations: 0,
+            evaluations: 1,
+            initial_objective: acc.objective,
+            final_objective: acc.objective,
+            final_gradient: f64::NAN,
+            last_step_mm: f64::NAN,
+        };
+        Iterate {
+            problem,
+            loss,
+            opts,
+            level,
+            col_rms,
+            x: problem.values(robot),
+            f_cur: acc.objective,
+            d: DVector::from_fn(k, |j, _| acc.a[(j, j)]),
+            acc,
+            report,
+            lambda: opts.initial_lambda,
+            nu: 2.0,
+            trial: robot.clone(),
+            m: DMatrix::zeros(k, k),
+            delta: DVector::zeros(k),
+            x_new: DVector::zeros(k),
+            current: true,
+        }
     }
-    let mut d = DVector::from_fn(k, |j, _| acc.a[(j, j)]);
-    let mut lambda = opts.initial_lambda;
-    let mut nu = 2.0;
-    let mut trial = robot.clone();
-    let mut m = DMatrix::zeros(k, k);
-    let mut delta = DVector::zeros(k);
-    let mut x_new = DVector::zeros(k);
-    // Whether `acc` is the pass at `robot`'s current values.
-    let mut current = true;
-    'outer: for it in 1..=opts.max_iterations {
-        report.iterations = it;
-        observer.progress(Stage::Identification(loss.name()), it, opts.max_iterations);
-        if !acc.objective.is_finite() || acc.b.iter().any(|v| !v.is_finite()) {
-            report.termination =
-                Termination::Failed("non-finite residuals or Jacobian".to_string());
-            break;
+
+    /// Iterates until a termination: each iteration tries the undamped step, then damped ones.
+    fn run(&mut self, robot: &mut Robot, observer: &dyn Observer) -> Termination {
+        let k = self.x.len();
+        if k == 0 {
+            self.report.final_gradient = 0.0;
+            return Termination::ConvergedGradient;
         }
-        let grad = gradient_cosine(&acc.a, &acc.b, acc.weighted_sq);
-        report.final_gradient = grad;
-        if grad <= opts.gradient_tolerance {
-            report.termination = Termination::ConvergedGradient;
-            break;
+        for it in 1..=self.opts.max_iterations {
+            self.report.iterations = it;
+            observer.progress(
+                Stage::Identification(self.loss.name()),
+                it,
+                self.opts.max_iterations,
+            );
+            if !self.acc.objective.is_finite() || self.acc.b.iter().any(|v| !v.is_finite()) {
+                return Termination::Failed("non-finite residuals or Jacobian".to_string());
+            }
+            let grad = gradient_cosine(&self.acc.a, &self.acc.b, self.acc.weighted_sq);
+            self.report.final_gradient = grad;
+            if grad <= self.opts.gradient_tolerance {
+                return Termination::ConvergedGradient;
+            }
+            for j in 0..k {
+                self.d[j] = self.d[j].max(self.acc.a[(j, j)]).max(f64::MIN_POSITIVE);
+            }
+            let next = match self.undamped(robot) {
+                Next::Damped => self.damped(robot),
+                next => next,
+            };
+            if let Next::Stop(termination) = next {
+                return termination;
+            }
         }
-        for j in 0..k {
-            d[j] = d[j].max(acc.a[(j, j)]).max(f64::MIN_POSITIVE);
-        }
-        // The undamped step first (Gauss-Newton for least squares, Newton's model for the
-        // other losses): near the minimum it converges in a few iterations where a damped step
-        // only creeps along the weakly determined directions. Its predicted gain is the most
-        // the model can gain, so a small one means convergence.
-        // Only where the damped steps have found the model trustworthy (lambda back at or below
-        // its initial value): far from the minimum the undamped step would mostly be rejected.
-        let newton_model = acc.h.as_ref().unwrap_or(&acc.a);
-        if lambda <= opts.initial_lambda
-            && damped_solve(newton_model, &d, 0.0, &acc.b, &mut m, &mut delta)
+        Termination::MaxIterations
+    }
+
+    /// The largest RMS tool displacement of one parameter's change in `delta` (mm).
+    fn step_mm(&self) -> f64 {
+        (0..self.x.len())
+            .map(|j| self.delta[j].abs() * self.col_rms[j])
+            .fold(0.0, f64::max)
+    }
+
+    /// The undamped step first (Gauss-Newton for least squares, Newton's model for the other
+    /// losses): near the minimum it converges in a few iterations where a damped step only
+    /// creeps along the weakly determined directions. Its predicted gain is the most the model
+    /// can gain, so a small one means convergence.
+    /// Only where the damped steps have found the model trustworthy (lambda back at or below its
+    /// initial value): far from the minimum the undamped step would mostly be rejected.
+    fn undamped(&mut self, robot: &mut Robot) -> Next {
+        let newton_model = self.acc.h.as_ref().unwrap_or(&self.acc.a);
+        if self.lambda > self.opts.initial_lambda
+            || !damped_solve(
+                newton_model,
+                &self.d,
+                0.0,
+                &self.acc.b,
+                &mut self.m,
+                &mut self.delta,
+            )
         {
-            let pred = acc.b.dot(&delta) - 0.5 * delta.dot(&(newton_model * &delta));
-            let tol = opts.objective_tolerance * acc.objective.abs();
-            if pred <= tol {
-                report.termination = Termination::ConvergedObjective;
-                break 'outer;
-            }
-            x_new.copy_from(&x);
-            x_new += &delta;
-            problem.apply(&mut trial, &x_new);
-            // The current pass's norms are not read once a step is tried (on a million points
-            // two sets of them would be 16 MB).
-            acc.norms = None;
-            let at_trial = problem.accumulate(&trial, loss, Level::Full);
-            let f_new = at_trial.objective;
-            report.evaluations += 1;
-            let gain = (acc.objective - f_new) / pred;
-            if f_new.is_finite() && gain > UNDAMPED_MIN_GAIN {
-                let step = (0..k)
-                    .map(|j| delta[j].abs() * col_rms[j])
-                    .fold(0.0, f64::max);
-                report.last_step_mm = step;
-                let small_change = acc.objective - f_new <= tol;
-                f_cur = f_new;
-                x.copy_from(&x_new);
-                problem.apply(robot, &x);
-                acc = at_trial;
-                report.final_objective = acc.objective;
-                lambda = (lambda / 3.0).max(MIN_LAMBDA);
-                nu = 2.0;
-                if step <= opts.step_tolerance_mm {
-                    report.termination = Termination::ConvergedStep;
-                    break 'outer;
-                }
-                if small_change {
-                    report.termination = Termination::ConvergedObjective;
-                    break 'outer;
-                }
-                continue 'outer;
-            }
-            problem.apply(&mut trial, &x);
+            return Next::Damped;
         }
+        let pred =
+            self.acc.b.dot(&self.delta) - 0.5 * self.delta.dot(&(newton_model * &self.delta));
+        let tol = self.opts.objective_tolerance * self.acc.objective.abs();
+        if pred <= tol {
+            return Next::Stop(Termination::ConvergedObjective);
+        }
+        self.x_new.copy_from(&self.x);
+        self.x_new += &self.delta;
+        self.problem.apply(&mut self.trial, &self.x_new);
+        // The current pass's norms are not read once a step is tried (on a million points two
+        // sets of them would be 16 MB).
+        self.acc.norms = None;
+        let at_trial = self.problem.accumulate(&self.trial, self.loss, Level::Full);
+        let f_new = at_trial.objective;
+        self.report.evaluations += 1;
+        let gain = (self.acc.objective - f_new) / pred;
+        if !(f_new.is_finite() && gain > UNDAMPED_MIN_GAIN) {
+            self.problem.apply(&mut self.trial, &self.x);
+            return Next::Damped;
+        }
+        let step = self.step_mm();
+        self.report.last_step_mm = step;
+        let small_change = self.acc.objective - f_new <= tol;
+        self.f_cur = f_new;
+        self.x.copy_from(&self.x_new);
+        self.problem.apply(robot, &self.x);
+        self.acc = at_trial;
+        self.report.final_objective = self.acc.objective;
+        self.lambda = (self.lambda / 3.0).max(MIN_LAMBDA);
+        self.nu = 2.0;
+        if step <= self.opts.step_tolerance_mm {
+            Next::Stop(Termination::ConvergedStep)
+        } else if small_change {
+            Next::Stop(Termination::ConvergedObjective)
+        } else {
+            Next::Iterate
+        }
+    }
+
+    /// Damped steps, raising the damping after each round that no step of lowers the objective,
+    /// until one does or the damping gives up.
+    fn damped(&mut self, robot: &mut Robot) -> Next {
         let mut first_try = true;
         loop {
-            // Newton's model first (fast near the minimum), then the reweighted one (a
-            // majorizer: reliable far from it and for exact fits).
-            let mut best_step = f64::INFINITY;
-            let mut accepted = None;
-            let mut small_change = false;
-            for use_newton in [true, false] {
-                let model = match (use_newton, &acc.h) {
-                    (true, Some(h)) => h,
-                    (true, None) => continue,
-                    (false, _) => &acc.a,
-                };
-                if !damped_solve(model, &d, lambda, &acc.b, &mut m, &mut delta) {
-                    continue;
-                }
-                let pred = acc.b.dot(&delta) - 0.5 * delta.dot(&(model * &delta));
-                if first_try
-                    && lambda <= opts.initial_lambda
-                    && pred <= opts.objective_tolerance * acc.objective.abs()
-                {
-                    report.termination = Termination::ConvergedObjective;
-                    break 'outer;
-                }
-                first_try = false;
-                let step = (0..k)
-                    .map(|j| delta[j].abs() * col_rms[j])
-                    .fold(0.0, f64::max);
-                best_step = best_step.min(step);
-                report.last_step_mm = step;
-                x_new.copy_from(&x);
-                x_new += &delta;
-                problem.apply(&mut trial, &x_new);
-                // Where the model is trusted the step is likely taken: its pass then serves
-                // the next iteration.
-                let near = lambda <= opts.initial_lambda;
-                if near {
-                    acc.norms = None;
-                }
-                let (f_new, at_trial) = trial_pass(problem, &trial, loss, near);
-                report.evaluations += 1;
-                let gain = (acc.objective - f_new) / pred;
-                if f_new.is_finite() && pred > 0.0 && gain > 1e-4 {
-                    let tol = opts.objective_tolerance * acc.objective.abs();
-                    small_change = acc.objective - f_new <= tol && pred <= tol;
-                    lambda *= (1.0 - (2.0 * gain - 1.0).powi(3)).max(1.0 / 3.0);
-                    accepted = Some((f_new, at_trial));
-                    break;
-                }
-                problem.apply(&mut trial, &x);
-            }
-            if let Some((f_new, at_trial)) = accepted {
-                f_cur = f_new;
-                x.copy_from(&x_new);
-                problem.apply(robot, &x);
-                nu = 2.0;
-                let converged = if report.last_step_mm <= opts.step_tolerance_mm {
-                    Some(Termination::ConvergedStep)
-                } else if small_change {
-                    Some(Termination::ConvergedObjective)
-                } else {
-                    None
-                };
-                // The pass at the new point: the trial's when it made one, else its own
-                // (not needed to stop).
-                match at_trial {
-                    Some(pass) => acc = pass,
-                    None if converged.is_none() => {
-                        acc = problem.accumulate(robot, loss, level);
-                        report.evaluations += 1;
-                    }
-                    None => current = false,
-                }
-                report.final_objective = f_new;
-                if let Some(t) = converged {
-                    report.termination = t;
-                    break 'outer;
-                }
-                continue 'outer;
-            }
+            let best_step = match self.damped_trials(robot, &mut first_try) {
+                Ok(next) => return next,
+                Err(best_step) => best_step,
+            };
             // Rejected: the current point stays. A rejected step below the tolerance means the
             // objective cannot be lowered at this precision.
-            if best_step <= opts.step_tolerance_mm {
-                report.termination = Termination::ConvergedStep;
-                break 'outer;
+            if best_step <= self.opts.step_tolerance_mm {
+                return Next::Stop(Termination::ConvergedStep);
             }
-            lambda *= nu;
-            nu *= 2.0;
-            if lambda > 1e30 {
-                report.termination = Termination::Failed(if best_step.is_finite() {
+            self.lambda *= self.nu;
+            self.nu *= 2.0;
+            if self.lambda > 1e30 {
+                return Next::Stop(Termination::Failed(if best_step.is_finite() {
                     "no step lowers the objective".to_string()
                 } else {
                     "the damped normal equations are singular".to_string()
-                });
-                break 'outer;
+                }));
             }
         }
     }
-    report.final_objective = f_cur;
-    (report, acc, current)
+
+    /// One round of damped trials at the current damping: Newton's model first (fast near the
+    /// minimum), then the reweighted one (a majorizer: reliable far from it and for exact fits).
+    /// `first_try` is cleared by the first step solved. The decision when a step is accepted
+    /// (or the lightly damped step predicts no gain), else the smallest of the steps tried (mm).
+    fn damped_trials(&mut self, robot: &mut Robot, first_try: &mut bool) -> Result<Next, f64> {
+        let mut best_step = f64::INFINITY;
+        for use_newton in [true, false] {
+            let model = match (use_newton, &self.acc.h) {
+                (true, Some(h)) => h,
+                (true, None) => continue,
+                (false, _) => &self.acc.a,
+            };
+            if !damped_solve(
+                model,
+                &self.d,
+                self.lambda,
+                &self.acc.b,
+                &mut self.m,
+                &mut self.delta,
+            ) {
+                continue;
+            }
+            let pred = self.acc.b.dot(&self.delta) - 0.5 * self.delta.dot(&(model * &self.delta));
+            if *first_try
+                && self.lambda <= self.opts.initial_lambda
+                && pred <= self.opts.objective_tolerance * self.acc.objective.abs()
+            {
+                return Ok(Next::Stop(Termination::ConvergedObjective));
+            }
+            *first_try = false;
+            let step = self.step_mm();
+            best_step = best_step.min(step);
+            self.report.last_step_mm = step;
+            self.x_new.copy_from(&self.x);
+            self.x_new += &self.delta;
+            self.problem.apply(&mut self.trial, &self.x_new);
+            // Where the model is trusted the step is likely taken: its pass then serves the next
+            // iteration.
+            let near = self.lambda <= self.opts.initial_lambda;
+            if near {
+                self.acc.norms = None;
+            }
+            let (f_new, at_trial) = trial_pass(self.problem, &self.trial, self.loss, near);
+            self.report.evaluations += 1;
+            let gain = (self.acc.objective - f_new) / pred;
+            if f_new.is_finite() && pred > 0.0 && gain > 1e-4 {
+                let tol = self.opts.objective_tolerance * self.acc.objective.abs();
+                let small_change = self.acc.objective - f_new <= tol && pred <= tol;
+                self.lambda *= (1.0 - (2.0 * gain - 1.0).powi(3)).max(1.0 / 3.0);
+                return Ok(self.accept(robot, f_new, at_trial, small_change));
+            }
+            self.problem.apply(&mut self.trial, &self.x);
+        }
+        Err(best_step)
+    }
+
+    /// Moves `robot` to the accepted damped step `x_new`, whose objective is `f_new`.
+    fn accept(
+        &mut self,
+        robot: &mut Robot,
+        f_new: f64,
+        at_trial: Option<Accumulated>,
+        small_change: bool,
+    ) -> Next {
+        self.f_cur = f_new;
+        self.x.copy_from(&self.x_new);
+        self.problem.apply(robot, &self.x);
+        self.nu = 2.0;
+        let converged = if self.report.last_step_mm <= self.opts.step_tolerance_mm {
+            Some(Termination::ConvergedStep)
+        } else if small_change {
+            Some(Termination::ConvergedObjective)
+        } else {
+            None
+        };
+        // The pass at the new point: the trial's when it made one, else its own (not needed to
+        // stop).
+        match at_trial {
+            Some(pass) => self.acc = pass,
+            None if converged.is_none() => {
+                self.acc = self.problem.accumulate(robot, self.loss, self.level);
+                self.report.evaluations += 1;
+            }
+            None => self.current = false,
+        }
+        self.report.final_objective = f_new;
+        match converged {
+            Some(termination) => Next::Stop(termination),
+            None => Next::Iterate,
+        }
+    }
 }
 
 /// The objective at a trial point `trial`, with the full pass ([`Level::Full`]) there when
