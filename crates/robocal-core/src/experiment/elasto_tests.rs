@@ -3,8 +3,9 @@
 //! another payload, and in the verification.
 
 use super::*;
+use crate::evaluation::evaluate;
 use crate::model::family::compliance;
-use crate::simulation::SET_VALIDATION;
+use crate::simulation::{simulate, TruthSpec, SET_VALIDATION};
 
 /// Compliance on joints 2 and 3 only, the paper's arm masses and a 300 kg payload.
 fn sagging() -> GravityModel {

@@ -23,6 +23,7 @@
 //! same numbers. The library writes nothing; the caller writes [`Experiment::files`].
 
 mod real_cell;
+mod steps;
 mod truth_compare;
 
 #[cfg(test)]
@@ -33,22 +34,16 @@ mod tests;
 pub use real_cell::{RealCell, VERIFICATION_START_S};
 pub use truth_compare::{compare_with_truth, TruthComparison};
 
-use crate::compensation::commanded::commanded_csv;
-use crate::compensation::{Compensation, Compensator, DampedLeastSquares};
+use crate::compensation::{Compensation, DampedLeastSquares};
 use crate::error::{Error, Result};
-use crate::evaluation::{evaluate, Against, Evaluation};
-use crate::identification::{
-    calibrate, split_measurements, Calibration, CalibrationData, CalibrationSettings,
-};
+use crate::evaluation::Evaluation;
+use crate::identification::{Calibration, CalibrationSettings};
 use crate::io::measurements::{measurements_csv, parse_measurements};
 use crate::io::{CalibrationResult, MeasurementSet, Positions};
 use crate::model::presets::preset;
 use crate::model::{JointSpace, Robot};
-use crate::progress::{As, Observer, Stage};
-use crate::simulation::{
-    simulate, simulate_joints, GravityModel, Simulation, SimulationConfig, TruthFile, TruthSpec,
-    SET_CALIBRATION, SET_VALIDATION,
-};
+use crate::progress::{Observer, Stage};
+use crate::simulation::{GravityModel, Simulation, SimulationConfig};
 use crate::stats::ErrorStats;
 use std::path::Path;
 
@@ -263,217 +258,56 @@ fn csv_bytes(set: &MeasurementSet, name: &str) -> Result<Vec<u8>> {
 /// Runs the experiment (see the module docs). `observer` hears the phases ([`PHASES`]) as the
 /// work advances (`done` and `total` count steps within the phase).
 pub fn run_experiment(config: ExperimentConfig, observer: &dyn Observer) -> Result<Experiment> {
-    let nominal = &config.nominal;
     // The cell's robots are geometric (their deflection is the simulator's gravity model); the
     // nominal model may add the families that deflect the joints, for the calibration.
-    let geometric = nominal.geometric();
-    let joints = nominal.joint_space();
-
-    // 1. The measurement session, split into the files `simulate --validation-out` writes.
-    observer.progress(Stage::Measurement, 0, 1);
-    let session = simulate(
+    let geometric = config.nominal.geometric();
+    let measured = steps::measure(&config, &geometric, observer)?;
+    let calibrated = steps::calibrate_files(&config, &measured, observer)?;
+    let (compensation, commanded_bytes, commanded) =
+        steps::compensate_desired(&config, &calibrated, &measured.desired, observer)?;
+    let verified = steps::verify(
+        &config,
         &geometric,
-        &TruthSpec::Robot(config.truth.clone()),
-        &config.session,
+        &measured.truth_json,
+        &commanded,
+        &calibrated,
         observer,
     )?;
-    let main = session.select(SET_VALIDATION, false);
-    let val = session.select(SET_VALIDATION, true);
-    let set_col = session
-        .measurements
-        .extra_columns
-        .iter()
-        .position(|c| c == "set");
-    let row_files: Vec<&Path> = session
-        .measurements
-        .rows
-        .iter()
-        .map(|r| match set_col {
-            Some(k) if r.extra[k] == SET_VALIDATION => Path::new(files::VALIDATION),
-            _ => Path::new(files::CELL),
-        })
-        .collect();
-    let truth_file = session.truth_file(&row_files);
-    let cell_csv = csv_bytes(&main, files::CELL)?;
-    let val_csv = csv_bytes(&val, files::VALIDATION)?;
-    let truth_json = truth_file.to_json()?;
-    let data = parse_csv(&cell_csv, files::CELL, joints, Positions::Required)?;
-    let validation = parse_csv(&val_csv, files::VALIDATION, joints, Positions::Required)?;
-    // The desired poses of the verification: the calibration rows, joints only.
-    let mut desired_set = session.select(SET_CALIBRATION, true);
-    for r in &mut desired_set.rows {
-        r.p = None;
-    }
-    // Keep only the joints, id and set: not the session's conditions.
-    let keep: Vec<usize> = (0..desired_set.extra_columns.len())
-        .filter(|&k| matches!(desired_set.extra_columns[k].as_str(), "id" | "set"))
-        .collect();
-    desired_set.extra_columns = keep
-        .iter()
-        .map(|&k| desired_set.extra_columns[k].clone())
-        .collect();
-    for r in &mut desired_set.rows {
-        r.extra = keep.iter().map(|&k| r.extra[k].clone()).collect();
-    }
-    real_cell::approach_from_below(&config, &mut desired_set);
-    let desired_csv = csv_bytes(&desired_set, files::DESIRED)?;
-    let desired = parse_csv(&desired_csv, files::DESIRED, joints, Positions::Optional)?;
-    observer.progress(Stage::Measurement, 1, 1);
-
-    // 2. Calibration from the files, as `robocal calibrate --data cell.csv --validate
-    //    validation.csv` reads them.
-    let split = split_measurements(&data)?;
-    let split_val = split_measurements(&validation)?;
-    let nominal = &real_cell::refer_to_data(nominal, &split)?;
-    let calibration = calibrate(
-        nominal,
-        CalibrationData {
-            calibration: &split.calibration,
-            plane: Some(&split.plane),
-            validation: Some(&split_val.validation),
-        },
-        &config.calibration,
-        &As {
-            inner: observer,
-            stage: Stage::Calibration,
-        },
-    )?;
-    if calibration.plausibility.implausible() {
-        return Err(Error::Implausible(format!(
-            "the simulated calibration failed the plausibility gate:\n{}",
-            calibration.plausibility.summary()
-        )));
-    }
-    let mut result = calibration.to_result();
-    if let Some(s) = &mut result.settings {
-        s.robot_arg = Some(nominal.name().to_owned());
-        s.data = Some(files::CELL.to_owned());
-        s.validate = Some(files::VALIDATION.to_owned());
-        // Simulated poses are within the limits: the joint limits are enforced, as by default.
-        s.nominal_limits = Some(false);
-        s.merge(config.result_settings.clone())
-            .map_err(|e| Error::invalid("result settings", e.to_string()))?;
-    }
-    // The files as `calibrate` records them, under the paths the settings give.
-    let given = |f: Option<&String>, default: &str| f.cloned().unwrap_or_else(|| default.into());
-    let settings = result.settings.as_ref();
-    result.inputs = Some(
-        [
-            (
-                "data",
-                given(settings.and_then(|s| s.data.as_ref()), files::CELL),
-                &cell_csv,
-            ),
-            (
-                "validation",
-                given(
-                    settings.and_then(|s| s.validate.as_ref()),
-                    files::VALIDATION,
-                ),
-                &val_csv,
-            ),
-        ]
-        .into_iter()
-        .map(|(role, f, bytes)| {
-            (
-                role.to_owned(),
-                crate::io::inputs::InputFile::from_bytes(Path::new(&f), bytes),
-            )
-        })
-        .collect(),
-    );
-    let result_json = result.to_text()?;
-    let result = CalibrationResult::parse(&result_json, Path::new(files::RESULT))?;
-    let calibrated = result.calibrated_robot(nominal, Path::new(files::RESULT))?;
-    observer.progress(Stage::Calibration, 1, 1);
-
-    // 3. Compensation of the calibration poses (eq. 12-14).
-    //    In a real cell: at the arm's temperature, every pose approached from below.
-    let at = calibrated.at_conditions(&real_cell::compensation_conditions(&config))?;
-    let plain = nominal.at_conditions(&Default::default())?;
-    let comp = Compensator::new(&plain, &at, config.ik)?;
-    let qs: Vec<Vec<f64>> = desired.rows.iter().map(|r| r.q.clone()).collect();
-    let compensation = comp.compensate_all(&qs, observer)?;
-    let extra_rows: Vec<&[String]> = desired.rows.iter().map(|r| r.extra.as_slice()).collect();
-    let commanded_bytes = commanded_csv(
-        joints,
-        &compensation,
-        Some(&qs),
-        &desired.extra_columns,
-        &extra_rows,
-    )?;
-    let commanded = parse_csv(
-        &commanded_bytes,
-        files::COMMANDED,
-        joints,
-        Positions::Optional,
-    )?;
-
-    // 4. Verification: the commanded joints measured in the same cell (the truth and tracker
-    //    frame as `simulate --truth cell.truth.json` reads them), against the desired positions.
-    let tf: TruthFile = serde_json::from_str(&truth_json)
-        .map_err(|e| Error::parse(Path::new(files::CELL_TRUTH), None, None, e.to_string()))?;
-    let truth_again = tf.truth_robot(&geometric, Path::new(files::CELL_TRUTH))?;
-    let vconfig = SimulationConfig {
-        tracker_frame: tf.tracker_frame,
-        ..config.verification_session()
-    };
-    let verification = simulate_joints(
-        &geometric,
-        &TruthSpec::Robot(truth_again),
-        &vconfig,
-        &commanded,
-        &As {
-            inner: observer,
-            stage: Stage::Verification,
-        },
-    )?;
-    let verify_csv = csv_bytes(&verification.measurements, files::VERIFY)?;
-    let verify = parse_csv(&verify_csv, files::VERIFY, joints, Positions::Required)?;
-    // From another station, the frame is registered again (under the calibrated model).
-    let frame = match config.real_cell {
-        Some(r) if r.verification_station != 0 => crate::registration::refit_frame(
-            &calibrated,
-            &crate::evaluation::observations_of(&verify)?,
-        )?,
-        _ => result.tracker_frame(),
-    };
-    let verification_errors = evaluate(nominal, &calibrated, &frame, &verify, Against::Desired)?;
 
     // 5. The truth in the identified parameters.
     observer.progress(Stage::TruthComparison, 0, 1);
     let truth_comparison = compare_with_truth(
-        &calibration,
+        &calibrated.calibration,
         &config.truth,
         &config.session.tracker_frame.to_tracker_frame(),
-        &split.calibration,
-        &split_val.validation,
+        &calibrated.split.calibration,
+        &calibrated.split_val.validation,
     )?;
     observer.progress(Stage::TruthComparison, 1, 1);
 
     let files = vec![
-        (files::CELL, cell_csv),
-        (files::VALIDATION, val_csv),
-        (files::CELL_TRUTH, truth_json.into_bytes()),
-        (files::DESIRED, desired_csv),
-        (files::RESULT, result_json.into_bytes()),
+        (files::CELL, measured.cell_csv),
+        (files::VALIDATION, measured.val_csv),
+        (files::CELL_TRUTH, measured.truth_json.into_bytes()),
+        (files::DESIRED, measured.desired_csv),
+        (files::RESULT, calibrated.result_json.into_bytes()),
         (files::COMMANDED, commanded_bytes),
-        (files::VERIFY, verify_csv),
+        (files::VERIFY, verified.verify_csv),
     ];
     Ok(Experiment {
         config,
-        session,
-        data,
-        validation,
-        desired,
-        calibration,
-        result,
-        calibrated,
+        session: measured.session,
+        data: measured.data,
+        validation: measured.validation,
+        desired: measured.desired,
+        calibration: calibrated.calibration,
+        result: calibrated.result,
+        calibrated: calibrated.calibrated,
         compensation,
         commanded,
-        verification,
-        verify,
-        verification_errors,
+        verification: verified.verification,
+        verify: verified.verify,
+        verification_errors: verified.verification_errors,
         truth_comparison,
         files,
     })

@@ -1,6 +1,6 @@
 use super::*;
 use crate::io::measurements::parse_measurements;
-use crate::simulation::SET_PLANE;
+use crate::simulation::{SET_CALIBRATION, SET_PLANE};
 
 fn run(config: ExperimentConfig) -> Experiment {
     run_experiment(config, &()).unwrap()
