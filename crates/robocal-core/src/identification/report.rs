@@ -7,10 +7,11 @@
 //! (the gate's checks) and `status` (with `partial_reason` or `implausible_reason`), each a
 //! typed section of [`crate::io::result_sections`].
 
-use crate::identification::identifiability::FixReason;
+use crate::identification::identifiability::{FixReason, FixedParam};
 use crate::identification::objective::{Loss, Objective, RobustLoss};
+use crate::identification::param_vector::ParamVector;
 use crate::identification::pipeline::{Calibration, SetErrors};
-use crate::io::result::{BeforeAfter, ErrorTables, FrameVec, RobotInfo, Status};
+use crate::io::result::{BeforeAfter, ErrorTables, FrameVec, ParamEntry, RobotInfo, Status};
 use crate::io::result_sections::{
     AffineEntry, CorrelationEntry, DownweightedEntry, DuplicateEntry, FixKind, FixedEntry,
     Identifiability, IdentifiedEntry, InitialFrameEntry, LossEntry, ObjectiveName, PointEntry,
@@ -58,12 +59,100 @@ fn point_entries(s: &SetErrors) -> Vec<PointEntry> {
         .collect()
 }
 
+/// The result file's entry of a parameter the identifiability fixed.
+fn fixed_entry(f: &FixedParam) -> FixedEntry {
+    let (kind, independence, duplicates) = match &f.reason {
+        FixReason::User => (FixKind::User, None, None),
+        FixReason::NoEffect | FixReason::Unseen { .. } => (FixKind::NoEffect, None, None),
+        FixReason::Undetermined { .. } => (FixKind::Undetermined, None, None),
+        FixReason::AtBound { .. } => (FixKind::AtBound, None, None),
+        FixReason::Duplicate { of, independence } => (
+            FixKind::Duplicate,
+            Some(*independence),
+            Some(
+                of.iter()
+                    .map(|(q, c)| DuplicateEntry {
+                        name: q.name(),
+                        coefficient: c * unit_factor(*q) / unit_factor(f.param),
+                    })
+                    .collect(),
+            ),
+        ),
+    };
+    FixedEntry {
+        name: f.param.name(),
+        reason: f.describe(),
+        kind,
+        independence,
+        duplicates,
+    }
+}
+
 impl Calibration {
     /// The result file's content. The `settings` record the calibration's own settings; the
     /// caller adds its file names (`robot_arg`, `data`, `validate`, ...) to them.
     pub fn to_result(&self) -> CalibrationResult {
-        let mut parameters = CalibrationResult::parameter_entries(&self.nominal, &self.calibrated);
         let pv = self.param_vector();
+        // A result is a calibration only when the solver converged and the fit passed the
+        // plausibility gate; otherwise it is marked partial or implausible so that no reader
+        // takes it for one.
+        let termination = &self.solver().termination;
+        let (status, partial_reason, implausible_reason) = if !termination.converged() {
+            (
+                Status::Partial,
+                Some(format!("the solver {}", termination.describe())),
+                None,
+            )
+        } else if self.plausibility.implausible() {
+            (Status::Implausible, None, Some(self.plausibility.summary()))
+        } else {
+            (Status::Calibrated, None, None)
+        };
+        let mut result = CalibrationResult::new(
+            RobotInfo::of(&self.nominal),
+            self.parameter_entries(&pv),
+            FrameVec::from_tracker_frame(self.tracker_frame()),
+            self.error_tables(),
+            status,
+        );
+        result.partial_reason = partial_reason;
+        result.implausible_reason = implausible_reason;
+        result.settings = Some(self.settings_section());
+        result.model_selection = self
+            .model_selection
+            .as_ref()
+            .map(crate::io::result_selection::ModelSelectionSection::of);
+        result.registration = Some(self.registration_section());
+        result.identifiability = Some(self.identifiability_section(&pv));
+        result.solver = Some(self.solver_section());
+        result.uncertainty = Some(self.uncertainty_section());
+        result.downweighted_points = Some(
+            self.downweighted
+                .iter()
+                .map(|d| DownweightedEntry {
+                    line: d.line,
+                    error_mm: d.error_mm,
+                    orientation_deg: d.orientation_deg,
+                    weight: d.weight,
+                })
+                .collect(),
+        );
+        result.points = Some(Points {
+            calibration: point_entries(&self.calibration),
+            validation: self.validation.as_ref().map(point_entries),
+        });
+        result.plausibility = Some(self.plausibility.to_section());
+        result.orientation_errors = self.orientation_errors();
+        result.prediction = self.prediction.as_ref().map(Into::into);
+        crate::io::result_payload::record(&mut result, &self.calibrated);
+        crate::io::result_thermal::record(&mut result, &self.calibrated);
+        result
+    }
+
+    /// `parameters`: nominal and calibrated values, with the standard deviation of the
+    /// identified ones and the reason of the fixed ones.
+    fn parameter_entries(&self, pv: &ParamVector) -> indexmap::IndexMap<String, ParamEntry> {
+        let mut parameters = CalibrationResult::parameter_entries(&self.nominal, &self.calibrated);
         for (name, e) in parameters.iter_mut() {
             let entry = pv.by_name(name).expect("names come from the robot");
             match &entry.fixed {
@@ -81,7 +170,12 @@ impl Calibration {
                 }
             }
         }
-        let errors = ErrorTables {
+        parameters
+    }
+
+    /// `errors`: Tables II and IV, on the calibration and the validation points.
+    fn error_tables(&self) -> ErrorTables {
+        ErrorTables {
             calibration: BeforeAfter {
                 before: self.calibration.before_stats(),
                 after: self.calibration.after_stats(),
@@ -90,57 +184,43 @@ impl Calibration {
                 before: v.before_stats(),
                 after: v.after_stats(),
             }),
-        };
+        }
+    }
+
+    /// `identifiability`: the identified parameters with their independence and effect, the
+    /// fixed ones with the reason.
+    fn identifiability_section(&self, pv: &ParamVector) -> Identifiability {
         let id = &self.identifiability;
         let rms = |p: Param| {
             pv.get(p)
                 .and_then(|e| e.rms_effect)
                 .map_or(f64::NAN, |v| v / unit_factor(p))
         };
-        let identified = id
-            .identified
-            .iter()
-            .zip(&id.independence)
-            .map(|(p, ind)| IdentifiedEntry {
-                name: p.name(),
-                independence: *ind,
-                rms_effect_mm_per_unit: rms(*p),
-                unit: p.unit(),
-            })
-            .collect();
-        let fixed = id
-            .fixed
-            .iter()
-            .map(|f| {
-                let (kind, independence, duplicates) = match &f.reason {
-                    FixReason::User => (FixKind::User, None, None),
-                    FixReason::NoEffect | FixReason::Unseen { .. } => {
-                        (FixKind::NoEffect, None, None)
-                    }
-                    FixReason::Undetermined { .. } => (FixKind::Undetermined, None, None),
-                    FixReason::AtBound { .. } => (FixKind::AtBound, None, None),
-                    FixReason::Duplicate { of, independence } => (
-                        FixKind::Duplicate,
-                        Some(*independence),
-                        Some(
-                            of.iter()
-                                .map(|(q, c)| DuplicateEntry {
-                                    name: q.name(),
-                                    coefficient: c * unit_factor(*q) / unit_factor(f.param),
-                                })
-                                .collect(),
-                        ),
-                    ),
-                };
-                FixedEntry {
-                    name: f.param.name(),
-                    reason: f.describe(),
-                    kind,
-                    independence,
-                    duplicates,
-                }
-            })
-            .collect();
+        Identifiability {
+            rank_tolerance: id.rank_tolerance,
+            condition_number: id.condition_number,
+            condition_limit: crate::identification::MAX_CONDITION_NUMBER,
+            ill_conditioned: id.ill_conditioned(),
+            n_identified: id.identified.len(),
+            n_fixed: id.fixed.len(),
+            identified: id
+                .identified
+                .iter()
+                .zip(&id.independence)
+                .map(|(p, ind)| IdentifiedEntry {
+                    name: p.name(),
+                    independence: *ind,
+                    rms_effect_mm_per_unit: rms(*p),
+                    unit: p.unit(),
+                })
+                .collect(),
+            fixed: id.fixed.iter().map(fixed_entry).collect(),
+        }
+    }
+
+    /// `registration`: the measurement frame (eq. 8-11), its initial frame, the affine fit and
+    /// the tool fit.
+    fn registration_section(&self) -> Registration {
         let reg = &self.registration;
         let initial = match reg.initial {
             InitialFrame::Plane {
@@ -156,7 +236,7 @@ impl Calibration {
             },
             InitialFrame::LeastSquares => InitialFrameEntry::LeastSquares,
         };
-        let registration = Registration {
+        Registration {
             objective: match reg.objective {
                 RegistrationObjective::SumOfNorms => RegistrationObjectiveName::SumOfNorms,
                 RegistrationObjective::LeastSquares => RegistrationObjectiveName::LeastSquares,
@@ -188,31 +268,14 @@ impl Calibration {
                 .validation_frame
                 .as_ref()
                 .map(FrameVec::from_tracker_frame),
-        };
-        let stages = self
-            .stages
-            .iter()
-            .map(|s| {
-                let r = &s.report;
-                StageEntry {
-                    loss: loss_entry(&s.loss),
-                    termination: r.termination.describe(),
-                    converged: r.termination.converged(),
-                    iterations: r.iterations,
-                    evaluations: r.evaluations,
-                    initial_objective: r.initial_objective,
-                    final_objective: r.final_objective,
-                    final_gradient: r.final_gradient,
-                    last_step_mm: r.last_step_mm,
-                    points: s.points,
-                }
-            })
-            .collect();
-        let last = self.solver();
+        }
+    }
+
+    /// `settings`: the calibration's own settings (the caller adds its file names).
+    fn settings_section(&self) -> Settings {
         let s = &self.settings;
-        let objective = objective_name(&s.objective);
-        let settings = Settings {
-            objective,
+        Settings {
+            objective: objective_name(&s.objective),
             robust_scale_mm: self.robust_scale_mm,
             affine_registration: s.affine_registration,
             rank_tolerance: s.identifiability.rank_tolerance,
@@ -233,7 +296,44 @@ impl Calibration {
             rows_outside_limits: None,
             weighting: Some(self.weighting),
             other: Default::default(),
-        };
+        }
+    }
+
+    /// `solver`: the whole solve (its iterations summed over the stages, the last stage's
+    /// termination) and each stage.
+    fn solver_section(&self) -> Solver {
+        let last = self.solver();
+        let stages = self
+            .stages
+            .iter()
+            .map(|s| {
+                let r = &s.report;
+                StageEntry {
+                    loss: loss_entry(&s.loss),
+                    termination: r.termination.describe(),
+                    converged: r.termination.converged(),
+                    iterations: r.iterations,
+                    evaluations: r.evaluations,
+                    initial_objective: r.initial_objective,
+                    final_objective: r.final_objective,
+                    final_gradient: r.final_gradient,
+                    last_step_mm: r.last_step_mm,
+                    points: s.points,
+                }
+            })
+            .collect();
+        Solver {
+            objective: objective_name(&self.settings.objective),
+            termination: last.termination.describe(),
+            converged: last.termination.converged(),
+            iterations: self.stages.iter().map(|s| s.report.iterations).sum(),
+            final_objective: last.final_objective,
+            stages,
+        }
+    }
+
+    /// `uncertainty`: the parameters' standard deviations and the most correlated pairs.
+    fn uncertainty_section(&self) -> Uncertainty {
         let most_correlated = self
             .covariance
             .most_correlated(10)
@@ -251,94 +351,31 @@ impl Calibration {
             .zip(self.covariance.std())
             .map(|(p, sd)| (p.name(), sd.is_finite().then(|| p.unit().from_internal(sd))))
             .collect();
-        // A result is a calibration only when the solver converged and the fit passed the
-        // plausibility gate; otherwise it is marked partial or implausible so that no reader
-        // takes it for one.
-        let termination = &last.termination;
-        let (status, partial_reason, implausible_reason) = if !termination.converged() {
-            (
-                Status::Partial,
-                Some(format!("the solver {}", termination.describe())),
-                None,
-            )
-        } else if self.plausibility.implausible() {
-            (Status::Implausible, None, Some(self.plausibility.summary()))
-        } else {
-            (Status::Calibrated, None, None)
-        };
-        let mut result = CalibrationResult::new(
-            RobotInfo::of(&self.nominal),
-            parameters,
-            FrameVec::from_tracker_frame(self.tracker_frame()),
-            errors,
-            status,
-        );
-        result.partial_reason = partial_reason;
-        result.implausible_reason = implausible_reason;
-        result.settings = Some(settings);
-        result.model_selection = self
-            .model_selection
-            .as_ref()
-            .map(crate::io::result_selection::ModelSelectionSection::of);
-        result.registration = Some(registration);
-        result.identifiability = Some(Identifiability {
-            rank_tolerance: id.rank_tolerance,
-            condition_number: id.condition_number,
-            condition_limit: crate::identification::MAX_CONDITION_NUMBER,
-            ill_conditioned: id.ill_conditioned(),
-            n_identified: id.identified.len(),
-            n_fixed: id.fixed.len(),
-            identified,
-            fixed,
-        });
-        result.solver = Some(Solver {
-            objective,
-            termination: last.termination.describe(),
-            converged: last.termination.converged(),
-            iterations: self.stages.iter().map(|s| s.report.iterations).sum(),
-            final_objective: last.final_objective,
-            stages,
-        });
-        result.uncertainty = Some(Uncertainty {
+        Uncertainty {
             sigma_mm: self.covariance.sigma_mm,
             std,
             most_correlated,
             std_unavailable: self.covariance.unavailable.clone(),
-        });
-        result.downweighted_points = Some(
-            self.downweighted
-                .iter()
-                .map(|d| DownweightedEntry {
-                    line: d.line,
-                    error_mm: d.error_mm,
-                    orientation_deg: d.orientation_deg,
-                    weight: d.weight,
-                })
-                .collect(),
-        );
-        result.points = Some(Points {
-            calibration: point_entries(&self.calibration),
-            validation: self.validation.as_ref().map(point_entries),
-        });
-        result.plausibility = Some(self.plausibility.to_section());
-        result.orientation_errors = self.calibration.orientation_deg.as_ref().map(|(b, a)| {
-            use crate::io::result_cell::{AngleBeforeAfter, AngleStats, OrientationErrors};
-            let pair = |b: &[f64], a: &[f64]| AngleBeforeAfter {
-                before: AngleStats::of(b),
-                after: AngleStats::of(a),
-            };
-            OrientationErrors {
+        }
+    }
+
+    /// `orientation_errors`, when the rows measured orientations (6-DoF).
+    fn orientation_errors(&self) -> Option<crate::io::result_cell::OrientationErrors> {
+        use crate::io::result_cell::{AngleBeforeAfter, AngleStats, OrientationErrors};
+        let pair = |b: &[f64], a: &[f64]| AngleBeforeAfter {
+            before: AngleStats::of(b),
+            after: AngleStats::of(a),
+        };
+        self.calibration
+            .orientation_deg
+            .as_ref()
+            .map(|(b, a)| OrientationErrors {
                 calibration: pair(b, a),
                 validation: self
                     .validation
                     .as_ref()
                     .and_then(|v| v.orientation_deg.as_ref())
                     .map(|(b, a)| pair(b, a)),
-            }
-        });
-        result.prediction = self.prediction.as_ref().map(Into::into);
-        crate::io::result_payload::record(&mut result, &self.calibrated);
-        crate::io::result_thermal::record(&mut result, &self.calibrated);
-        result
+            })
     }
 }
