@@ -5,13 +5,15 @@
 mod conditions;
 mod constraints;
 mod gap;
+mod output;
 
 use super::common;
 use super::io_plan::{self, IoPlan};
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use robocal_core::evaluation::gap::Repeatability;
+use robocal_core::evaluation::gap::{Gap, Repeatability};
 use robocal_core::evaluation::{Against, Evaluator, PerPointWriter, Reference};
+use robocal_core::frame::TrackerFrame;
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::measurements::read_measurements;
 use robocal_core::io::{
@@ -154,80 +156,99 @@ impl TryFrom<&EvaluateArgs> for Settings {
 }
 
 pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
-    let Settings {
-        nominal,
-        calibrated: cal,
-        result: res,
-        against,
-        params,
-        data,
-        per_point: per_point_path,
-        mut outputs,
-        json,
-        nominal_limits,
-        refit_frame,
-        repeatability_mm,
-    } = Settings::try_from(&a)?;
-    if let Some(inputs) = &res.inputs {
-        robocal_core::io::inputs::check_unchanged(inputs, &data, &params)?;
+    let mut s = Settings::try_from(&a)?;
+    if let Some(inputs) = &s.result.inputs {
+        robocal_core::io::inputs::check_unchanged(inputs, &s.data, &s.params)?;
     }
-    let section = robocal_core::io::result_constraint::ConstraintSection::of(&res, &params)?;
+    let section = robocal_core::io::result_constraint::ConstraintSection::of(&s.result, &s.params)?;
     // A file that cannot be read is the reader's to report, with its context.
-    if super::calibrate::is_constraint_file(&data, &nominal).unwrap_or(false) {
-        if per_point_path.is_some() || !matches!(against, Against::Auto | Against::Model) {
+    if super::calibrate::is_constraint_file(&s.data, &s.nominal).unwrap_or(false) {
+        if s.per_point.is_some() || !matches!(s.against, Against::Auto | Against::Model) {
             return Err(crate::exit::usage(
                 "--per-point and --against desired apply to tracker points, not to constraint \
                  rows",
             ));
         }
         return constraints::run(constraints::HeldOut {
-            nominal: &nominal,
-            calibrated: &cal,
+            nominal: &s.nominal,
+            calibrated: &s.calibrated,
             section: section.as_ref(),
-            params: &params,
-            data: &data,
-            json,
+            params: &s.params,
+            data: &s.data,
+            json: s.json,
         });
     }
     // A calibration up to the base pose has no tracker frame: tracker points are registered to
     // it, as with --refit-frame.
-    let refit_frame = refit_frame || section.as_ref().is_some_and(|s| !s.base_pose_known);
-    if let Some(s) = section.as_ref().filter(|s| !s.base_pose_known) {
+    if let Some(c) = section.as_ref().filter(|c| !c.base_pose_known) {
+        s.refit_frame = true;
         errln!(
             "note: {} is a constraint calibration: {}; the tracker frame of {} is registered to \
              its points under each model (as --refit-frame), so the errors are those after the \
              best rigid alignment",
-            params.display(),
-            s.frame,
-            data.display()
+            s.params.display(),
+            c.frame,
+            s.data.display()
         )?;
     }
-    // Row by row: only the error norms are kept (16 bytes per row), so files of any length fit.
-    let context = || format!("--data {}", data.display());
-    let mut reader = MeasurementReader::open(&data, nominal.joint_space(), Positions::Required)
+    let e = evaluate_rows(&mut s)?;
+    if s.json {
+        outln!("{}", serde_json::to_string_pretty(&output::json(&s, &e)?)?)?;
+    } else {
+        output::print(&s, &e)?;
+    }
+    Ok(())
+}
+
+/// What the rows of `--data` gave.
+struct Evaluated {
+    /// The tracker frames of the nominal and the calibrated model (fitted to the data with
+    /// `--refit-frame`).
+    nominal_frame: TrackerFrame,
+    frame: TrackerFrame,
+    reference: Reference,
+    /// Rows evaluated, and of them outside the joint limits.
+    n: usize,
+    n_outside: usize,
+    /// The nominal and the calibrated model's error statistics.
+    series: Vec<Series>,
+    /// The calibrated model without each condition family the data's columns feed, and its
+    /// mean error.
+    without: Vec<conditions::Without>,
+    means_without: Vec<f64>,
+    /// A verification's gap to the prediction.
+    gap: Option<Gap>,
+}
+
+/// Evaluates the rows of `--data` one by one (only the error norms are kept, 16 bytes per row,
+/// so files of any length fit), writing `--per-point` once the rows are all checked.
+fn evaluate_rows(s: &mut Settings) -> anyhow::Result<Evaluated> {
+    let (nominal, cal) = (&s.nominal, &s.calibrated);
+    let context = || format!("--data {}", s.data.display());
+    let mut reader = MeasurementReader::open(&s.data, nominal.joint_space(), Positions::Required)
         .with_context(context)?;
     let header = reader.header();
     // A station of their own: both frames fitted to the whole file first.
-    let whole = || read_measurements(&data, nominal.joint_space(), Positions::Required);
-    let (nominal_frame, frame) = if refit_frame {
+    let whole = || read_measurements(&s.data, nominal.joint_space(), Positions::Required);
+    let (nominal_frame, frame) = if s.refit_frame {
         let set = whole().with_context(context)?;
-        robocal_core::evaluation::station_frames(&nominal, &cal, &set)?
+        robocal_core::evaluation::station_frames(nominal, cal, &set)?
     } else {
-        (res.nominal_frame(), res.tracker_frame())
+        (s.result.nominal_frame(), s.result.tracker_frame())
     };
     let ev =
-        Evaluator::new(&nominal, &cal, &frame, &header, against)?.with_nominal_frame(nominal_frame);
+        Evaluator::new(nominal, cal, &frame, &header, s.against)?.with_nominal_frame(nominal_frame);
     let names = ev.series();
     // The calibrated model without each condition family the data's columns feed.
-    let without = conditions::models_without(&cal, &header)?;
+    let without = conditions::models_without(cal, &header)?;
     let ev_without = without
         .iter()
-        .map(|w| Evaluator::new(&nominal, &w.model, &frame, &header, against))
+        .map(|w| Evaluator::new(nominal, &w.model, &frame, &header, s.against))
         .collect::<Result<Vec<_>, _>>()?;
     let mut sums_without = vec![0.0; without.len()];
-    let mut per_point = match &per_point_path {
+    let mut per_point = match &s.per_point {
         Some(p) => Some(PerPointWriter::to_output(
-            outputs.open(p)?,
+            s.outputs.open(p)?,
             &header,
             [names[0].0, names[1].0],
         )?),
@@ -235,7 +256,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     };
     let mut norms = [Vec::new(), Vec::new()];
     let mut not_converged = Statuses::new(&header);
-    let mut outside = OutsideLimits::new(&nominal, &data);
+    let mut outside = OutsideLimits::new(nominal, &s.data);
     while let Some(r) = reader.next_row().with_context(context)? {
         outside.check(r.line, &r.q);
         let e = ev.errors(&r)?;
@@ -254,15 +275,15 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     }
     let n_outside = outside.count();
     // Refused before anything is written (the per-point writer is dropped).
-    super::common::check_limits(outside, nominal_limits, &mut Vec::new())?;
+    super::common::check_limits(outside, s.nominal_limits, &mut Vec::new())?;
     let mean = norms[1].iter().sum::<f64>() / norms[1].len().max(1) as f64;
     if mean > robocal_core::registration::STATION_MIN_MM {
         // Far off: data of another robot or in another unit (calibrate's gate, exit 6), or
         // from another tracker station.
         let set = whole().with_context(context)?;
-        robocal_core::evaluation::check_data_matches(&cal, &set)?;
-        if !refit_frame && ev.reference() == Reference::Model {
-            robocal_core::evaluation::check_station(&cal, &set, mean)?;
+        robocal_core::evaluation::check_data_matches(cal, &set)?;
+        if !s.refit_frame && ev.reference() == Reference::Model {
+            robocal_core::evaluation::check_station(cal, &set, mean)?;
         }
     }
     if let Some(w) = per_point {
@@ -280,104 +301,49 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         })
         .collect();
     let reference = ev.reference();
-    let means_without: Vec<f64> = sums_without.iter().map(|s| s / n.max(1) as f64).collect();
     let gap = if reference == Reference::Desired {
         let set = whole().with_context(context)?;
-        // The robot's repeatability: the RP given, else its class's default per joint.
-        let repeatability = match repeatability_mm {
-            Some(rp) => Repeatability::Rp(rp),
-            None => Repeatability::PerJoint {
-                std_deg: RepeatabilityModel::default_for(&nominal).std_deg,
-                source: "the class default".to_owned(),
-            },
-        };
-        robocal_core::evaluation::gap::split(
-            &nominal,
-            &cal,
-            &res,
-            &set,
-            series[0].stats.rms_mm,
-            refit_frame.then_some(&frame),
-            repeatability,
-        )?
+        gap_split(s, &set, series[0].stats.rms_mm, &frame)?
     } else {
         None
     };
-    if json {
-        let mut o = serde_json::Map::new();
-        o.insert("data".into(), data.display().to_string().into());
-        o.insert("params".into(), params.display().to_string().into());
-        o.insert(
-            "reference".into(),
-            match reference {
-                Reference::Model => "model",
-                Reference::Desired => "desired",
-            }
-            .into(),
-        );
-        o.insert("n".into(), n.into());
-        if refit_frame {
-            o.insert(
-                "refit_frame".into(),
-                serde_json::json!({
-                    "calibrated": frame.vector_deg(),
-                    "nominal": nominal_frame.vector_deg(),
-                }),
-            );
-        }
-        if nominal_limits {
-            o.insert("rows_outside_limits".into(), n_outside.into());
-        }
-        for s in &series {
-            o.insert(s.name.into(), serde_json::to_value(s.stats)?);
-        }
-        if reference == Reference::Desired {
-            o.insert(
-                "predicted".into(),
-                serde_json::json!({
-                    "new_poses": res.prediction.as_ref().map(|p| serde_json::json!({
-                        "mean_mm": p.mean_mm,
-                        "std_mm": p.std_mm,
-                        "rms_mm": p.rms_mm,
-                    })),
-                    "calibration": res.errors.calibration.after,
-                    "validation": res.errors.validation.map(|v| v.after),
-                }),
-            );
-        }
-        if let Some(g) = &gap {
-            o.insert("gap".into(), g.json());
-        }
-        if !without.is_empty() {
-            o.insert(
-                "calibrated_without".into(),
-                without
-                    .iter()
-                    .zip(&means_without)
-                    .map(|(w, m)| (w.key.to_owned(), serde_json::json!({ "mean_mm": m })))
-                    .collect::<serde_json::Map<_, _>>()
-                    .into(),
-            );
-        }
-        if let Some(p) = &per_point_path {
-            o.insert("per_point".into(), p.display().to_string().into());
-        }
-        outln!("{}", serde_json::to_string_pretty(&o)?)?;
-    } else {
-        print_table(
-            (&data, &params, per_point_path.as_deref()),
-            n,
-            reference,
-            &series,
-            &res,
-            refit_frame.then_some(&frame),
-        )?;
-        if let Some(g) = &gap {
-            gap::print(g)?;
-        }
-        conditions::print(&without, &means_without, series[1].stats.mean_mm)?;
-    }
-    Ok(())
+    Ok(Evaluated {
+        nominal_frame,
+        frame,
+        reference,
+        n,
+        n_outside,
+        series,
+        means_without: sums_without.iter().map(|s| s / n.max(1) as f64).collect(),
+        without,
+        gap,
+    })
+}
+
+/// A verification's gap to the calibration's prediction (see [`gap`]), with the robot's
+/// repeatability: the RP given, else its class's default per joint.
+fn gap_split(
+    s: &Settings,
+    set: &MeasurementSet,
+    verified_rms_mm: f64,
+    frame: &TrackerFrame,
+) -> anyhow::Result<Option<Gap>> {
+    let repeatability = match s.repeatability_mm {
+        Some(rp) => Repeatability::Rp(rp),
+        None => Repeatability::PerJoint {
+            std_deg: RepeatabilityModel::default_for(&s.nominal).std_deg,
+            source: "the class default".to_owned(),
+        },
+    };
+    Ok(robocal_core::evaluation::gap::split(
+        &s.nominal,
+        &s.calibrated,
+        &s.result,
+        set,
+        verified_rms_mm,
+        s.refit_frame.then_some(frame),
+        repeatability,
+    )?)
 }
 
 /// One series' name, description and statistics.
@@ -434,136 +400,4 @@ impl Statuses {
         )?;
         Ok(())
     }
-}
-
-/// Picks one figure out of a statistics record.
-type Figure = fn(&ErrorStats) -> f64;
-
-/// The rows of the statistics tables.
-const STAT_ROWS: [(&str, Figure); 5] = [
-    ("Mean (mm)", |s| s.mean_mm),
-    ("St. dev. (mm)", |s| s.std_mm),
-    ("Max. (mm)", |s| s.max_mm),
-    ("RMS (mm)", |s| s.rms_mm),
-    ("P95 (mm)", |s| s.p95_mm),
-];
-
-fn cell(v: f64) -> String {
-    if v.is_finite() {
-        format!(" {v:>12.4}")
-    } else {
-        format!(" {:>12}", "-")
-    }
-}
-
-/// Prints the statistics of `files` (`--data`, `--params`, `--per-point`).
-fn print_table(
-    (data, params, per_point_path): (&Path, &Path, Option<&Path>),
-    n: usize,
-    reference: Reference,
-    series: &[Series],
-    res: &CalibrationResult,
-    refit: Option<&robocal_core::frame::TrackerFrame>,
-) -> anyhow::Result<()> {
-    let what = match reference {
-        Reference::Model => "validation: measured points against the models at the measured joints",
-        Reference::Desired => {
-            "verification: measured commanded poses against their desired positions (Table V)"
-        }
-    };
-    let frame = match refit {
-        Some(f) => {
-            let v = f.vector_deg();
-            format!(
-                "tracker frame fitted to these data (another station): x={:.3} y={:.3} z={:.3} mm, \
-                 A={:.4} B={:.4} C={:.4} deg",
-                v[0], v[1], v[2], v[3], v[4], v[5]
-            )
-        }
-        None => format!("tracker frame of {}", params.display()),
-    };
-    outln!("{}: {} points; {what}; {frame}", data.display(), n)?;
-    match reference {
-        Reference::Model => {
-            for s in series {
-                outln!("  {:<11} {}", s.name, s.description)?;
-            }
-            outln!()?;
-            outln!("{:<14} {:>12} {:>12}", "", series[0].name, series[1].name)?;
-            for (label, f) in STAT_ROWS {
-                outln!(
-                    "{label:<14}{}{}",
-                    cell(f(&series[0].stats)),
-                    cell(f(&series[1].stats))
-                )?;
-            }
-            let (b, c) = (series[0].stats.mean_mm, series[1].stats.mean_mm);
-            if b > 0.0 {
-                outln!(
-                    "mean error {} by {:.1}% with the calibrated model",
-                    if c <= b { "reduced" } else { "increased" },
-                    100.0 * (b - c).abs() / b
-                )?;
-            }
-        }
-        Reference::Desired => {
-            // Verification beside what the calibration predicted (the result's Table IV).
-            let cal = res.errors.calibration.after;
-            let val = res.errors.validation.map(|v| v.after);
-            outln!(
-                "  predicted: the calibrated model's errors in {} (Table IV)",
-                params.display()
-            )?;
-            outln!()?;
-            out!("{:<14} {:>12} {:>12}", "", "verification", "pred. cal.")?;
-            if val.is_some() {
-                out!(" {:>12}", "pred. val.")?;
-            }
-            outln!()?;
-            for (label, f) in STAT_ROWS {
-                // A result file without p95 reads it as 0: show it as unknown.
-                let pred = |s: &ErrorStats| {
-                    if label.starts_with("P95") && s.p95_mm == 0.0 {
-                        f64::NAN
-                    } else {
-                        f(s)
-                    }
-                };
-                out!(
-                    "{label:<14}{}{}",
-                    cell(f(&series[0].stats)),
-                    cell(pred(&cal))
-                )?;
-                if let Some(v) = &val {
-                    out!("{}", cell(pred(v)))?;
-                }
-                outln!()?;
-            }
-            // One prediction everywhere: the expected mean error at new poses spread like the
-            // calibration poses (calibrate's `prediction`); Table IV's calibration points only
-            // for a result without one, and then named as such.
-            let m = series[0].stats.mean_mm;
-            let (p, basis) = match res.prediction.as_ref().map(|p| p.mean_mm) {
-                Some(p) if p.is_finite() => (
-                    p,
-                    "predicted at new poses spread like the calibration poses (calibrate's \
-                     prediction)",
-                ),
-                _ => (
-                    cal.mean_mm,
-                    "on the calibration points (Table IV; the result has no prediction)",
-                ),
-            };
-            if p > 0.0 {
-                outln!(
-                    "verification mean {m:.4} mm vs {p:.4} mm {basis} ({:+.0}%)",
-                    100.0 * (m - p) / p
-                )?;
-            }
-        }
-    }
-    if let Some(p) = per_point_path {
-        outln!("wrote {} ({n} rows)", io_plan::shown(p))?;
-    }
-    Ok(())
 }
