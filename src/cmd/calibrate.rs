@@ -5,8 +5,11 @@ use super::common;
 use crate::exit;
 use anyhow::Context;
 use clap::{Args, ValueEnum};
-use robocal_core::identification::{calibrate, CalibrationData, Observations};
+use robocal_core::identification::{calibrate, CalibrationData, Observations, SplitData};
+use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::result_sections::RowsOutside;
+use robocal_core::io::CalibrationResult;
+use robocal_core::Robot;
 use std::path::PathBuf;
 
 mod constraints;
@@ -184,15 +187,13 @@ enum RobustArg {
 
 pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
     let s = Settings::try_from(&a)?;
-    let Settings { robot, betas, .. } = &s;
-    let rank_tolerance = s.calibration.identifiability.rank_tolerance;
     // The data file is opened once as measurements; only a header those refuse is read again
     // to tell whether it holds constraint rows (whose header needs no x,y,z), in the order of
     // checks of a file sniffed first: its header's errors, constraint data, then measurements.
-    let opened = MeasurementReader::open(&s.data, robot.joint_space(), Positions::Required);
+    let opened = MeasurementReader::open(&s.data, s.robot.joint_space(), Positions::Required);
     let constraint = match &opened {
         Ok(r) => constraints::has_constraint_column(r.extra_columns()),
-        Err(_) => constraints::is_constraint_file(&s.data, robot)?,
+        Err(_) => constraints::is_constraint_file(&s.data, &s.robot)?,
     };
     if constraint {
         return constraints::run(&s, a.distances.as_deref(), a.accept_unknown_scale);
@@ -205,11 +206,73 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         )));
     }
     let mut outside = Vec::new();
-    let mut data = read_from(opened?, &s.data, robot, s.nominal_limits, &mut outside)?;
-    let robot = &real_cell::fit_to_data(robot, &mut data, &s.data)?;
+    let mut data = read_from(opened?, &s.data, &s.robot, s.nominal_limits, &mut outside)?;
+    let robot = &real_cell::fit_to_data(&s.robot, &mut data, &s.data)?;
+    let validation = read_validation(&s, robot, &data, &mut outside)?;
+    print_sets(&s, robot, &data, &validation)?;
+    let bar = crate::progress::Bar::new("calibrating");
+    let result = calibrate(
+        robot,
+        CalibrationData {
+            calibration: &data.calibration,
+            plane: Some(&data.plane),
+            validation: Some(&validation),
+        },
+        &s.calibration,
+        &bar,
+    );
+    bar.finish();
+    let cal = result.with_context(|| format!("calibrating from {}", s.data.display()))?;
+    let verdict = Verdict {
+        converged: cal.solver().termination.converged(),
+        implausible: cal.plausibility.implausible(),
+        summary: common::indent(&cal.plausibility.summary()),
+        why: format!(
+            "the solver {} after {} iteration(s) (--max-iterations {})",
+            cal.solver().termination.describe(),
+            cal.stages
+                .iter()
+                .map(|s| s.report.iterations)
+                .sum::<usize>(),
+            s.calibration.solver.max_iterations
+        ),
+    };
+    if let Some(sel) = &cal.model_selection {
+        print_selection(sel)?;
+    }
+    print_report(&cal, verdict.converged, verdict.implausible)?;
+    print_plausibility(&cal)?;
+    if let Some(why) = &cal.covariance.unavailable {
+        errln!(
+            "warning: standard deviations unavailable (written as null): {why} (--rank-tol \
+             {:e} given explicitly)",
+            s.calibration.identifiability.rank_tolerance
+        )?;
+    }
+    let mut res = cal.to_result();
+    res.inputs = Some(record_inputs(&s)?);
+    if let Some(rs) = &mut res.settings {
+        record_settings(rs, &s, &outside);
+    }
+    // The fit and its data are not needed to write the result: free them before its text is
+    // built, the largest allocation of a large calibration (about 90 bytes a point).
+    drop(cal);
+    drop(data);
+    drop(validation);
+    write_or_refuse(res, &s, &verdict)
+}
+
+/// The validation points: the data's own `validation` rows and, with `--validate`, every point
+/// of that file but its plane points (ignored with a note).
+fn read_validation(
+    s: &Settings,
+    robot: &Robot,
+    data: &SplitData,
+    outside: &mut Vec<OutsideLimits>,
+) -> anyhow::Result<Observations> {
     let mut validation = data.validation.clone();
     if let Some(v) = &s.validate {
-        let vd = read(v, robot, s.nominal_limits, &mut outside)?;
+        let vd = read(v, robot, s.nominal_limits, outside)?;
         if !vd.plane.is_empty() {
             errln!(
                 "note: {}: {} plane point(s) ignored in the validation set",
@@ -220,17 +283,27 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
         validation = merge(validation, &vd.calibration)?;
         validation = merge(validation, &vd.validation)?;
     }
+    Ok(validation)
+}
+
+/// The first line: the robot and how many points of each kind calibrate and validate it.
+fn print_sets(
+    s: &Settings,
+    robot: &Robot,
+    data: &SplitData,
+    validation: &Observations,
+) -> anyhow::Result<()> {
     outln!(
         "robot {} ({} joints, {}){}; {} calibration point(s){}{}",
         robot.name(),
         robot.dof(),
         robot.convention().as_str(),
-        if betas.is_empty() {
+        if s.betas.is_empty() {
             String::new()
         } else {
             format!(
                 ", Hayati tilt on {}",
-                betas
+                s.betas
                     .iter()
                     .map(|i| format!("beta{}", i + 1))
                     .collect::<Vec<_>>()
@@ -249,76 +322,53 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             format!(", {} validation point(s)", validation.len())
         },
     )?;
-    let bar = crate::progress::Bar::new("calibrating");
-    let result = calibrate(
-        robot,
-        CalibrationData {
-            calibration: &data.calibration,
-            plane: Some(&data.plane),
-            validation: Some(&validation),
-        },
-        &s.calibration,
-        &bar,
-    );
-    bar.finish();
-    let cal = result.with_context(|| format!("calibrating from {}", s.data.display()))?;
-    let converged = cal.solver().termination.converged();
-    let implausible = cal.plausibility.implausible();
-    if let Some(sel) = &cal.model_selection {
-        print_selection(sel)?;
-    }
-    print_report(&cal, converged, implausible)?;
-    print_plausibility(&cal)?;
-    if let Some(why) = &cal.covariance.unavailable {
-        errln!(
-            "warning: standard deviations unavailable (written as null): {why} (--rank-tol \
-             {rank_tolerance:e} given explicitly)"
-        )?;
-    }
-    let mut res = cal.to_result();
-    res.inputs = Some(record_inputs(&s)?);
-    if let Some(rs) = &mut res.settings {
-        rs.robot_arg = Some(s.robot_arg.clone());
-        rs.data = Some(s.data.display().to_string());
-        rs.validate = s.validate.as_ref().map(|v| v.display().to_string());
-        rs.nominal_limits = Some(s.nominal_limits);
-        rs.rows_outside_limits = (!outside.is_empty()).then(|| {
-            outside
-                .iter()
-                .map(|o| RowsOutside {
-                    file: o.path().display().to_string(),
-                    rows: o.count(),
-                    lines: o.lines().to_vec(),
-                })
-                .collect()
-        });
-    }
-    let summary = common::indent(&cal.plausibility.summary());
-    let failed_gate = if implausible {
-        format!("\nThe fit also FAILED the plausibility gate:\n{summary}")
-    } else {
-        String::new()
-    };
-    let why = format!(
-        "the solver {} after {} iteration(s) (--max-iterations {})",
-        cal.solver().termination.describe(),
-        cal.stages
+    Ok(())
+}
+
+/// The result's `settings` as the command line gave them: the robot, the files, the joint
+/// limits and the rows outside them.
+fn record_settings(
+    rs: &mut robocal_core::io::result_sections::Settings,
+    s: &Settings,
+    outside: &[OutsideLimits],
+) {
+    rs.robot_arg = Some(s.robot_arg.clone());
+    rs.data = Some(s.data.display().to_string());
+    rs.validate = s.validate.as_ref().map(|v| v.display().to_string());
+    rs.nominal_limits = Some(s.nominal_limits);
+    rs.rows_outside_limits = (!outside.is_empty()).then(|| {
+        outside
             .iter()
-            .map(|s| s.report.iterations)
-            .sum::<usize>(),
-        s.calibration.solver.max_iterations
-    );
-    // The fit and its data are not needed to write the result: free them before its text is
-    // built, the largest allocation of a large calibration (about 90 bytes a point).
-    drop(cal);
-    drop(data);
-    drop(validation);
-    if converged && !implausible {
+            .map(|o| RowsOutside {
+                file: o.path().display().to_string(),
+                rows: o.count(),
+                lines: o.lines().to_vec(),
+            })
+            .collect()
+    });
+}
+
+/// Whether the fit is a calibration, and the words for when it is not.
+struct Verdict {
+    converged: bool,
+    implausible: bool,
+    /// The plausibility gate's summary, indented.
+    summary: String,
+    /// How the solver ended.
+    why: String,
+}
+
+/// Writes the result when it is a calibration. When it is not, fails (exit 6 for an implausible
+/// fit, 4 for one that did not converge), writing it marked only when asked
+/// (`--accept-implausible`, `--keep-partial`).
+fn write_or_refuse(mut res: CalibrationResult, s: &Settings, v: &Verdict) -> anyhow::Result<()> {
+    let Verdict { summary, why, .. } = v;
+    if v.converged && !v.implausible {
         res.write(&s.out)?;
         outln!("result written to {}", s.out.display())?;
         return Ok(());
     }
-    if converged {
+    if v.converged {
         // Converged but implausible: not a calibration. Fail; keep it only if asked, marked.
         if s.accept_implausible {
             res.write(&s.out)?;
@@ -342,6 +392,11 @@ pub fn run(a: CalibrateArgs) -> anyhow::Result<()> {
             s.out.display()
         )));
     }
+    let failed_gate = if v.implausible {
+        format!("\nThe fit also FAILED the plausibility gate:\n{summary}")
+    } else {
+        String::new()
+    };
     // Not converged: not a calibration. Fail; keep the partial result only if asked, marked.
     if s.keep_partial {
         res.partial_reason = Some(why.clone());
