@@ -113,6 +113,9 @@ fn stats_table(title: &str, cols: &[(&str, ErrorStats)]) -> String {
     s
 }
 
+/// Prints the calibration: the measurement frame and the weights, Table II, the
+/// identifiability, Table III with the standard deviations, the solver, Table IV and the
+/// prediction. `converged` and `implausible` mark the tables of a fit that is not a calibration.
 pub(super) fn print_report(
     c: &Calibration,
     converged: bool,
@@ -125,6 +128,17 @@ pub(super) fn print_report(
     } else {
         ""
     };
+    print_registration(c)?;
+    print_before(c)?;
+    print_identifiability(c)?;
+    print_parameters(c, partial)?;
+    print_solver(c)?;
+    print_after(c, partial)?;
+    print_prediction(c)
+}
+
+/// The initial and the fitted measurement frame (eq. 8-11), and the point weights.
+fn print_registration(c: &Calibration) -> anyhow::Result<()> {
     let reg = &c.registration;
     let tf = robocal_core::io::result::FrameVec::from_tracker_frame(&reg.frame);
     outln!()?;
@@ -146,7 +160,13 @@ pub(super) fn print_report(
         "tracker frame in the base frame (mm, deg): x {:.4}  y {:.4}  z {:.4}  A {:.5}  B {:.5}  C {:.5}",
         tf.x, tf.y, tf.z, tf.a, tf.b, tf.c
     )?;
-    print_weighting(&c.weighting)?;
+    print_weighting(&c.weighting)
+}
+
+/// Table II (the nominal model in the fitted frame), with the fitted tools, the orientation
+/// errors of 6-DoF rows and the affine registration.
+fn print_before(c: &Calibration) -> anyhow::Result<()> {
+    let reg = &c.registration;
     let before_cols: Vec<(&str, ErrorStats)> =
         std::iter::once(("Calibration", c.calibration.before_stats()))
             .chain(
@@ -203,6 +223,11 @@ pub(super) fn print_report(
             sv[2]
         )?;
     }
+    Ok(())
+}
+
+/// What was identified, and why each other parameter is fixed.
+fn print_identifiability(c: &Calibration) -> anyhow::Result<()> {
     let id = &c.identifiability;
     outln!()?;
     outln!(
@@ -221,6 +246,12 @@ pub(super) fn print_report(
         )?;
     }
     outln!()?;
+    Ok(())
+}
+
+/// Table III: the calibrated parameters, their standard deviations and the most correlated
+/// pairs.
+fn print_parameters(c: &Calibration, partial: &str) -> anyhow::Result<()> {
     let pv = c.param_vector();
     let entry = |p: Param| pv.get(p).expect("a parameter of the calibrated robot");
     outln!(
@@ -260,6 +291,11 @@ pub(super) fn print_report(
         )?;
     }
     outln!()?;
+    Ok(())
+}
+
+/// How the solve ended, over all its stages, and the points the robust objective down-weighted.
+fn print_solver(c: &Calibration) -> anyhow::Result<()> {
     let s = c.solver();
     let whole = c.whole_solve();
     let warm = c
@@ -301,6 +337,11 @@ pub(super) fn print_report(
             )?;
         }
     }
+    Ok(())
+}
+
+/// Table IV: the calibrated model's errors.
+fn print_after(c: &Calibration, partial: &str) -> anyhow::Result<()> {
     let after_cols: Vec<(&str, ErrorStats)> =
         std::iter::once(("Calibration", c.calibration.after_stats()))
             .chain(
@@ -317,7 +358,6 @@ pub(super) fn print_report(
             &after_cols
         )
     )?;
-    print_prediction(c)?;
     Ok(())
 }
 
