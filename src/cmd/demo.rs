@@ -137,10 +137,18 @@ pub fn run(a: DemoArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// What the experiment did, step by step, beside the paper's tables.
 fn print_run(exp: &Experiment) -> anyhow::Result<()> {
+    print_setup(exp)?;
+    print_before(exp)?;
+    print_identification(exp)?;
+    print_verification(exp)
+}
+
+/// The cell: the nominal and the true robot (with its sag), the tracker and the points.
+fn print_setup(exp: &Experiment) -> anyhow::Result<()> {
     let cfg = &exp.config;
     let s = &cfg.session;
-    let cal = &exp.calibration;
     outln!(
         "robocal demo: the experiment of Samak et al. (2019) on a simulated KUKA KR 480 R3330, seed {}",
         s.seed
@@ -204,6 +212,12 @@ fn print_run(exp: &Experiment) -> anyhow::Result<()> {
         s.validation_poses
     )?;
     super::demo_real_cell::print_cell(exp)?;
+    Ok(())
+}
+
+/// The measurement frame and Table II beside the paper's.
+fn print_before(exp: &Experiment) -> anyhow::Result<()> {
+    let cal = &exp.calibration;
     outln!()?;
     match cal.registration.initial {
         InitialFrame::Plane { n, tilt_deg, .. } => para(&format!(
@@ -238,6 +252,13 @@ fn print_run(exp: &Experiment) -> anyhow::Result<()> {
         )
     )?;
     outln!()?;
+    Ok(())
+}
+
+/// The identification, Table III and Table IV beside the paper's.
+fn print_identification(exp: &Experiment) -> anyhow::Result<()> {
+    let cal = &exp.calibration;
+    let e = &exp.result.errors;
     let id = &cal.identifiability;
     let solver = cal.solver();
     para(&format!(
@@ -275,7 +296,12 @@ fn print_run(exp: &Experiment) -> anyhow::Result<()> {
         )
     )?;
     outln!()?;
+    Ok(())
+}
 
+/// The compensation and Table V: the verification against the prediction, beside the paper's.
+fn print_verification(exp: &Experiment) -> anyhow::Result<()> {
+    let cfg = &exp.config;
     let n = exp.compensation.len();
     let converged = exp
         .compensation
@@ -432,10 +458,14 @@ fn print_elasto(
     Ok(())
 }
 
+/// The files written, and the commands that write them again by hand.
 fn print_files(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
-    let cfg = &exp.config;
-    let s = &cfg.session;
-    let p = |name: &str| sh(&dir.join(name));
+    print_file_list(exp, dir)?;
+    print_commands(exp, dir)
+}
+
+/// The files the experiment wrote in `dir`, and what each holds.
+fn print_file_list(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
     outln!("Files in {}:", dir.display())?;
     let n_cal = exp.desired.rows.len();
     for (names, what) in [
@@ -470,6 +500,11 @@ fn print_files(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
     ] {
         outln!("  {names:<28} {what}")?;
     }
+    Ok(())
+}
+
+/// `simulate`'s flags of the session's gravity model (none without one).
+fn gravity_flags(s: &robocal_core::simulation::SimulationConfig) -> Vec<String> {
     let mut gravity = Vec::new();
     if let Some(g) = &s.gravity {
         gravity.push(format!(
@@ -482,6 +517,15 @@ fn print_files(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
         ));
         gravity.push(format!("--payload-kg {}", g.payload_kg));
     }
+    gravity
+}
+
+/// The commands that give the same files again, step by step.
+fn print_commands(exp: &Experiment, dir: &Path) -> anyhow::Result<()> {
+    let cfg = &exp.config;
+    let s = &cfg.session;
+    let p = |name: &str| sh(&dir.join(name));
+    let gravity = gravity_flags(s);
     let robot = format!("--robot {PAPER_NOMINAL}");
     para(
         "Each step by hand, giving the same files again (in the source tree, `cargo run --release \
