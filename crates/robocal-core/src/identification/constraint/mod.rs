@@ -44,6 +44,7 @@ use crate::model::family::{backlash, thermal};
 use crate::model::{Param, Robot, Unit};
 use crate::observations::constraint::{ConstraintData, CONSTRAINT_COLUMN};
 use fit::Layout;
+use nalgebra::DVector;
 use unseen::{column_name, feature_advice, structural, unseen_family_parameters, weakest};
 
 /// Settings of a constraint calibration.
@@ -196,37 +197,11 @@ pub fn calibrate_constraints(
     data: &ConstraintData,
     opts: &ConstraintOptions,
 ) -> Result<ConstraintCalibration> {
-    opts.validate()?;
-    if data.rows.is_empty() {
-        return Err(Error::invalid("constraint data", "no rows"));
-    }
-    if data.dof != nominal.dof() {
-        return Err(Error::JointCount {
-            context: data.describe(0),
-            expected: nominal.dof(),
-            got: data.dof,
-        });
-    }
-    data.check_counts()?;
-    let mut robot = fitted_model(nominal, data)?;
-    let mut features = start_values(&robot, data)?;
-    let scale =
-        match scale_source(data) {
-            Some(from) => Scale::Known { from },
-            None if opts.accept_unknown_scale => Scale::Assumed {
-                held: longest_length(&robot)?,
-            },
-            None => return Err(Error::Numerical(
-                "the robot's scale is not determined by these data: scaling every length of the \
-                 robot and of the features leaves every residual unchanged, so the model could be \
-                 off by millimetres while the residuals look perfect. Add a known distance \
-                 between two fixed points or sphere centres (a distances file: from,to,\
-                 distance_mm), or a sphere of known radius (its radius_mm), or accept a result \
-                 up to scale explicitly"
-                    .into(),
-            )),
-        };
-    let (mut identified, mut fixed) = structural(&robot, data, opts)?;
+    check_input(nominal, data, opts)?;
+    let start_robot = fitted_model(nominal, data)?;
+    let start_features = start_values(&start_robot, data)?;
+    let scale = scale_of(&start_robot, data, opts)?;
+    let (mut identified, mut fixed) = structural(&start_robot, data, opts)?;
     if let Scale::Assumed { held } = &scale {
         identified.retain(|p| p != held);
         fixed.push(Fixed {
@@ -236,30 +211,12 @@ pub fn calibrate_constraints(
                 .into(),
         });
     }
-    let start_frame = start_frame(&robot, data)?;
-    let mut unseen = vec![if data.tracker.is_empty() {
-        UP_TO_BASE.to_string()
-    } else {
-        format!(
-            "the base frame's own parameters: the {} tracker row(s) register the base to the \
-             tracker frame (estimated with the robot, as for tracker data), which takes up any \
-             move of the base, so they are held at their nominal values",
-            data.tracker.len()
-        )
-    }];
-    if let Scale::Assumed { held } = &scale {
-        unseen.push(format!(
-            "the robot's scale: no known length in the data; {} is held at its nominal value",
-            held.name()
-        ));
-    }
-    unseen.extend(unseen_family_parameters(&fixed));
+    let start_frame = start_frame(&start_robot, data)?;
+    let mut unseen = unseen_at_start(data, &scale, &fixed);
     // Fit; fix what the data turn out not to see; fit again.
-    let start_robot = robot.clone();
-    let start_features = features.clone();
     loop {
-        robot = start_robot.clone();
-        features = start_features.clone();
+        let mut robot = start_robot.clone();
+        let mut features = start_features.clone();
         let mut frame = start_frame;
         let mut layout = Layout::new(&robot, &identified, &features);
         if frame.is_some() {
@@ -277,43 +234,9 @@ pub fn calibrate_constraints(
         let j = j.expect("asked for");
         let (cond, weak) = weakest(&j, opts.weak_tolerance);
         if let Some(v) = weak {
-            // The robot parameter with the largest share of the unseen direction.
-            let Some((c, _)) = (0..identified.len())
-                .map(|c| (c, v[c].abs()))
-                .max_by(|a, b| a.1.total_cmp(&b.1))
-                .filter(|(_, w)| *w > 1e-3)
-            else {
-                return Err(Error::Numerical(format!(
-                    "the features' own parameters are not determined by these data (condition \
-                     number {cond:.3e}); {}",
-                    feature_advice(&features)
-                )));
-            };
-            let p = identified.remove(c);
-            let mut others: Vec<(String, f64)> = (0..layout.n)
-                .filter(|&k| k != c && v[k].abs() > 0.1 * v[c].abs())
-                .map(|k| (column_name(&layout, &features, k), v[k].abs()))
-                .collect();
-            others.sort_by(|a, b| b.1.total_cmp(&a.1));
-            let with: Vec<String> = others.into_iter().take(4).map(|o| o.0).collect();
-            let reason = format!(
-                "not seen by these constraints{}{}",
-                if with.is_empty() {
-                    String::new()
-                } else {
-                    format!(" (its effect is nearly that of {})", with.join(", "))
-                },
-                if features
-                    .iter()
-                    .all(|f| f.kind == crate::observations::constraint::ConstraintKind::Plane)
-                {
-                    "; a plane sees the tool point only along its normal"
-                } else {
-                    ""
-                }
-            );
-            unseen.push(format!("{}: {reason}", p.name()));
-            fixed.push(Fixed { param: p, reason });
+            let (param, reason) = unseen_direction(&v, &layout, &features, &mut identified, cond)?;
+            unseen.push(format!("{}: {reason}", param.name()));
+            fixed.push(Fixed { param, reason });
             if identified.is_empty() {
                 return Err(Error::Numerical(
                     "the constraints determine none of the robot's parameters".into(),
@@ -321,6 +244,158 @@ pub fn calibrate_constraints(
             }
             continue;
         }
+        let residuals = Residuals::of(&e, data, &features);
+        let implausible = gate::checks(
+            &start_robot,
+            &robot,
+            &features,
+            data,
+            &residuals.distances_mm,
+        );
+        let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
+        return Ok(ConstraintCalibration {
+            nominal: start_robot,
+            robot,
+            identified,
+            fixed,
+            residual_rms_mm: rms(&residuals.norms),
+            residual_max_mm: residuals.norms.iter().cloned().fold(0.0, f64::max),
+            feature_rms_mm: residuals.feature_rms_mm,
+            features,
+            scale,
+            unseen,
+            distance_residuals_mm: residuals.distances_mm,
+            frame,
+            tracker_residuals_mm: residuals.tracker_mm,
+            condition_number: cond,
+            fit: report,
+            implausible,
+            model_selection: None,
+        });
+    }
+}
+
+/// The options, and rows for a robot of `nominal`'s joints in the counts each feature needs.
+fn check_input(nominal: &Robot, data: &ConstraintData, opts: &ConstraintOptions) -> Result<()> {
+    opts.validate()?;
+    if data.rows.is_empty() {
+        return Err(Error::invalid("constraint data", "no rows"));
+    }
+    if data.dof != nominal.dof() {
+        return Err(Error::JointCount {
+            context: data.describe(0),
+            expected: nominal.dof(),
+            got: data.dof,
+        });
+    }
+    data.check_counts()
+}
+
+/// What fixes the robot's scale: the data's known lengths, else (accepted explicitly) the
+/// robot's longest link held at its nominal value; without either, an error.
+fn scale_of(robot: &Robot, data: &ConstraintData, opts: &ConstraintOptions) -> Result<Scale> {
+    match scale_source(data) {
+        Some(from) => Ok(Scale::Known { from }),
+        None if opts.accept_unknown_scale => Ok(Scale::Assumed {
+            held: longest_length(robot)?,
+        }),
+        None => Err(Error::Numerical(
+            "the robot's scale is not determined by these data: scaling every length of the \
+             robot and of the features leaves every residual unchanged, so the model could be \
+             off by millimetres while the residuals look perfect. Add a known distance \
+             between two fixed points or sphere centres (a distances file: from,to,\
+             distance_mm), or a sphere of known radius (its radius_mm), or accept a result \
+             up to scale explicitly"
+                .into(),
+        )),
+    }
+}
+
+/// What constraint data cannot see before any fit: the base frame (or what tracker rows
+/// register), the scale when it is held, and the families' parameters fixed structurally.
+fn unseen_at_start(data: &ConstraintData, scale: &Scale, fixed: &[Fixed]) -> Vec<String> {
+    let mut unseen = vec![if data.tracker.is_empty() {
+        UP_TO_BASE.to_string()
+    } else {
+        format!(
+            "the base frame's own parameters: the {} tracker row(s) register the base to the \
+             tracker frame (estimated with the robot, as for tracker data), which takes up any \
+             move of the base, so they are held at their nominal values",
+            data.tracker.len()
+        )
+    }];
+    if let Scale::Assumed { held } = scale {
+        unseen.push(format!(
+            "the robot's scale: no known length in the data; {} is held at its nominal value",
+            held.name()
+        ));
+    }
+    unseen.extend(unseen_family_parameters(fixed));
+    unseen
+}
+
+/// The robot parameter with the largest share of the unseen direction `v` of the fit's
+/// Jacobian, taken out of `identified`, with the reason it is fixed (what its effect is nearly
+/// that of). An error when the direction is the features' own (no robot parameter in it).
+fn unseen_direction(
+    v: &[f64],
+    layout: &Layout,
+    features: &[FeatureEstimate],
+    identified: &mut Vec<Param>,
+    cond: f64,
+) -> Result<(Param, String)> {
+    let Some((c, _)) = (0..identified.len())
+        .map(|c| (c, v[c].abs()))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .filter(|(_, w)| *w > 1e-3)
+    else {
+        return Err(Error::Numerical(format!(
+            "the features' own parameters are not determined by these data (condition \
+             number {cond:.3e}); {}",
+            feature_advice(features)
+        )));
+    };
+    let p = identified.remove(c);
+    let mut others: Vec<(String, f64)> = (0..layout.n)
+        .filter(|&k| k != c && v[k].abs() > 0.1 * v[c].abs())
+        .map(|k| (column_name(layout, features, k), v[k].abs()))
+        .collect();
+    others.sort_by(|a, b| b.1.total_cmp(&a.1));
+    let with: Vec<String> = others.into_iter().take(4).map(|o| o.0).collect();
+    let reason = format!(
+        "not seen by these constraints{}{}",
+        if with.is_empty() {
+            String::new()
+        } else {
+            format!(" (its effect is nearly that of {})", with.join(", "))
+        },
+        if features
+            .iter()
+            .all(|f| f.kind == crate::observations::constraint::ConstraintKind::Plane)
+        {
+            "; a plane sees the tool point only along its normal"
+        } else {
+            ""
+        }
+    );
+    Ok((p, reason))
+}
+
+/// The fit's residuals by kind of row.
+struct Residuals {
+    /// The error norm of each constraint row (mm).
+    norms: Vec<f64>,
+    /// RMS of each feature's rows (mm).
+    feature_rms_mm: Vec<f64>,
+    /// Each known distance's residual (mm, signed).
+    distances_mm: Vec<f64>,
+    /// Each tracker row's error norm (mm).
+    tracker_mm: Vec<f64>,
+}
+
+impl Residuals {
+    /// Splits the residual vector `e` (constraint rows, then distances, then tracker rows).
+    fn of(e: &DVector<f64>, data: &ConstraintData, features: &[FeatureEstimate]) -> Residuals {
         let mut norms = Vec::with_capacity(data.rows.len());
         let mut per_feature = vec![(0.0, 0usize); features.len()];
         let mut row = 0;
@@ -332,40 +407,19 @@ pub fn calibrate_constraints(
             per_feature[r.feature].0 += n * n;
             per_feature[r.feature].1 += 1;
         }
-        let distance_residuals_mm = e.as_slice()[row..row + data.distances.len()].to_vec();
-        let tracker: Vec<f64> = (0..data.tracker.len())
+        let distances_mm = e.as_slice()[row..row + data.distances.len()].to_vec();
+        let tracker_mm = (0..data.tracker.len())
             .map(|i| e.rows(row + data.distances.len() + 3 * i, 3).norm())
             .collect();
-        let implausible = gate::checks(
-            &start_robot,
-            &robot,
-            &features,
-            data,
-            &distance_residuals_mm,
-        );
-        let rms = |v: &[f64]| (v.iter().map(|x| x * x).sum::<f64>() / v.len().max(1) as f64).sqrt();
-        return Ok(ConstraintCalibration {
-            nominal: start_robot,
-            robot,
-            identified,
-            fixed,
-            residual_rms_mm: rms(&norms),
-            residual_max_mm: norms.iter().cloned().fold(0.0, f64::max),
+        Residuals {
+            norms,
             feature_rms_mm: per_feature
                 .iter()
                 .map(|(s, n)| (s / (*n).max(1) as f64).sqrt())
                 .collect(),
-            features,
-            scale,
-            unseen,
-            distance_residuals_mm,
-            frame,
-            tracker_residuals_mm: tracker,
-            condition_number: cond,
-            fit: report,
-            implausible,
-            model_selection: None,
-        });
+            distances_mm,
+            tracker_mm,
+        }
     }
 }
 
