@@ -332,40 +332,95 @@ pub fn analyze_reduced(
     reduced: &Reduced,
 ) -> Result<Identifiability> {
     let all = robot.param_list();
-    let n = all.len();
+    let npts = obs.len().max(1) as f64;
+    let norms: Vec<f64> = (0..all.len()).map(|j| reduced.r.column(j).norm()).collect();
+    let mut sweep = sweep_columns(robot, obs, opts, reduced, &norms);
+    if sweep.kept.is_empty() {
+        return Err(nothing_to_identify(&sweep.fixed));
+    }
+    // The triangular factor T of the kept unit columns (K = Q T, Q = `basis`).
+    let k = sweep.kept.len();
+    let t = DMatrix::from_fn(k, k, |a, b| sweep.factor[b].get(a).copied().unwrap_or(0.0));
+    let mut fixed = std::mem::take(&mut sweep.fixed);
+    for &(p, rho) in &sweep.dependent {
+        fixed.push(sweep.explain(robot, reduced, &norms, &t, p, rho)?);
+    }
+    let mut kept = sweep.kept;
+    check_free(opts, &fixed)?;
+    let condition_number = condition_number(&t);
+    // Model order is `Param` order.
+    kept.sort_by_key(|(p, _)| *p);
+    fixed.sort_by_key(|f| f.param);
+    Ok(Identifiability {
+        identified: kept.iter().map(|(p, _)| *p).collect(),
+        independence: kept.iter().map(|(_, r)| *r).collect(),
+        fixed,
+        condition_number,
+        rank_tolerance: opts.rank_tolerance,
+        column_rms: all
+            .iter()
+            .zip(&norms)
+            .map(|(p, v)| (*p, v / npts.sqrt()))
+            .collect(),
+    })
+}
+
+/// What the sweep over the columns in priority order found.
+struct Sweep {
+    /// Orthonormal basis of the kept columns (Q).
+    basis: Vec<DVector<f64>>,
+    /// Column m of the triangular factor T of the kept unit columns (K = Q T): their
+    /// coefficients on the basis vectors before it, then their independence.
+    factor: Vec<Vec<f64>>,
+    /// The kept parameters with their independence.
+    kept: Vec<(Param, f64)>,
+    /// The parameters whose column depends on the kept ones, with their independence.
+    dependent: Vec<(Param, f64)>,
+    /// The parameters fixed by the user or without effect on the measurements.
+    fixed: Vec<FixedParam>,
+}
+
+/// The unit column `j` of the reduced Jacobian (zero for a column without effect).
+fn unit_column(r: &DMatrix<f64>, norms: &[f64], j: usize) -> DVector<f64> {
+    if norms[j] > 0.0 {
+        r.column(j) / norms[j]
+    } else {
+        DVector::zeros(norms.len())
+    }
+}
+
+/// Gram-Schmidt (twice, for orthogonality) over the unit columns in priority order: a column
+/// more independent of those kept before it than the rank tolerance is kept.
+fn sweep_columns(
+    robot: &Robot,
+    obs: &Observations,
+    opts: &IdentifiabilityOptions,
+    reduced: &Reduced,
+    norms: &[f64],
+) -> Sweep {
     let Reduced { r, angular } = reduced;
     let blind = obs.kind().blind_to_orientation();
-    let npts = obs.len().max(1) as f64;
-    let norms: Vec<f64> = (0..n).map(|j| r.column(j).norm()).collect();
     let max_norm = norms.iter().cloned().fold(0.0, f64::max);
-    let col = |p: Param| robot.param_position(p).expect("robot parameter");
-    let unit = |j: usize| -> DVector<f64> {
-        if norms[j] > 0.0 {
-            r.column(j) / norms[j]
-        } else {
-            DVector::zeros(n)
-        }
-    };
     let tol = opts.rank_tolerance;
-    let mut basis: Vec<DVector<f64>> = Vec::new();
-    // Column m of the triangular factor T of the kept unit columns (K = Q T, Q = `basis`):
-    // their coefficients on the basis vectors before it, then their independence.
-    let mut factor: Vec<Vec<f64>> = Vec::new();
-    let mut kept: Vec<(Param, f64)> = Vec::new();
-    let mut fixed: Vec<FixedParam> = opts
-        .fix
-        .iter()
-        .map(|p| FixedParam {
-            param: *p,
-            reason: FixReason::User,
-        })
-        .collect();
-    let mut dependent: Vec<(Param, f64)> = Vec::new();
+    let mut sweep = Sweep {
+        basis: Vec::new(),
+        factor: Vec::new(),
+        kept: Vec::new(),
+        dependent: Vec::new(),
+        fixed: opts
+            .fix
+            .iter()
+            .map(|p| FixedParam {
+                param: *p,
+                reason: FixReason::User,
+            })
+            .collect(),
+    };
     for p in priority_order(robot, &opts.free) {
         if opts.fix.contains(&p) {
             continue;
         }
-        let j = col(p);
+        let j = robot.param_position(p).expect("robot parameter");
         if norms[j] <= 1e-12 * max_norm || norms[j] == 0.0 {
             let reason = match blind {
                 // It only turns the tool frame, which the measurements do not see.
@@ -374,13 +429,13 @@ pub fn analyze_reduced(
                 },
                 _ => FixReason::NoEffect,
             };
-            fixed.push(FixedParam { param: p, reason });
+            sweep.fixed.push(FixedParam { param: p, reason });
             continue;
         }
-        let mut v = unit(j);
-        let mut coefficients = vec![0.0; basis.len() + 1];
+        let mut v = unit_column(r, norms, j);
+        let mut coefficients = vec![0.0; sweep.basis.len() + 1];
         for _ in 0..2 {
-            for (q, t) in basis.iter().zip(&mut coefficients) {
+            for (q, t) in sweep.basis.iter().zip(&mut coefficients) {
                 let c = q.dot(&v);
                 v.axpy(-c, q, 1.0);
                 *t += c;
@@ -388,40 +443,54 @@ pub fn analyze_reduced(
         }
         let rho = v.norm();
         if rho > tol {
-            basis.push(v / rho);
+            sweep.basis.push(v / rho);
             *coefficients.last_mut().expect("one entry at least") = rho;
-            factor.push(coefficients);
-            kept.push((p, rho));
+            sweep.factor.push(coefficients);
+            sweep.kept.push((p, rho));
         } else {
-            dependent.push((p, rho));
+            sweep.dependent.push((p, rho));
         }
     }
-    if kept.is_empty() {
-        let rest: Vec<String> = fixed
-            .iter()
-            .filter(|f| f.reason != FixReason::User)
-            .map(|f| f.param.name())
-            .collect();
-        return Err(Error::Numerical(if rest.is_empty() {
-            "every parameter is held fixed: nothing to identify".to_string()
-        } else {
-            format!(
-                "nothing to identify: the parameters not held fixed ({}) have no effect on the \
-                 measured points",
-                rest.join(", ")
-            )
-        }));
-    }
-    // Explain each dependent column by the kept ones: the least-squares coefficients of the
-    // kept unit columns K = Q T, c = T^-1 Q^T u. (The kept columns have full rank: each one's
-    // independence is above the tolerance, so T's diagonal is.)
-    let kept_cols: Vec<usize> = kept.iter().map(|(p, _)| col(*p)).collect();
-    let k = kept.len();
-    let t = DMatrix::from_fn(k, k, |a, b| factor[b].get(a).copied().unwrap_or(0.0));
-    for (p, rho) in dependent {
+    sweep
+}
+
+/// The error when no parameter is left to identify.
+fn nothing_to_identify(fixed: &[FixedParam]) -> Error {
+    let rest: Vec<String> = fixed
+        .iter()
+        .filter(|f| f.reason != FixReason::User)
+        .map(|f| f.param.name())
+        .collect();
+    Error::Numerical(if rest.is_empty() {
+        "every parameter is held fixed: nothing to identify".to_string()
+    } else {
+        format!(
+            "nothing to identify: the parameters not held fixed ({}) have no effect on the \
+             measured points",
+            rest.join(", ")
+        )
+    })
+}
+
+impl Sweep {
+    /// Explains the dependent column of `p` by the kept ones: the least-squares coefficients of
+    /// the kept unit columns K = Q T, c = T^-1 Q^T u (the kept columns have full rank: each one's
+    /// independence is above the tolerance, so T's diagonal is), at most four of them, in the
+    /// parameters' units.
+    fn explain(
+        &self,
+        robot: &Robot,
+        reduced: &Reduced,
+        norms: &[f64],
+        t: &DMatrix<f64>,
+        p: Param,
+        rho: f64,
+    ) -> Result<FixedParam> {
+        let (basis, kept) = (&self.basis, &self.kept);
+        let col = |p: Param| robot.param_position(p).expect("robot parameter");
         let j = col(p);
-        let u = unit(j);
-        let projections = DVector::from_iterator(k, basis.iter().map(|q| q.dot(&u)));
+        let u = unit_column(&reduced.r, norms, j);
+        let projections = DVector::from_iterator(kept.len(), basis.iter().map(|q| q.dot(&u)));
         let c = t.solve_upper_triangular(&projections).ok_or_else(|| {
             Error::Numerical("identifiability: the kept columns are dependent".to_string())
         })?;
@@ -439,60 +508,53 @@ pub fn analyze_reduced(
         terms.truncate(4);
         let of = terms
             .into_iter()
-            .map(|(b, v)| (kept[b].0, v * norms[j] / norms[kept_cols[b]]))
+            .map(|(b, v)| (kept[b].0, v * norms[j] / norms[col(kept[b].0)]))
             .collect();
-        fixed.push(FixedParam {
+        Ok(FixedParam {
             param: p,
             reason: FixReason::Duplicate {
                 of,
                 independence: rho,
             },
-        });
+        })
     }
-    // --free parameters must have been kept.
+}
+
+/// `--free` parameters must have been kept.
+fn check_free(opts: &IdentifiabilityOptions, fixed: &[FixedParam]) -> Result<()> {
     let mut bad = Vec::new();
     for p in &opts.free {
         if let Some(f) = fixed.iter().find(|f| f.param == *p) {
             bad.push(format!("{}: {}", p.name(), f.describe()));
         }
     }
-    if !bad.is_empty() {
-        return Err(Error::Numerical(format!(
-            "`identifiability.free`: cannot identify {} from these poses ({}); free only one of a set of \
-             parameters with the same effect",
-            if bad.len() == 1 {
-                "this parameter"
-            } else {
-                "these parameters"
-            },
-            bad.join("; ")
-        )));
+    if bad.is_empty() {
+        return Ok(());
     }
-    // K and T have the same singular values (Q is orthonormal), and T is only k x k.
+    Err(Error::Numerical(format!(
+        "`identifiability.free`: cannot identify {} from these poses ({}); free only one of a set of \
+         parameters with the same effect",
+        if bad.len() == 1 {
+            "this parameter"
+        } else {
+            "these parameters"
+        },
+        bad.join("; ")
+    )))
+}
+
+/// The condition number of the kept unit columns: K and T have the same singular values (Q is
+/// orthonormal), and T is only k x k.
+fn condition_number(t: &DMatrix<f64>) -> f64 {
     let sv = t.singular_values();
     let (smax, smin) = sv
         .iter()
         .fold((0.0f64, f64::INFINITY), |(a, b), v| (a.max(*v), b.min(*v)));
-    let condition_number = if sv.is_empty() {
+    if sv.is_empty() {
         f64::NAN
     } else if smin > 0.0 {
         smax / smin
     } else {
         f64::INFINITY
-    };
-    // Model order is `Param` order.
-    kept.sort_by_key(|(p, _)| *p);
-    fixed.sort_by_key(|f| f.param);
-    Ok(Identifiability {
-        identified: kept.iter().map(|(p, _)| *p).collect(),
-        independence: kept.iter().map(|(_, r)| *r).collect(),
-        fixed,
-        condition_number,
-        rank_tolerance: tol,
-        column_rms: all
-            .iter()
-            .zip(&norms)
-            .map(|(p, v)| (*p, v / npts.sqrt()))
-            .collect(),
-    })
+    }
 }
