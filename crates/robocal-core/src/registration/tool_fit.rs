@@ -123,65 +123,13 @@ pub(crate) fn fit_tools_from(
             }
         })
         .collect();
-    let np = 6 + 3 * k;
     let mut iterations = 0;
     let mut converged = false;
     while iterations < MAX_ALTERNATIONS {
         iterations += 1;
-        // r_i = F m_i - (o_i + R_i t_k); d r / d(rotation of F) = -[F m_i - t_F]x, d r / d t_F =
-        // I, d r / d t_k = -R_i.
-        // The normal equations by blocks, each summed over its points in point order (the
-        // frame's block over every point, a target's blocks over its own): the sums a dense
-        // matrix indexed per entry would hold, without the indexing.
-        let mut frame_block = SMatrix::<f64, 6, 6>::zeros();
-        let mut frame_b = SVector::<f64, 6>::zeros();
-        let mut cross = vec![SMatrix::<f64, 6, 3>::zeros(); k];
-        let mut tool_block = vec![Matrix3::<f64>::zeros(); k];
-        let mut tool_b = vec![Vector3::<f64>::zeros(); k];
-        let tf = frame.origin();
-        for (i, f) in flanges.iter().enumerate() {
-            let t = obs.target(i);
-            let p = frame.to_base(obs.m(i));
-            let r = p - (f.translation.vector + f.rotation * tools[t]);
-            let mut j = nalgebra::SMatrix::<f64, 3, 9>::zeros();
-            j.fixed_view_mut::<3, 3>(0, 0)
-                .copy_from(&(-(p - tf).cross_matrix()));
-            j.fixed_view_mut::<3, 3>(0, 3)
-                .copy_from(&Matrix3::identity());
-            j.fixed_view_mut::<3, 3>(0, 6)
-                .copy_from(&(-f.rotation.matrix()));
-            let jtj = j.transpose() * j;
-            let jtr = j.transpose() * r;
-            frame_block += jtj.fixed_view::<6, 6>(0, 0);
-            frame_b += jtr.fixed_rows::<6>(0);
-            cross[t] += jtj.fixed_view::<6, 3>(0, 6);
-            tool_block[t] += jtj.fixed_view::<3, 3>(6, 6);
-            tool_b[t] += jtr.fixed_rows::<3>(6);
-        }
-        // `J^T J` is symmetric to the bit (each entry's products are the same, summed in the same
-        // order), so the block below the frame's is the transpose of the one beside it.
-        let mut a = DMatrix::<f64>::zeros(np, np);
-        let mut b = DVector::<f64>::zeros(np);
-        a.fixed_view_mut::<6, 6>(0, 0).copy_from(&frame_block);
-        b.fixed_rows_mut::<6>(0).copy_from(&frame_b);
-        for t in 0..k {
-            let o = 6 + 3 * t;
-            a.fixed_view_mut::<6, 3>(0, o).copy_from(&cross[t]);
-            a.fixed_view_mut::<3, 6>(o, 0)
-                .copy_from(&cross[t].transpose());
-            a.fixed_view_mut::<3, 3>(o, o).copy_from(&tool_block[t]);
-            b.fixed_rows_mut::<3>(o).copy_from(&tool_b[t]);
-        }
-        for (t, c) in count.iter().enumerate() {
-            if *c == 0 {
-                // A target no observation measures keeps its tool.
-                for x in 0..3 {
-                    a[(6 + 3 * t + x, 6 + 3 * t + x)] = 1.0;
-                }
-            }
-        }
+        let (a, b) = normal_equations(obs, &flanges, &frame, &tools, &count);
         let step =
-            match a.clone().cholesky() {
+            match a.cholesky() {
                 Some(ch) => ch.solve(&(-&b)),
                 None => return Err(crate::error::Error::Numerical(
                     "the tool points cannot be fitted: the poses do not turn the flange enough \
@@ -189,26 +137,7 @@ pub(crate) fn fit_tools_from(
                         .into(),
                 )),
             };
-        let rot = nalgebra::Rotation3::new(Vector3::new(step[0], step[1], step[2]));
-        let origin = tf + Vector3::new(step[3], step[4], step[5]);
-        let pose = frame.pose();
-        let new_rot = rot * pose.rotation;
-        // The origin moves by the step; the rotation turns about it.
-        frame = TrackerFrame::new(frame::frame(
-            *new_rot.matrix(),
-            origin + rot * (pose.translation.vector - tf),
-        ));
-        let mut change = Vector3::new(step[3], step[4], step[5]).norm();
-        for (t, tool) in tools.iter_mut().enumerate() {
-            let d = Vector3::new(step[6 + 3 * t], step[7 + 3 * t], step[8 + 3 * t]);
-            if count[t] > 0 {
-                *tool += d;
-            }
-            change = change.max(d.norm());
-        }
-        // A rotation step, as the motion it causes 1 m away.
-        change = change.max(1e3 * rot.angle());
-        if change <= TOOL_TOLERANCE_MM {
+        if take_step(&step, &mut frame, &mut tools, &count) <= TOOL_TOLERANCE_MM {
             converged = true;
             break;
         }
@@ -218,7 +147,127 @@ pub(crate) fn fit_tools_from(
         .enumerate()
         .map(|(i, f)| f.rotation * tools[obs.target(i)] + f.translation.vector)
         .collect();
-    // Orientations: for 6-DoF data, the rotation closest to the mean of R_i^T R_F R_meas,i.
+    let out = tool_vectors(robot, obs, &flanges, &frame, &tools, &count);
+    let residuals: Vec<f64> = (0..n)
+        .map(|i| (frame.to_base(obs.m(i)) - model[i]).norm())
+        .collect();
+    let stats = ErrorStats::from_norms(&residuals);
+    Ok(ToolFit {
+        frame,
+        tools: out,
+        iterations,
+        converged,
+        applied: false,
+        residuals,
+        stats,
+    })
+}
+
+/// The normal equations of one Gauss-Newton step on the frame (rotation, then translation) and
+/// the tools (three unknowns each): r_i = F m_i - (o_i + R_i t_k); d r / d(rotation of F) =
+/// -[F m_i - t_F]x, d r / d t_F = I, d r / d t_k = -R_i. A target no observation measures
+/// (`count` 0) keeps its tool.
+fn normal_equations(
+    obs: &Observations,
+    flanges: &[Frame],
+    frame: &TrackerFrame,
+    tools: &[Vector3<f64>],
+    count: &[usize],
+) -> (DMatrix<f64>, DVector<f64>) {
+    let k = tools.len();
+    let np = 6 + 3 * k;
+    // The normal equations by blocks, each summed over its points in point order (the frame's
+    // block over every point, a target's blocks over its own): the sums a dense matrix indexed
+    // per entry would hold, without the indexing.
+    let mut frame_block = SMatrix::<f64, 6, 6>::zeros();
+    let mut frame_b = SVector::<f64, 6>::zeros();
+    let mut cross = vec![SMatrix::<f64, 6, 3>::zeros(); k];
+    let mut tool_block = vec![Matrix3::<f64>::zeros(); k];
+    let mut tool_b = vec![Vector3::<f64>::zeros(); k];
+    let tf = frame.origin();
+    for (i, f) in flanges.iter().enumerate() {
+        let t = obs.target(i);
+        let p = frame.to_base(obs.m(i));
+        let r = p - (f.translation.vector + f.rotation * tools[t]);
+        let mut j = nalgebra::SMatrix::<f64, 3, 9>::zeros();
+        j.fixed_view_mut::<3, 3>(0, 0)
+            .copy_from(&(-(p - tf).cross_matrix()));
+        j.fixed_view_mut::<3, 3>(0, 3)
+            .copy_from(&Matrix3::identity());
+        j.fixed_view_mut::<3, 3>(0, 6)
+            .copy_from(&(-f.rotation.matrix()));
+        let jtj = j.transpose() * j;
+        let jtr = j.transpose() * r;
+        frame_block += jtj.fixed_view::<6, 6>(0, 0);
+        frame_b += jtr.fixed_rows::<6>(0);
+        cross[t] += jtj.fixed_view::<6, 3>(0, 6);
+        tool_block[t] += jtj.fixed_view::<3, 3>(6, 6);
+        tool_b[t] += jtr.fixed_rows::<3>(6);
+    }
+    // `J^T J` is symmetric to the bit (each entry's products are the same, summed in the same
+    // order), so the block below the frame's is the transpose of the one beside it.
+    let mut a = DMatrix::<f64>::zeros(np, np);
+    let mut b = DVector::<f64>::zeros(np);
+    a.fixed_view_mut::<6, 6>(0, 0).copy_from(&frame_block);
+    b.fixed_rows_mut::<6>(0).copy_from(&frame_b);
+    for t in 0..k {
+        let o = 6 + 3 * t;
+        a.fixed_view_mut::<6, 3>(0, o).copy_from(&cross[t]);
+        a.fixed_view_mut::<3, 6>(o, 0)
+            .copy_from(&cross[t].transpose());
+        a.fixed_view_mut::<3, 3>(o, o).copy_from(&tool_block[t]);
+        b.fixed_rows_mut::<3>(o).copy_from(&tool_b[t]);
+    }
+    for (t, c) in count.iter().enumerate() {
+        if *c == 0 {
+            for x in 0..3 {
+                a[(6 + 3 * t + x, 6 + 3 * t + x)] = 1.0;
+            }
+        }
+    }
+    (a, b)
+}
+
+/// Moves the frame and the measured targets' tools by `step`; returns the largest change (mm;
+/// a rotation as the motion it causes 1 m away).
+fn take_step(
+    step: &DVector<f64>,
+    frame: &mut TrackerFrame,
+    tools: &mut [Vector3<f64>],
+    count: &[usize],
+) -> f64 {
+    let tf = frame.origin();
+    let rot = nalgebra::Rotation3::new(Vector3::new(step[0], step[1], step[2]));
+    let origin = tf + Vector3::new(step[3], step[4], step[5]);
+    let pose = frame.pose();
+    let new_rot = rot * pose.rotation;
+    // The origin moves by the step; the rotation turns about it.
+    *frame = TrackerFrame::new(frame::frame(
+        *new_rot.matrix(),
+        origin + rot * (pose.translation.vector - tf),
+    ));
+    let mut change = Vector3::new(step[3], step[4], step[5]).norm();
+    for (t, tool) in tools.iter_mut().enumerate() {
+        let d = Vector3::new(step[6 + 3 * t], step[7 + 3 * t], step[8 + 3 * t]);
+        if count[t] > 0 {
+            *tool += d;
+        }
+        change = change.max(d.norm());
+    }
+    change.max(1e3 * rot.angle())
+}
+
+/// Each target's tool as a frame vector: the fitted point, with the robot's orientation, or for
+/// 6-DoF data the rotation closest to the mean of R_i^T R_F R_meas,i.
+fn tool_vectors(
+    robot: &Robot,
+    obs: &Observations,
+    flanges: &[Frame],
+    frame: &TrackerFrame,
+    tools: &[Vector3<f64>],
+    count: &[usize],
+) -> Vec<[f64; 6]> {
+    let k = tools.len();
     let mut out: Vec<[f64; 6]> = (0..k)
         .map(|t| {
             let mut v = if t < robot.target_count() {
@@ -251,19 +300,7 @@ pub(crate) fn fit_tools_from(
             }
         }
     }
-    let residuals: Vec<f64> = (0..n)
-        .map(|i| (frame.to_base(obs.m(i)) - model[i]).norm())
-        .collect();
-    let stats = ErrorStats::from_norms(&residuals);
-    Ok(ToolFit {
-        frame,
-        tools: out,
-        iterations,
-        converged,
-        applied: false,
-        residuals,
-        stats,
-    })
+    out
 }
 
 /// The rotation nearest to `m` (polar decomposition by SVD, determinant +1).
