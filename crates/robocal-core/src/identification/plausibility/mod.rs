@@ -270,23 +270,7 @@ pub fn assess(fit: &Fit) -> Plausibility {
 /// tool points when computed before ([`ShapeChecks::of`]).
 pub(crate) fn assess_with(fit: &Fit, shape: Option<&ShapeChecks>) -> Plausibility {
     let reach = reach_mm(fit.start);
-    let mut checks = Vec::new();
-
-    let converged = fit.solver.termination.converged();
-    checks.push(check(
-        CheckKind::Convergence,
-        fit.solver.iterations as f64,
-        fit.max_iterations as f64,
-        "iterations",
-        converged,
-        format!(
-            "the solver {} after {} iteration(s) (limit {})",
-            fit.solver.termination.describe(),
-            fit.solver.iterations,
-            fit.max_iterations
-        ),
-    ));
-
+    let mut checks = vec![convergence(fit)];
     let shape = match shape {
         Some(known) => {
             checks.extend(known.checks.iter().cloned());
@@ -294,75 +278,9 @@ pub(crate) fn assess_with(fit: &Fit, shape: Option<&ShapeChecks>) -> Plausibilit
         }
         None => Shape::of(fit.calibration, fit.start, &mut checks),
     };
-    let (baseline_rms, scaled) = (shape.rigid_rms, shape.scale);
-
     let limit_mm = NOMINAL_ERROR_LIMIT * reach;
-    let table2 = |rms: f64, what: &str| {
-        format!(
-            "the nominal model misses the {what} points by {rms:.3} mm RMS after the frame fit \
-             (Table II), {:.2}% of the robot's reach of {reach:.0} mm; limit: {}% ({limit_mm:.1} \
-             mm)",
-            100.0 * rms / reach,
-            100.0 * NOMINAL_ERROR_LIMIT
-        )
-    };
-    let rms2 = fit.nominal_rms_mm;
-    checks.push(check(
-        CheckKind::NominalError,
-        rms2,
-        limit_mm,
-        "mm",
-        rms2 <= limit_mm,
-        table2(rms2, "calibration"),
-    ));
-    if let Some(v) = fit.validation_before.filter(|v| !v.is_empty()) {
-        let rms = ErrorStats::from_norms(v).rms_mm;
-        checks.push(check(
-            CheckKind::ValidationNominalError,
-            rms,
-            limit_mm,
-            "mm",
-            rms <= limit_mm,
-            table2(rms, "validation"),
-        ));
-    }
-
-    let length_limit = LENGTH_MOVE_LIMIT * reach;
-    let (lp, lv) = largest_move(fit, Unit::Mm).map_or((None, 0.0), |(p, v)| (Some(p), v));
-    checks.push(check(
-        CheckKind::LengthMoves,
-        lv,
-        length_limit,
-        "mm",
-        lv <= length_limit,
-        match lp {
-            Some(p) => format!(
-                "the largest move of an identified length is {} by {lv:.3} mm, {:.2}% of the \
-                 reach; limit: {}% ({length_limit:.1} mm)",
-                p.name(),
-                100.0 * lv / reach,
-                100.0 * LENGTH_MOVE_LIMIT
-            ),
-            None => "no length identified".into(),
-        },
-    ));
-    let (ap, av) = largest_move(fit, Unit::Deg).map_or((None, 0.0), |(p, v)| (Some(p), v));
-    checks.push(check(
-        CheckKind::AngleMoves,
-        av,
-        ANGLE_MOVE_LIMIT_DEG,
-        "deg",
-        av <= ANGLE_MOVE_LIMIT_DEG,
-        match ap {
-            Some(p) => format!(
-                "the largest move of an identified angle is {} by {av:.4} deg; limit: \
-                 {ANGLE_MOVE_LIMIT_DEG} deg",
-                p.name()
-            ),
-            None => "no angle identified".into(),
-        },
-    ));
-
+    checks.extend(nominal_errors(fit, reach));
+    checks.extend(moves(fit, reach));
     checks.push(ranges::check_non_geometric(fit));
     checks.push(statistics::improvement(fit));
     checks.push(statistics::discarded(fit));
@@ -372,17 +290,15 @@ pub(crate) fn assess_with(fit: &Fit, shape: Option<&ShapeChecks>) -> Plausibilit
     let data_suspect = checks
         .iter()
         .any(|c| !c.passed && c.kind != CheckKind::Convergence);
-    let explanations = if data_suspect && baseline_rms.is_finite() {
-        explain(fit.nominal, fit.calibration, baseline_rms, limit_mm)
+    let explanations = if data_suspect && shape.rigid_rms.is_finite() {
+        explain(fit.nominal, fit.calibration, shape.rigid_rms, limit_mm)
     } else {
         Vec::new()
     };
-    let radians = joints_look_like_radians(fit.nominal, fit.calibration);
-    let scale = scaled;
     let causes = Causes {
         explanations: &explanations,
-        radians,
-        scale,
+        radians: joints_look_like_radians(fit.nominal, fit.calibration),
+        scale: shape.scale,
         failed: checks
             .iter()
             .filter(|c| !c.passed)
@@ -398,6 +314,99 @@ pub(crate) fn assess_with(fit: &Fit, shape: Option<&ShapeChecks>) -> Plausibilit
         checks,
         explanations,
     }
+}
+
+/// Whether the solver converged within its iterations.
+fn convergence(fit: &Fit) -> Check {
+    check(
+        CheckKind::Convergence,
+        fit.solver.iterations as f64,
+        fit.max_iterations as f64,
+        "iterations",
+        fit.solver.termination.converged(),
+        format!(
+            "the solver {} after {} iteration(s) (limit {})",
+            fit.solver.termination.describe(),
+            fit.solver.iterations,
+            fit.max_iterations
+        ),
+    )
+}
+
+/// The nominal model's error after the frame fit (Table II) on the calibration and the
+/// validation points, against a share of the robot's reach.
+fn nominal_errors(fit: &Fit, reach: f64) -> Vec<Check> {
+    let limit_mm = NOMINAL_ERROR_LIMIT * reach;
+    let table2 = |rms: f64, what: &str| {
+        format!(
+            "the nominal model misses the {what} points by {rms:.3} mm RMS after the frame fit \
+             (Table II), {:.2}% of the robot's reach of {reach:.0} mm; limit: {}% ({limit_mm:.1} \
+             mm)",
+            100.0 * rms / reach,
+            100.0 * NOMINAL_ERROR_LIMIT
+        )
+    };
+    let rms2 = fit.nominal_rms_mm;
+    let mut checks = vec![check(
+        CheckKind::NominalError,
+        rms2,
+        limit_mm,
+        "mm",
+        rms2 <= limit_mm,
+        table2(rms2, "calibration"),
+    )];
+    if let Some(v) = fit.validation_before.filter(|v| !v.is_empty()) {
+        let rms = ErrorStats::from_norms(v).rms_mm;
+        checks.push(check(
+            CheckKind::ValidationNominalError,
+            rms,
+            limit_mm,
+            "mm",
+            rms <= limit_mm,
+            table2(rms, "validation"),
+        ));
+    }
+    checks
+}
+
+/// The largest moves of an identified length (against a share of the reach) and angle.
+fn moves(fit: &Fit, reach: f64) -> [Check; 2] {
+    let length_limit = LENGTH_MOVE_LIMIT * reach;
+    let (lp, lv) = largest_move(fit, Unit::Mm).map_or((None, 0.0), |(p, v)| (Some(p), v));
+    let lengths = check(
+        CheckKind::LengthMoves,
+        lv,
+        length_limit,
+        "mm",
+        lv <= length_limit,
+        match lp {
+            Some(p) => format!(
+                "the largest move of an identified length is {} by {lv:.3} mm, {:.2}% of the \
+                 reach; limit: {}% ({length_limit:.1} mm)",
+                p.name(),
+                100.0 * lv / reach,
+                100.0 * LENGTH_MOVE_LIMIT
+            ),
+            None => "no length identified".into(),
+        },
+    );
+    let (ap, av) = largest_move(fit, Unit::Deg).map_or((None, 0.0), |(p, v)| (Some(p), v));
+    let angles = check(
+        CheckKind::AngleMoves,
+        av,
+        ANGLE_MOVE_LIMIT_DEG,
+        "deg",
+        av <= ANGLE_MOVE_LIMIT_DEG,
+        match ap {
+            Some(p) => format!(
+                "the largest move of an identified angle is {} by {av:.4} deg; limit: \
+                 {ANGLE_MOVE_LIMIT_DEG} deg",
+                p.name()
+            ),
+            None => "no angle identified".into(),
+        },
+    );
+    [lengths, angles]
 }
 
 /// The gate's data checks for measurements read against an existing calibration (evaluate,
