@@ -49,6 +49,8 @@ const FLAGS: &[(&str, &str)] = &[
     ("identifiability.rank_tolerance", "--rank-tol"),
     ("robust_scale_mm", "--robust-scale"),
     ("weighting.tracker", "--tracker-sigma"),
+    ("weighting.mm_per_deg", "--orientation-weight"),
+    ("solver.max_iterations", "--max-iterations"),
     ("validation_refit_frame", "--validate-refit-frame"),
     // evaluate
     ("refit_frame", "--refit-frame"),

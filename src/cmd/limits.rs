@@ -8,11 +8,6 @@
 
 use crate::exit;
 
-/// Most solver iterations of `calibrate`. It converges in 5 to 350 iterations (README,
-/// "Calibrating"); a million iterations of a 75-point problem already run for tens of minutes,
-/// and a solver that has not converged by then will not.
-pub const MAX_CALIBRATION_ITERATIONS: usize = 1_000_000;
-
 /// Most iterations of one inverse-kinematics solve in `compensate` (default 500; a solve
 /// converges in a handful). The limit applies per row, and a file may have millions of rows.
 pub const MAX_IK_ITERATIONS: usize = 100_000;

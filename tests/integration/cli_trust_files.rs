@@ -603,10 +603,11 @@ fn absurd_counts_and_sizes_are_usage_errors_not_panics() {
         "{d}/r.json",
     ];
     for (n, want) in [
-        ("0", "--max-iterations 0: must be at least 1"),
+        ("0", "--max-iterations: at least 1, got 0"),
         (
             "18446744073709551615",
-            "--max-iterations 18446744073709551615: at most 1000000",
+            "--max-iterations: at most 1000000 (a solver that has not converged by then will \
+             not), got 18446744073709551615",
         ),
     ] {
         let mut a = cal.to_vec();
@@ -662,7 +663,7 @@ fn absurd_counts_and_sizes_are_usage_errors_not_panics() {
     }
     let mut a = cal.to_vec();
     a.extend(["--objective", "robust", "--robust-scale", "1e300"]);
-    refused(d, &a, 2, &["--robust-scale 1e300: at most 1000000 mm"]);
+    refused(d, &a, 2, &["--robust-scale: at most 1000000 mm, got 1e300"]);
     refused(
         d,
         &[

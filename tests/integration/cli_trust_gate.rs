@@ -408,7 +408,7 @@ fn nothing_to_identify_and_tolerances_beyond_double_precision_are_clear_errors()
     let o = run(&["--fix", &all]);
     o.assert_code(2);
     assert!(
-        o.stderr().contains("--fix names every parameter"),
+        o.stderr().contains("--fix: names every parameter"),
         "{}",
         o.stderr()
     );

@@ -202,6 +202,13 @@ fn bad_calibration_and_compensation_settings_name_the_setting_not_a_flag() {
         ..Default::default()
     };
     names_setting(run(scale), "robust_scale_mm");
+    names_setting(
+        run(CalibrationSettings {
+            robust_scale_mm: Some(1e300),
+            ..Default::default()
+        }),
+        "robust_scale_mm",
+    );
     // d2 and d3 (axes 2 and 3 are parallel) have the same effect: only one can be freed.
     let free = IdentifiabilityOptions {
         free: vec![Param::d(1), Param::d(2)],
@@ -222,4 +229,104 @@ fn bad_calibration_and_compensation_settings_name_the_setting_not_a_flag() {
     };
     names_setting(dls(-1.0, 10).validate(), "tolerance_mm");
     names_setting(dls(1e-3, 0).validate(), "max_iterations");
+}
+
+/// The calibration's settings are checked in one place, [`CalibrationSettings::check`], which the
+/// CLI and the Python bindings call before reading data: each bad value names its setting, as a
+/// usage error (a bad flag's value), and contradicting parameter lists as an invalid value.
+#[test]
+fn calibration_settings_are_checked_once_naming_each_setting() {
+    use crate::Error;
+    let robot = kr480();
+    assert!(CalibrationSettings::default().check(&robot).is_ok());
+    let d = CalibrationSettings::default;
+    let ids = |fix: Vec<Param>, free: Vec<Param>, rank_tolerance: f64| IdentifiabilityOptions {
+        fix,
+        free,
+        rank_tolerance,
+        ..Default::default()
+    };
+    let tol = IdentifiabilityOptions::default().rank_tolerance;
+    let mut heavy = d();
+    heavy.weighting.mm_per_deg = 1e7;
+    let mut weightless = d();
+    weightless.weighting.mm_per_deg = 0.0;
+    let cases: Vec<(CalibrationSettings, &str, bool)> = vec![
+        (
+            CalibrationSettings {
+                solver: crate::identification::SolverOptions {
+                    max_iterations: 0,
+                    ..Default::default()
+                },
+                ..d()
+            },
+            "solver.max_iterations",
+            true,
+        ),
+        (
+            CalibrationSettings {
+                solver: crate::identification::SolverOptions {
+                    max_iterations: crate::identification::MAX_ITERATIONS + 1,
+                    ..Default::default()
+                },
+                ..d()
+            },
+            "solver.max_iterations",
+            true,
+        ),
+        (
+            CalibrationSettings {
+                identifiability: ids(robot.params(), vec![], tol),
+                ..d()
+            },
+            "identifiability.fix",
+            true,
+        ),
+        (
+            CalibrationSettings {
+                identifiability: ids(vec![Param::d(2)], vec![Param::d(2)], tol),
+                ..d()
+            },
+            "identifiability.fix",
+            false,
+        ),
+        (
+            CalibrationSettings {
+                identifiability: ids(vec![], vec![], 1e-15),
+                ..d()
+            },
+            "identifiability.rank_tolerance",
+            true,
+        ),
+        (
+            CalibrationSettings {
+                robust_scale_mm: Some(f64::NAN),
+                ..d()
+            },
+            "robust_scale_mm",
+            true,
+        ),
+        (
+            CalibrationSettings {
+                robust_scale_mm: Some(2e6),
+                ..d()
+            },
+            "robust_scale_mm",
+            true,
+        ),
+        (heavy, "weighting.mm_per_deg", true),
+        (weightless, "weighting.mm_per_deg", true),
+    ];
+    for (settings, field, usage) in cases {
+        match settings.check(&robot) {
+            Err(Error::Usage { field: f, message }) if usage => {
+                assert_eq!(f, field, "{message}");
+                assert!(!message.contains("--"), "a flag in: {message}");
+            }
+            Err(Error::Invalid { field: f, message }) if !usage => {
+                assert_eq!(f, field, "{message}");
+            }
+            other => panic!("{field}: {other:?}"),
+        }
+    }
 }

@@ -56,6 +56,8 @@ const KEYWORDS: &[(&str, &str)] = &[
     ("identifiability.rank_tolerance", "rank_tol"),
     ("robust_scale_mm", "robust_scale"),
     ("weighting.tracker", "tracker_sigma"),
+    ("weighting.mm_per_deg", "orientation_weight"),
+    ("solver.max_iterations", "max_iterations"),
     ("validation_refit_frame", "validate_refit_frame"),
     ("orientation_mm_per_deg", "orientation_weight"),
     ("payload_kg", "payload_kg"),

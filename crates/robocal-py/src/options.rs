@@ -1,21 +1,17 @@
-//! The options of `robocal.calibrate`, checked as the CLI checks its flags (`src/cmd/calibrate.rs`)
-//! before any work, and turned into the library's `CalibrationSettings` and model families.
+//! The options of `robocal.calibrate`, turned into the library's `CalibrationSettings` and model
+//! families and checked by the library (`CalibrationSettings::check`, as the CLI's flags are)
+//! before any work.
 
-use crate::errors::{input, usage, IntoPy};
+use crate::errors::{usage, IntoPy};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use robocal_core::identification::{
     AutoFamilies, CalibrationSettings, IdentifiabilityOptions, ModelChoice, Objective, RobustLoss,
-    SolverOptions, DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
+    SolverOptions, DEFAULT_RANK_TOLERANCE,
 };
 use robocal_core::model::family::{backlash, compliance, thermal, transmission};
 use robocal_core::observations::{TrackerSigma, Weighting};
 use robocal_core::{Param, Robot};
-
-/// The iteration limit's range (the CLI's `--max-iterations`).
-const MAX_ITERATIONS: usize = 1_000_000;
-/// The largest length accepted for a scale (mm): 1 km, as the CLI.
-const MAX_LENGTH_MM: f64 = 1e6;
 
 /// Everything `calibrate` takes beside the data.
 #[derive(Debug, Clone)]
@@ -216,20 +212,10 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
         }
     };
     let robust_scale: Option<f64> = opt(d, "robust_scale", "a number (mm)")?;
-    if let Some(s) = robust_scale {
-        if !(s > 0.0 && s.is_finite() && s <= MAX_LENGTH_MM) {
-            return Err(usage(format!(
-                "robust_scale: {s} is not a positive length of at most {MAX_LENGTH_MM} mm"
-            )));
-        }
-    }
     let max_iterations: i64 = opt(d, "max_iterations", "an int")?.unwrap_or(1000);
-    if !(1..=MAX_ITERATIONS as i64).contains(&max_iterations) {
-        return Err(usage(format!(
-            "max_iterations: {max_iterations} is not in 1..{MAX_ITERATIONS} (a solver that has \
-             not converged by then will not)"
-        )));
-    }
+    // The library checks the range (`CalibrationSettings::check`); a negative int is no count.
+    let max_iterations = usize::try_from(max_iterations)
+        .map_err(|_| usage(format!("max_iterations: at least 1, got {max_iterations}")))?;
 
     // Model families, in the CLI's order: tilts, compliance, harmonics.
     let beta = joint_selection(d, "beta")?;
@@ -312,29 +298,8 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
 
     let fix = param_list(robot, &names(d, "fix")?, "fix")?;
     let free = param_list(robot, &names(d, "free")?, "free")?;
-    if fix.len() == robot.param_count() {
-        return Err(usage(format!(
-            "fix names every parameter of robot `{}` ({}): nothing is left to identify",
-            robot.name(),
-            robot.param_count()
-        )));
-    }
-    if let Some(p) = fix.iter().find(|p| free.contains(p)) {
-        return Err(input(format!(
-            "fix: `{}` is given both to `fix` and to `free`",
-            p.name()
-        )));
-    }
     let rank_tol: Option<f64> = opt(d, "rank_tol", "a number")?;
     let rank_tolerance = rank_tol.unwrap_or(DEFAULT_RANK_TOLERANCE);
-    if !(MIN_RANK_TOLERANCE..1.0).contains(&rank_tolerance) {
-        return Err(usage(format!(
-            "rank_tol: {rank_tolerance:?} is not in [{MIN_RANK_TOLERANCE:e}, 1); it is the \
-             smallest independence (sine of the angle between a parameter's effect and the \
-             others') accepted, and below {MIN_RANK_TOLERANCE:e} double precision cannot tell a \
-             parameter from an exact duplicate"
-        )));
-    }
 
     let mut weighting = Weighting::default();
     // "off": every point weighs the same, even data in a tracker's frame.
@@ -365,11 +330,6 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
         })?);
     }
     if let Some(m) = opt::<f64>(d, "orientation_weight", "a number (mm per degree)")? {
-        if !(m > 0.0 && m.is_finite() && m <= 1e6) {
-            return Err(usage(format!(
-                "orientation_weight: {m}: expected a positive number of mm per degree"
-            )));
-        }
         weighting.mm_per_deg = m;
     }
     let flag = |k: &str| -> PyResult<bool> { Ok(opt::<bool>(d, k, "a bool")?.unwrap_or(false)) };
@@ -403,13 +363,16 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
             allow_ill_conditioned: rank_tol.is_some(),
         },
         solver: SolverOptions {
-            max_iterations: max_iterations as usize,
+            max_iterations,
             ..Default::default()
         },
         weighting,
         validation_refit_frame: flag("validate_refit_frame")?,
         model,
     };
+    // The one check of the settings, as the CLI's (the library names the setting; the error
+    // shows it as this module's keyword).
+    settings.check(robot).py_err()?;
     Ok(Options {
         settings,
         nominal_limits: flag("nominal_limits")?,

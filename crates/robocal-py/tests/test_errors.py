@@ -83,7 +83,10 @@ def test_bad_options():
         (dict(tracker_sigma=(0, 0)), robocal.UsageError, "tracker_sigma"),
         (dict(tracker_sigma=(1,)), robocal.UsageError, "tracker_sigma"),
         (dict(payload_kg=5.0), robocal.UsageError, "payload_kg"),
-        (dict(robust_scale=-1.0), robocal.UsageError, "robust_scale"),
+        (dict(robust_scale=-1.0), robocal.UsageError, "robust_scale: -1 is not a positive length"),
+        (dict(robust_scale=1e300), robocal.UsageError, "robust_scale: at most 1000000 mm"),
+        (dict(orientation_weight=0.0), robocal.UsageError, "orientation_weight: 0"),
+        (dict(max_iterations=-3), robocal.UsageError, "max_iterations: at least 1, got -3"),
         (dict(max_iterations="many"), robocal.UsageError, "max_iterations: expected an int"),
     ]
     for kw, exc, words in cases:

@@ -2,14 +2,14 @@
 //! arguments): the robot with its Hayati tilts and joint families, parameter names, weighting,
 //! the library's calibration settings, the files plan; and the reading of a measurement file.
 
+use super::super::common;
 use super::super::io_plan::IoPlan;
-use super::super::{common, limits};
 use super::joint_list::joint_list;
 use super::{CalibrateArgs, ModelArg, ObjectiveArg, RobustArg};
 use crate::exit;
 use robocal_core::identification::{
     read_split, AutoFamilies, CalibrationSettings, IdentifiabilityOptions, ModelChoice, Objective,
-    RobustLoss, SolverOptions, DEFAULT_RANK_TOLERANCE, MIN_RANK_TOLERANCE,
+    RobustLoss, SolverOptions, DEFAULT_RANK_TOLERANCE,
 };
 use robocal_core::io::joint_limits::OutsideLimits;
 use robocal_core::io::{MeasurementReader, Positions};
@@ -60,11 +60,6 @@ pub(crate) fn weighting(
         })?);
     }
     if let Some(m) = orientation_weight {
-        if !(m > 0.0 && m.is_finite() && m <= 1e6) {
-            return Err(exit::usage(format!(
-                "--orientation-weight {m}: expected a positive number of mm per degree"
-            )));
-        }
         w.mm_per_deg = m;
     }
     Ok(w)
@@ -209,23 +204,14 @@ impl TryFrom<&CalibrateArgs> for Settings {
     type Error = anyhow::Error;
 
     fn try_from(a: &CalibrateArgs) -> anyhow::Result<Settings> {
-        limits::count(
-            "--max-iterations",
-            a.max_iterations,
-            1,
-            limits::MAX_CALIBRATION_ITERATIONS,
-            "a solver that has not converged by then will not",
-        )?;
-        if let Some(s) = a.robust_scale {
-            limits::magnitude("--robust-scale", s, limits::MAX_LENGTH_MM, "mm")?;
-        }
         let mut robot = common::robot(&a.robot)?;
         let betas = apply_beta(&mut robot, &a.beta)?;
         let compliant = apply_joint_families(&mut robot, a)?;
         super::real_cell::apply(&mut robot, a.backlash.as_deref(), a.thermal.as_deref())?;
         if compliant.is_empty() && a.compliance.as_deref().map(str::trim) == Some("auto") {
             errln!(
-                "note: --compliance auto: no joint of robot `{}` turns under gravity (every axis                  is parallel to its `gravity`); no compliance added",
+                "note: --compliance auto: no joint of robot `{}` turns under gravity (every axis \
+                 is parallel to its `gravity`); no compliance added",
                 robot.name()
             )?;
         }
@@ -238,30 +224,7 @@ impl TryFrom<&CalibrateArgs> for Settings {
         }
         let fix = param_list(&robot, &a.fix, "--fix")?;
         let free = param_list(&robot, &a.free, "--free")?;
-        if fix.len() == robot.param_count() {
-            return Err(exit::usage(format!(
-                "--fix names every parameter of robot `{}` ({}): nothing is left to identify",
-                robot.name(),
-                robot.param_count()
-            )));
-        }
-        if let Some(p) = fix.iter().find(|p| free.contains(p)) {
-            // Exit code 3, as when the library finds it.
-            return Err(exit::input(format!(
-                "--fix: `{}` is given both to --fix and to --free",
-                p.name()
-            )));
-        }
         let rank_tolerance = a.rank_tol.unwrap_or(DEFAULT_RANK_TOLERANCE);
-        if !(MIN_RANK_TOLERANCE..1.0).contains(&rank_tolerance) {
-            return Err(exit::usage(format!(
-                "--rank-tol {rank_tolerance:?}: not in [{MIN_RANK_TOLERANCE:e}, 1); it is the \
-                 smallest independence (sine of the angle between a parameter's effect and the \
-                 others') accepted, and below {MIN_RANK_TOLERANCE:e} double precision cannot \
-                 tell a parameter from an exact duplicate (whose independence computes as 1e-17 \
-                 to 1e-14 from rounding)"
-            )));
-        }
         IoPlan::new()
             .robot("--robot", &a.robot)
             .input("--data", &a.data)
@@ -318,6 +281,8 @@ impl TryFrom<&CalibrateArgs> for Settings {
                 }),
             },
         };
+        // The library checks its settings (ranges, parameter sets) before any data are read.
+        calibration.check(&robot)?;
         Ok(Settings {
             robot_arg: a.robot.clone(),
             robot,

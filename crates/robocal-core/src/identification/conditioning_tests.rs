@@ -74,11 +74,12 @@ fn nothing_left_to_identify_is_an_error_not_a_panic() {
         },
     )
     .unwrap_err();
-    assert!(matches!(e, Error::Numerical(_)), "{e:?}");
+    // Refused with the settings, before any work, naming the setting.
     assert!(
-        e.to_string().contains("every parameter is held fixed"),
-        "{e}"
+        matches!(&e, Error::Usage { field, .. } if field == "identifiability.fix"),
+        "{e:?}"
     );
+    assert!(e.to_string().contains("nothing is left to identify"), "{e}");
     // Everything but the tool orientation, which has no effect on a point.
     let effective: Vec<Param> = all
         .iter()
@@ -116,7 +117,11 @@ fn rank_tolerances_below_double_precision_are_refused() {
             },
         )
         .unwrap_err();
-        assert!(matches!(e, Error::Invalid { .. }), "{tol}: {e:?}");
+        // A value out of its range, as a bad flag's: a usage error naming the setting.
+        assert!(
+            matches!(&e, Error::Usage { field, .. } if field == "identifiability.rank_tolerance"),
+            "{tol}: {e:?}"
+        );
         assert!(e.to_string().contains("double precision"), "{e}");
     }
     // The floor itself is accepted, and the exact duplicates stay fixed there.

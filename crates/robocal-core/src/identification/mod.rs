@@ -74,6 +74,6 @@ pub use pipeline::{
 pub use plausibility::{Check, CheckKind, Plausibility};
 pub use prediction::{MapPoint, Prediction};
 pub use selection::calibrate;
-pub use solver::{solve, SolverOptions, SolverReport, Termination};
+pub use solver::{solve, SolverOptions, SolverReport, Termination, MAX_ITERATIONS};
 pub use split::{read_split, split_measurements, SplitData};
 pub use system::Problem;

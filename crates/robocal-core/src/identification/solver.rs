@@ -44,6 +44,11 @@ pub struct SolverOptions {
     pub warm_start_points: usize,
 }
 
+/// Most iterations a calibration's solve may be given: it converges in 5 to 350; a million
+/// iterations of a 75-point problem already run for tens of minutes, and a solver that has not
+/// converged by then will not.
+pub const MAX_ITERATIONS: usize = 1_000_000;
+
 /// From this many points, the solve starts on an even subsample (see [`crate::identification::pipeline`]'s stages).
 pub const WARM_START_MIN_POINTS: usize = 100_000;
 
