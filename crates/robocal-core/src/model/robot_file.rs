@@ -32,12 +32,14 @@
 //! ```
 
 use super::controller::{Controller, Coupling};
-use super::{Convention, JointLimit, JointType, Link, Param, Robot};
+use super::{JointType, Param, Robot};
 use crate::error::{Error, Result};
-use crate::ranges;
+use fields::{FileText, JointTables};
 use serde::Deserialize;
 use std::path::Path;
 use toml::Spanned;
+
+mod fields;
 
 /// A frame vector as written, with the spans of the vector and of each number.
 type FrameEntry = Spanned<Vec<Spanned<f64>>>;
@@ -82,6 +84,7 @@ struct ControllerEntry {
 /// Default joint range (degrees) when a robot file gives none.
 pub const DEFAULT_LIMIT_DEG: f64 = 360.0;
 
+/// The 1-based line of byte `offset` of `text`.
 fn line_of(text: &str, offset: usize) -> usize {
     text.as_bytes()[..offset.min(text.len())]
         .iter()
@@ -182,208 +185,19 @@ pub(super) fn from_description(
 
 /// Checks a parsed robot file (`text` is its text, for the lines in errors) and builds the robot.
 fn build(file: RobotFile, text: &str, path: &Path) -> Result<Robot> {
-    let err = |span: std::ops::Range<usize>, field: String, msg: String| Error::Parse {
-        path: path.to_owned(),
-        line: Some(line_of(text, span.start)),
-        field: Some(field),
-        message: msg,
-    };
-    // Every number must be finite and within the plausible range of its kind (crate::ranges).
-    let value = |v: &Spanned<f64>, field: String, range: &ranges::Range| -> Result<f64> {
-        range
-            .check(*v.get_ref())
-            .map_err(|msg| err(v.span(), field, msg))
-    };
-    let length = |v: &Spanned<f64>, field: String| value(v, field, &ranges::LENGTH);
-    let angle = |v: &Spanned<f64>, field: String| value(v, field, &ranges::ANGLE);
-    let convention = match file.convention.get_ref().as_str() {
-        "mdh" => Convention::Mdh,
-        "dh" => Convention::Dh,
-        other => {
-            return Err(err(
-                file.convention.span(),
-                "convention".into(),
-                format!("`{other}` is not a convention: use \"mdh\" (modified DH, Craig) or \"dh\" (standard DH)"),
-            ))
-        }
-    };
-    if file.joints.is_empty() {
-        return Err(Error::parse(
-            path,
-            None,
-            Some("joints"),
-            "no [[joints]] table: a robot needs at least one joint",
-        ));
-    }
-    if file.joints.len() > super::MAX_JOINTS {
-        return Err(Error::parse(
-            path,
-            None,
-            Some("joints"),
-            format!(
-                "{} joints; at most {} are supported",
-                file.joints.len(),
-                super::MAX_JOINTS
-            ),
-        ));
-    }
-    let frame_vec = |v: &Option<Spanned<Vec<Spanned<f64>>>>, name: &str| -> Result<[f64; 6]> {
-        let Some(v) = v else { return Ok([0.0; 6]) };
-        if v.get_ref().len() != 6 {
-            return Err(err(
-                v.span(),
-                name.into(),
-                format!(
-                    "expected 6 numbers [x, y, z, A, B, C] (mm, deg), got {}",
-                    v.get_ref().len()
-                ),
-            ));
-        }
-        let mut out = [0.0; 6];
-        for (k, x) in v.get_ref().iter().enumerate() {
-            let range = if k < 3 {
-                &ranges::LENGTH
-            } else {
-                &ranges::ANGLE
-            };
-            out[k] = value(x, format!("{name}[{k}]"), range)?;
-        }
-        Ok(crate::frame::vec_deg_to_rad(&out))
-    };
-    let base = frame_vec(&file.base, "base")?;
-    let mut tool0 = frame_vec(&file.tool, "tool")?;
-    let mut tools = Vec::new();
-    if let Some(list) = &file.tools {
-        if list.get_ref().is_empty() || list.get_ref().len() > crate::observations::MAX_TARGETS {
-            return Err(err(
-                list.span(),
-                "tools".into(),
-                format!(
-                    "expected 1 to {} tool vectors, got {}",
-                    crate::observations::MAX_TARGETS,
-                    list.get_ref().len()
-                ),
-            ));
-        }
-        for (k, v) in list.get_ref().iter().enumerate() {
-            tools.push(frame_vec(&Some(v.clone()), &format!("tools[{k}]"))?);
-        }
-        if file.tool.is_some() && tools[0] != tool0 {
-            return Err(err(
-                list.span(),
-                "tools".into(),
-                "the first of `tools` is the tool of target 1 and must equal `tool` (or leave \
-                 `tool` out)"
-                    .into(),
-            ));
-        }
-        tool0 = tools[0];
-    }
-    let tool_correction = frame_vec(&file.tool_correction, "tool_correction")?;
-    let mut links = Vec::with_capacity(file.joints.len());
-    let mut limits = Vec::with_capacity(file.joints.len());
-    let mut types = Vec::with_capacity(file.joints.len());
-    let mut betas = Vec::new();
-    for (i, j) in file.joints.iter().enumerate() {
-        let f = |name: &str| format!("joints[{}].{name}", i + 1);
-        let kind = match &j.kind {
-            None => JointType::Revolute,
-            Some(k) => JointType::parse(k.get_ref()).ok_or_else(|| {
-                err(
-                    k.span(),
-                    f("type"),
-                    format!(
-                        "`{}` is not a joint type: use \"revolute\" or \"prismatic\"",
-                        k.get_ref()
-                    ),
-                )
-            })?,
-        };
-        types.push(kind);
-        let unit = kind.unit();
-        let phi = match &j.phi {
-            Some(v) => angle(v, f("phi"))?,
-            None => 0.0,
-        };
-        let beta = match &j.beta {
-            Some(v) => {
-                betas.push(i);
-                angle(v, f("beta"))?
-            }
-            None => 0.0,
-        };
-        links.push(Link {
-            alpha: angle(&j.alpha, f("alpha"))?.to_radians(),
-            d: length(&j.d, f("d"))?,
-            a: length(&j.a, f("a"))?,
-            phi: phi.to_radians(),
-            beta: beta.to_radians(),
-        });
-        let (min, max) = match &j.limits {
-            None if kind == JointType::Prismatic => {
-                return Err(Error::parse(
-                    path,
-                    j.kind.as_ref().map(|k| line_of(text, k.span().start)),
-                    Some(&f("limits")),
-                    "a prismatic joint needs its travel: limits = [min, max] in mm",
-                ))
-            }
-            None => (-DEFAULT_LIMIT_DEG, DEFAULT_LIMIT_DEG),
-            Some(l) => {
-                if l.get_ref().len() != 2 {
-                    return Err(err(
-                        l.span(),
-                        f("limits"),
-                        format!(
-                            "expected [min, max] in {}, got {} numbers",
-                            unit_word(kind),
-                            l.get_ref().len()
-                        ),
-                    ));
-                }
-                // Angles (deg, multi-turn axes allowed) or, for a prismatic joint, lengths (mm).
-                let range = match kind {
-                    JointType::Revolute => &ranges::JOINT,
-                    JointType::Prismatic => &ranges::LENGTH,
-                };
-                let min = value(&l.get_ref()[0], f("limits"), range)?;
-                let max = value(&l.get_ref()[1], f("limits"), range)?;
-                if min > max {
-                    return Err(err(
-                        l.span(),
-                        f("limits"),
-                        format!(
-                            "min {min} {u} is greater than max {max} {u}",
-                            u = unit.as_str()
-                        ),
-                    ));
-                }
-                (min, max)
-            }
-        };
-        limits.push(JointLimit {
-            min: unit.to_internal(min),
-            max: unit.to_internal(max),
-        });
-    }
+    let at = FileText { text, path };
+    let convention = fields::convention(&file.convention, &at)?;
+    fields::check_joint_count(&file.joints, path)?;
+    let base = at.frame_vector(&file.base, "base")?;
+    let (tool0, tools) = fields::tools(&file.tool, &file.tools, &at)?;
+    let tool_correction = at.frame_vector(&file.tool_correction, "tool_correction")?;
+    let joints = JointTables::check(&file.joints, &at)?;
     let controller = match &file.controller {
         None => None,
-        Some(c) => Some(controller_section(c, &types, text, path)?),
+        Some(c) => Some(controller_section(c, &joints.types, text, path)?),
     };
-    let name = file.name.unwrap_or_else(|| {
-        path.file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "robot".into())
-    });
-    let mut robot = Robot::new(name, convention, links, limits, base, tool0)
-        .map_err(|e| Error::parse(path, None, None, e.to_string()))?;
-    robot
-        .set_joint_types(types)
-        .and_then(|()| robot.set_controller(controller))
-        .map_err(|e| Error::parse(path, None, None, e.to_string()))?;
-    for i in betas {
-        robot.enable_beta(i)?;
-    }
+    let name = fields::robot_name(file.name, path);
+    let mut robot = fields::nominal_robot(name, convention, joints, base, tool0, controller, path)?;
     if tools.len() > 1 {
         robot.set_target_tools(&tools)?;
     }
@@ -391,22 +205,12 @@ fn build(file: RobotFile, text: &str, path: &Path) -> Result<Robot> {
         robot.set(Param::tool(k), v);
     }
     if let Some(g) = &file.gravity {
-        let v: Vec<f64> = g.get_ref().iter().map(|x| *x.get_ref()).collect();
-        let bad = |msg: String| err(g.span(), "gravity".to_owned(), msg);
-        let g3: [f64; 3] = v.as_slice().try_into().map_err(|_| {
-            bad(format!(
-                "expected [gx, gy, gz], the direction of gravity in the base frame, got {} numbers",
-                v.len()
-            ))
-        })?;
-        robot.set_gravity(g3).map_err(|e| match e {
-            Error::Invalid { message, .. } => bad(message),
-            other => bad(other.to_string()),
-        })?;
+        fields::set_gravity(&mut robot, g, &at)?;
     }
     Ok(robot)
 }
 
+/// The unit of a joint type's values in messages: "degrees" or "mm".
 fn unit_word(t: JointType) -> &'static str {
     match t {
         JointType::Revolute => "degrees",
