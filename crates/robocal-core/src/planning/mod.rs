@@ -259,6 +259,52 @@ pub fn plan_with(
     observer: &dyn Observer,
 ) -> Result<Plan> {
     let s = settings;
+    check_settings(robot, s)?;
+    observer.progress(Stage::Candidates, 0, 1);
+    let candidates = offered_candidates(robot, s)?;
+    let random = draw(robot, s, s.poses, 2)?;
+    let identified = identifiable(robot, s, &candidates)?;
+    let k = identified.len();
+    check_size(s, candidates.len(), k)?;
+    let d = design_inputs(robot, s, &identified, &candidates);
+    let ridge = DMatrix::identity(k, k) * 1e-6;
+    observer.progress(Stage::Candidates, 1, 1);
+
+    let c = select::choose(
+        &d.blocks,
+        &(&d.fixed + &ridge),
+        s.criterion,
+        &d.w,
+        s.poses,
+        greedy,
+        observer,
+    );
+    let chosen = c.chosen;
+    let n_all = s.poses + s.include.len();
+    let planned = quality(
+        &(&d.fixed + d.blocks.information(&chosen)),
+        n_all,
+        &d.scale,
+        &d.workspace,
+        s.noise_mm,
+    );
+    let random_q = random_quality(robot, s, &d, &random, n_all);
+    Ok(Plan {
+        poses: chosen.iter().map(|&i| candidates[i].clone()).collect(),
+        identified,
+        planned,
+        random: random_q,
+        greedy_value: c.greedy_value,
+        final_value: c.final_value,
+        exchange_passes: c.passes,
+        exchanges: c.exchanges,
+    })
+}
+
+/// Checks the settings a plan cannot start without: at least one pose, as many candidates as
+/// poses, a positive noise, a non-negative noise per metre, and included poses with the robot's
+/// joint count.
+fn check_settings(robot: &Robot, s: &PlanSettings) -> Result<()> {
     if s.poses == 0 {
         return Err(Error::invalid("poses", "must be at least 1"));
     }
@@ -301,7 +347,12 @@ pub fn plan_with(
             ));
         }
     }
-    observer.progress(Stage::Candidates, 0, 1);
+    Ok(())
+}
+
+/// The candidate poses offered to the selection: `s.candidates` random poses (stream 1) less
+/// those already among the included poses.
+fn offered_candidates(robot: &Robot, s: &PlanSettings) -> Result<Vec<Vec<f64>>> {
     // Candidates already among the included poses (same seed, same rules) are not offered.
     let mut candidates = draw(robot, s, s.candidates, 1)?;
     let taken: std::collections::HashSet<Vec<u64>> = s
@@ -310,8 +361,12 @@ pub fn plan_with(
         .map(|q| q.iter().map(|v| v.to_bits()).collect())
         .collect();
     candidates.retain(|q| !taken.contains(&q.iter().map(|v| v.to_bits()).collect::<Vec<_>>()));
-    let random = draw(robot, s, s.poses, 2)?;
+    Ok(candidates)
+}
 
+/// The parameters the included poses and (the first [`ANALYSIS_POSES`] of) the candidates
+/// identify.
+fn identifiable(robot: &Robot, s: &PlanSettings, candidates: &[Vec<f64>]) -> Result<Vec<Param>> {
     // The identifiable parameters: analysis of the candidates at their nominal tool points.
     let mut obs = Observations::new(robot.dof());
     for (line, q) in s
@@ -323,8 +378,12 @@ pub fn plan_with(
         obs.push(q, robot.tool_position(q), line + 1)?;
     }
     let ident = analyze(robot, &obs, &IdentifiabilityOptions::default())?;
-    let identified = ident.identified.clone();
-    let k = identified.len();
+    Ok(ident.identified)
+}
+
+/// Checks that the plan can identify `k` parameters (at least `k` poses with the included
+/// ones) and that its estimated time is within [`select::MAX_SECONDS`].
+fn check_size(s: &PlanSettings, n_candidates: usize, k: usize) -> Result<()> {
     if s.poses + s.include.len() < k {
         return Err(Error::invalid(
             "poses",
@@ -339,7 +398,7 @@ pub fn plan_with(
             ),
         ));
     }
-    let secs = select::estimated_seconds(s.poses, candidates.len(), k);
+    let secs = select::estimated_seconds(s.poses, n_candidates, k);
     if secs > select::MAX_SECONDS {
         return Err(Error::invalid(
             "poses",
@@ -348,84 +407,117 @@ pub fn plan_with(
                  (estimated; a plan is limited to {} minutes): choose fewer poses or \
                  candidates, or plan in parts, each part's poses included in the next",
                 s.poses,
-                candidates.len(),
+                n_candidates,
                 (secs / 60.0).ceil(),
                 select::MAX_SECONDS / 60.0
             ),
         ));
     }
+    Ok(())
+}
+
+/// What the selection and the qualities work on: the candidates' scaled Jacobian blocks and
+/// the information they share.
+struct DesignInputs {
+    /// Positions of the identified parameters among the robot's.
+    index: Vec<usize>,
+    /// Each column's RMS over the candidates (the columns are divided by it).
+    scale: Vec<f64>,
+    /// The candidates' scaled blocks, not noise-weighted: the workspace.
+    workspace: Blocks,
+    /// The workspace's mean `J^T J`.
+    w: DMatrix<f64>,
+    /// The candidates' scaled, noise-weighted blocks the selection chooses from.
+    blocks: Blocks,
+    /// The information of the included poses (zero without them).
+    fixed: DMatrix<f64>,
+}
+
+/// The design's inputs for `identified` over `candidates` and the included poses.
+fn design_inputs(
+    robot: &Robot,
+    s: &PlanSettings,
+    identified: &[Param],
+    candidates: &[Vec<f64>],
+) -> DesignInputs {
+    let k = identified.len();
     let index: Vec<usize> = identified
         .iter()
         .map(|p| robot.param_position(*p).expect("a parameter of the robot"))
         .collect();
 
-    let mut jc = jacobians(robot, &index, &candidates);
-    let scale: Vec<f64> = (0..k)
+    let mut jc = jacobians(robot, &index, candidates);
+    let scale = column_scale(&jc, k);
+    scale_columns(&mut jc, k, &scale);
+    // The workspace's mean J^T J: the candidates' model-error blocks, not noise-weighted.
+    let workspace = Blocks::new(k, jc.clone());
+    let all: Vec<usize> = (0..workspace.len()).collect();
+    let w = workspace.information(&all) / workspace.len().max(1) as f64;
+    weight_by_noise(&mut jc, k, robot, candidates, s);
+    let blocks = Blocks::new(k, jc);
+    let fixed = included_information(robot, s, &index, &scale);
+    DesignInputs {
+        index,
+        scale,
+        workspace,
+        w,
+        blocks,
+        fixed,
+    }
+}
+
+/// The RMS of each of the `k` columns of the Jacobian blocks `jc` (at least the smallest
+/// positive number).
+fn column_scale(jc: &[f64], k: usize) -> Vec<f64> {
+    (0..k)
         .map(|a| {
             let ss: f64 = jc.chunks_exact(k).map(|row| row[a] * row[a]).sum();
             (ss * ROWS as f64 / jc.len().max(1) as f64 * k as f64)
                 .sqrt()
                 .max(f64::MIN_POSITIVE)
         })
-        .collect();
-    scale_columns(&mut jc, k, &scale);
-    // The workspace's mean J^T J: the candidates' model-error blocks, not noise-weighted.
-    let workspace = Blocks::new(k, jc.clone());
-    let all: Vec<usize> = (0..workspace.len()).collect();
-    let w = workspace.information(&all) / workspace.len().max(1) as f64;
-    weight_by_noise(&mut jc, k, robot, &candidates, s);
-    let blocks = Blocks::new(k, jc);
-    let mut ji = jacobians(robot, &index, &s.include);
-    scale_columns(&mut ji, k, &scale);
+        .collect()
+}
+
+/// The information matrix of the included poses (scaled, noise-weighted), zero without them.
+fn included_information(
+    robot: &Robot,
+    s: &PlanSettings,
+    index: &[usize],
+    scale: &[f64],
+) -> DMatrix<f64> {
+    let k = index.len();
+    let mut ji = jacobians(robot, index, &s.include);
+    scale_columns(&mut ji, k, scale);
     weight_by_noise(&mut ji, k, robot, &s.include, s);
     let included = Blocks::new(k, ji);
     let all_included: Vec<usize> = (0..s.include.len()).collect();
-    let fixed = if s.include.is_empty() {
+    if s.include.is_empty() {
         DMatrix::zeros(k, k)
     } else {
         included.information(&all_included)
-    };
-    let ridge = DMatrix::identity(k, k) * 1e-6;
-    observer.progress(Stage::Candidates, 1, 1);
+    }
+}
 
-    let c = select::choose(
-        &blocks,
-        &(&fixed + &ridge),
-        s.criterion,
-        &w,
-        s.poses,
-        greedy,
-        observer,
-    );
-    let chosen = c.chosen;
-    let n_all = s.poses + s.include.len();
-    let planned = quality(
-        &(&fixed + blocks.information(&chosen)),
-        n_all,
-        &scale,
-        &workspace,
-        s.noise_mm,
-    );
-    let mut jr = jacobians(robot, &index, &random);
-    scale_columns(&mut jr, k, &scale);
-    weight_by_noise(&mut jr, k, robot, &random, s);
+/// The quality of the random poses `random` with the included ones, `n_all` poses in all.
+fn random_quality(
+    robot: &Robot,
+    s: &PlanSettings,
+    d: &DesignInputs,
+    random: &[Vec<f64>],
+    n_all: usize,
+) -> Quality {
+    let k = d.index.len();
+    let mut jr = jacobians(robot, &d.index, random);
+    scale_columns(&mut jr, k, &d.scale);
+    weight_by_noise(&mut jr, k, robot, random, s);
     let rb = Blocks::new(k, jr);
     let all_random: Vec<usize> = (0..random.len()).collect();
-    let random_q = quality(
-        &(&fixed + rb.information(&all_random)),
+    quality(
+        &(&d.fixed + rb.information(&all_random)),
         n_all,
-        &scale,
-        &workspace,
+        &d.scale,
+        &d.workspace,
         s.noise_mm,
-    );
-    Ok(Plan {
-        poses: chosen.iter().map(|&i| candidates[i].clone()).collect(),
-        identified,
-        planned,
-        random: random_q,
-        greedy_value: c.greedy_value,
-        final_value: c.final_value,
-        exchange_passes: c.passes,
-        exchanges: c.exchanges,
-    })
+    )
 }
