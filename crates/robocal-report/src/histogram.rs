@@ -176,7 +176,54 @@ where
     DB::ErrorType: 'static,
 {
     let e = draw_err("histogram");
-    // Title and legend above the plot, so that neither hides a bar.
+    let plot_area = draw_title_and_legend(root, series, b, title)?;
+    let x_lo = b.bin_range(0).0;
+    let x_hi = b.bin_range(b.bins() - 1).1;
+    let max_count = b.max_count().max(1) as u32;
+    // Head room for the count labels and the mean labels.
+    let y_hi = max_count + (max_count as f64 * 0.22).ceil() as u32 + 2;
+    let mut chart = ChartBuilder::on(&plot_area)
+        .margin_top(4)
+        .margin_left(14)
+        .margin_right(28)
+        .margin_bottom(10)
+        .x_label_area_size(52)
+        .y_label_area_size(64)
+        .build_cartesian_2d(x_lo..x_hi, 0u32..y_hi)
+        .map_err(&e)?;
+    draw_axes(&mut chart, b, x_lo, x_hi, y_hi)?;
+    draw_series_bars(&mut chart, series, b, x_lo, x_hi, y_hi)?;
+    draw_mean_labels(&mut chart, series, b, x_lo, x_hi, y_hi)?;
+    if b.overflow {
+        let (l, r) = b.bin_range(b.bins() - 1);
+        chart
+            .draw_series(std::iter::once(Text::new(
+                format!("> {}", crate::numfmt::magnitude(b.cap())),
+                ((l + r) / 2.0, 0u32),
+                font(12.0)
+                    .color(&MUTED)
+                    .pos(Pos::new(HPos::Center, VPos::Top)),
+            )))
+            .map_err(&e)?;
+    }
+    Ok(())
+}
+
+/// The chart of [`draw_bars`]: mm on x, counts on y.
+type BarChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordu32>>;
+
+/// Draws the title and the legend above the plot, so that neither hides a bar; returns the area
+/// below them, for the plot.
+fn draw_title_and_legend<DB: DrawingBackend>(
+    root: &DrawingArea<DB, plotters::coord::Shift>,
+    series: &[HistogramSeries],
+    b: &Binning,
+    title: &str,
+) -> Result<DrawingArea<DB, plotters::coord::Shift>>
+where
+    DB::ErrorType: 'static,
+{
+    let e = draw_err("histogram");
     let legend_px = 13.0;
     let texts: Vec<String> = series
         .iter()
@@ -215,24 +262,22 @@ where
         legend_w,
         legend_px,
     )?;
+    Ok(plot_area)
+}
 
-    let x_lo = b.bin_range(0).0;
-    let x_hi = b.bin_range(b.bins() - 1).1;
+/// The mesh, the axis labels and, for log bins, the 1-2-5 ticks.
+fn draw_axes<DB: DrawingBackend>(
+    chart: &mut BarChart<'_, DB>,
+    b: &Binning,
+    x_lo: f64,
+    x_hi: f64,
+    y_hi: u32,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = draw_err("histogram");
     let log = b.scale == Scale::Log;
-    let max_count = b.max_count().max(1) as u32;
-    // Head room for the count labels and the mean labels.
-    let y_hi = max_count + (max_count as f64 * 0.22).ceil() as u32 + 2;
-
-    let mut chart = ChartBuilder::on(&plot_area)
-        .margin_top(4)
-        .margin_left(14)
-        .margin_right(28)
-        .margin_bottom(10)
-        .x_label_area_size(52)
-        .y_label_area_size(64)
-        .build_cartesian_2d(x_lo..x_hi, 0u32..y_hi)
-        .map_err(&e)?;
-
     let tick_step = nice_step((x_hi - x_lo) / 12.0);
     let x_dec = decimals_for(tick_step);
     let cap = b.cap();
@@ -268,19 +313,32 @@ where
         .draw()
         .map_err(&e)?;
 
-    let k = series.len().max(1);
-    let gap = 0.08;
-    let slot = (1.0 - 2.0 * gap) / k as f64;
-    let (plot_w, plot_h) = chart.plotting_area().dim_in_pixel();
+    if log {
+        log_ticks(chart, b, x_lo, b.axis(b.cap()), y_hi)?;
+    }
+    Ok(())
+}
+
+/// The mean lines, then each series' bars side by side in their bins, with their counts above
+/// them when the bars are wide enough.
+fn draw_series_bars<DB: DrawingBackend>(
+    chart: &mut BarChart<'_, DB>,
+    series: &[HistogramSeries],
+    b: &Binning,
+    x_lo: f64,
+    x_hi: f64,
+    y_hi: u32,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = draw_err("histogram");
+    let (gap, slot) = bar_slots(series);
+    let (plot_w, _) = chart.plotting_area().dim_in_pixel();
     let bar_px = plot_w as f64 * b.width() * slot / (x_hi - x_lo);
     let show_counts = bar_px >= 11.0;
-    let shows_mean = |s: usize| b.n[s] > 0 && b.mean[s].is_finite() && b.axis(b.mean[s]) <= x_hi;
-    if log {
-        log_ticks(&mut chart, b, x_lo, cap_axis, y_hi)?;
-    }
-
     // Mean lines first, so that bars and counts stay on top of them.
-    for s in (0..series.len()).filter(|&s| shows_mean(s)) {
+    for s in (0..series.len()).filter(|&s| shows_mean(b, s, x_hi)) {
         let m = b.axis(b.mean[s]);
         chart
             .draw_series(DashedLineSeries::new(
@@ -325,9 +383,40 @@ where
             chart.draw_series(texts).map_err(&e)?;
         }
     }
-    // Mean labels at the top, staggered so that close means stay readable.
+    Ok(())
+}
+
+/// The gap at each side of a bin and each series' share of it.
+fn bar_slots(series: &[HistogramSeries]) -> (f64, f64) {
+    let k = series.len().max(1);
+    let gap = 0.08;
+    (gap, (1.0 - 2.0 * gap) / k as f64)
+}
+
+/// Whether series `s`'s mean is drawn: it has points and its mean is on the axis.
+fn shows_mean(b: &Binning, s: usize, x_hi: f64) -> bool {
+    b.n[s] > 0 && b.mean[s].is_finite() && b.axis(b.mean[s]) <= x_hi
+}
+
+/// The mean labels at the top, staggered so that close means stay readable.
+fn draw_mean_labels<DB: DrawingBackend>(
+    chart: &mut BarChart<'_, DB>,
+    series: &[HistogramSeries],
+    b: &Binning,
+    x_lo: f64,
+    x_hi: f64,
+    y_hi: u32,
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let e = draw_err("histogram");
+    let (plot_w, plot_h) = chart.plotting_area().dim_in_pixel();
     let px_per_count = plot_h as f64 / y_hi as f64;
-    for (row, s) in (0..series.len()).filter(|&s| shows_mean(s)).enumerate() {
+    for (row, s) in (0..series.len())
+        .filter(|&s| shows_mean(b, s, x_hi))
+        .enumerate()
+    {
         let m = b.axis(b.mean[s]);
         let y = y_hi.saturating_sub(((4.0 + 16.0 * row as f64) / px_per_count).round() as u32);
         let near_right = (m - x_lo) / (x_hi - x_lo) > 0.85;
@@ -344,18 +433,6 @@ where
                 font(12.0)
                     .color(&series_color(s))
                     .pos(Pos::new(anchor, VPos::Top)),
-            )))
-            .map_err(&e)?;
-    }
-    if b.overflow {
-        let (l, r) = b.bin_range(b.bins() - 1);
-        chart
-            .draw_series(std::iter::once(Text::new(
-                format!("> {}", crate::numfmt::magnitude(cap)),
-                ((l + r) / 2.0, 0u32),
-                font(12.0)
-                    .color(&MUTED)
-                    .pos(Pos::new(HPos::Center, VPos::Top)),
             )))
             .map_err(&e)?;
     }
