@@ -9,8 +9,8 @@ use robocal_core::io::measurements::{measurements_csv, read_measurements, Positi
 use robocal_core::io::result::FrameVec;
 use robocal_core::io::write_all_atomic;
 use robocal_core::simulation::{
-    simulate, simulate_joints, PerJoint, SimulationBuilder, SimulationConfig, SimulationSettings,
-    TargetMeasurement, TruthSource, TruthSpec, SET_VALIDATION,
+    simulate, simulate_joints, PerJoint, Simulation, SimulationBuilder, SimulationConfig,
+    SimulationSettings, TargetMeasurement, TruthFile, TruthSource, TruthSpec, SET_VALIDATION,
 };
 use robocal_core::Robot;
 use std::path::{Path, PathBuf};
@@ -363,18 +363,20 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     if let Some(kind) = &a.constraint {
         return constraints::run(&a, kind);
     }
-    let Settings {
-        nominal,
-        truth,
-        cfg,
-        joints,
-        out,
-        truth_out,
-        validation_out,
-        targets,
-    } = Settings::try_from(&a)?;
+    let s = Settings::try_from(&a)?;
+    let sim = measure(&s)?;
+    let truth_file = write_files(&s, &sim)?;
+    for w in &sim.warnings {
+        errln!("warning: {w}")?;
+    }
+    print_summary(&s, &truth_file)
+}
 
-    let joints = match &joints {
+/// The session: the joints of `--joints` measured, or poses drawn, on the true robot, with a
+/// progress bar for large sessions.
+fn measure(s: &Settings) -> anyhow::Result<Simulation> {
+    let (nominal, truth, cfg) = (&s.nominal, &s.truth, &s.cfg);
+    let joints = match &s.joints {
         Some(p) => Some(read_measurements(
             p,
             nominal.joint_space(),
@@ -393,14 +395,20 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     };
     let mut sim = match joints {
         // The joint file is dropped as soon as it is measured (large files: memory).
-        Some(j) => simulate_joints(&nominal, &truth, &cfg, &j, observer)?,
-        None => simulate(&nominal, &truth, &cfg, observer)?,
+        Some(j) => simulate_joints(nominal, truth, cfg, &j, observer)?,
+        None => simulate(nominal, truth, cfg, observer)?,
     };
-    sim.measure_targets(&targets)?;
+    sim.measure_targets(&s.targets)?;
     if let Some(b) = &bar {
         b.finish();
     }
+    Ok(sim)
+}
 
+/// Writes `--out` (and `--validation-out`, the validation rows split off) and the truth file
+/// beside it, all or none; returns the truth file.
+fn write_files(s: &Settings, sim: &Simulation) -> anyhow::Result<TruthFile> {
+    let (out, truth_out, validation_out) = (&s.out, &s.truth_out, &s.validation_out);
     // Split the validation rows off if asked; every row's file, in row order, for the truth file.
     let split = validation_out.as_ref().map(|_| {
         (
@@ -430,7 +438,7 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
         path: p.to_owned(),
         source: e,
     };
-    let main_csv = measurements_csv(main).map_err(|e| io(&out, e))?;
+    let main_csv = measurements_csv(main).map_err(|e| io(out, e))?;
     let json = truth_file.to_json()?;
     let mut writes: Vec<(&Path, Vec<u8>)> = vec![(out.as_path(), main_csv)];
     if let (Some(p), Some(v)) = (&validation_out, val) {
@@ -440,9 +448,12 @@ pub fn run(a: SimulateArgs) -> anyhow::Result<()> {
     let refs: Vec<(&Path, &[u8])> = writes.iter().map(|(p, b)| (*p, b.as_slice())).collect();
     write_all_atomic(&refs)?;
 
-    for w in &sim.warnings {
-        errln!("warning: {w}")?;
-    }
+    Ok(truth_file)
+}
+
+/// What was written, the truth robot, the tracker and the effects the session simulated.
+fn print_summary(s: &Settings, truth_file: &TruthFile) -> anyhow::Result<()> {
+    let (cfg, truth_out) = (&s.cfg, &s.truth_out);
     // "wrote cell.csv (3 plane, 75 calibration rows), ..."
     let mut per_file: Vec<(String, Vec<String>)> = Vec::new();
     for (set, info) in &truth_file.sets {
