@@ -185,24 +185,7 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         .map(|p| program_format(a.program_format.as_deref(), p))
         .transpose()?;
     io.check()?;
-    let mut settings = PlanSettings {
-        cycles: a.cycles,
-        edge_mm: a.cube_mm,
-        centre_mm: a
-            .center
-            .as_deref()
-            .map(|s| triple("--center", s))
-            .transpose()?,
-        orientation_deg: a
-            .orientation
-            .as_deref()
-            .map(|s| triple("--orientation", s))
-            .transpose()?,
-        floor_z_mm: a.floor_mm,
-        footprint_radius_mm: a.footprint_mm,
-        ..PlanSettings::default()
-    };
-    settings.validate()?;
+    let mut settings = plan_settings(&a)?;
     let model = common::model(a.robot.as_deref(), a.params.as_deref())?;
     if let (Some((_, res)), Some(p)) = (&model.calibrated, &a.params) {
         common::warn_not_calibrated(res, p)?;
@@ -226,7 +209,39 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         }
         _ => write_atomic(&a.out, &csv)?,
     }
+    print_plan(&a, &plan, &model.nominal, format)
+}
 
+/// The plan's settings from the flags, checked by the library.
+fn plan_settings(a: &PlanArgs) -> anyhow::Result<PlanSettings> {
+    let settings = PlanSettings {
+        cycles: a.cycles,
+        edge_mm: a.cube_mm,
+        centre_mm: a
+            .center
+            .as_deref()
+            .map(|s| triple("--center", s))
+            .transpose()?,
+        orientation_deg: a
+            .orientation
+            .as_deref()
+            .map(|s| triple("--orientation", s))
+            .transpose()?,
+        floor_z_mm: a.floor_mm,
+        footprint_radius_mm: a.footprint_mm,
+        ..PlanSettings::default()
+    };
+    settings.validate()?;
+    Ok(settings)
+}
+
+/// The cube, the tool orientation, the five poses with their joints, and the files written.
+fn print_plan(
+    a: &PlanArgs,
+    plan: &robocal_core::iso9283::Plan,
+    robot: &robocal_core::Robot,
+    format: Option<Format>,
+) -> anyhow::Result<()> {
     let c = plan.cube.centre;
     outln!(
         "cube: edge {:.1} mm, centre ({:.1}, {:.1}, {:.1}) mm (base frame){}",
@@ -250,7 +265,6 @@ fn plan(a: PlanArgs) -> anyhow::Result<()> {
         o[4],
         o[5]
     )?;
-    let robot = &model.nominal;
     let names: Vec<String> = (1..=robot.dof()).map(|i| format!("q{i}")).collect();
     outln!(
         "{:<5}{:>11}{:>11}{:>11}  joints{} (deg)",
