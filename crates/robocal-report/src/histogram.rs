@@ -191,9 +191,16 @@ where
         .y_label_area_size(64)
         .build_cartesian_2d(x_lo..x_hi, 0u32..y_hi)
         .map_err(&e)?;
-    draw_axes(&mut chart, b, x_lo, x_hi, y_hi)?;
-    draw_series_bars(&mut chart, series, b, x_lo, x_hi, y_hi)?;
-    draw_mean_labels(&mut chart, series, b, x_lo, x_hi, y_hi)?;
+    let bars = Bars {
+        series,
+        b,
+        x_lo,
+        x_hi,
+        y_hi,
+    };
+    draw_axes(&mut chart, &bars)?;
+    draw_series_bars(&mut chart, &bars)?;
+    draw_mean_labels(&mut chart, &bars)?;
     if b.overflow {
         let (l, r) = b.bin_range(b.bins() - 1);
         chart
@@ -211,6 +218,16 @@ where
 
 /// The chart of [`draw_bars`]: mm on x, counts on y.
 type BarChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordu32>>;
+
+/// What the parts of [`draw_bars`] draw: the series, their bins and the chart's ranges.
+#[derive(Clone, Copy)]
+struct Bars<'a> {
+    series: &'a [HistogramSeries],
+    b: &'a Binning,
+    x_lo: f64,
+    x_hi: f64,
+    y_hi: u32,
+}
 
 /// Draws the title and the legend above the plot, so that neither hides a bar; returns the area
 /// below them, for the plot.
@@ -266,16 +283,17 @@ where
 }
 
 /// The mesh, the axis labels and, for log bins, the 1-2-5 ticks.
-fn draw_axes<DB: DrawingBackend>(
-    chart: &mut BarChart<'_, DB>,
-    b: &Binning,
-    x_lo: f64,
-    x_hi: f64,
-    y_hi: u32,
-) -> Result<()>
+fn draw_axes<DB: DrawingBackend>(chart: &mut BarChart<'_, DB>, bars: &Bars) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
+    let Bars {
+        b,
+        x_lo,
+        x_hi,
+        y_hi,
+        ..
+    } = *bars;
     let e = draw_err("histogram");
     let log = b.scale == Scale::Log;
     let tick_step = nice_step((x_hi - x_lo) / 12.0);
@@ -321,17 +339,17 @@ where
 
 /// The mean lines, then each series' bars side by side in their bins, with their counts above
 /// them when the bars are wide enough.
-fn draw_series_bars<DB: DrawingBackend>(
-    chart: &mut BarChart<'_, DB>,
-    series: &[HistogramSeries],
-    b: &Binning,
-    x_lo: f64,
-    x_hi: f64,
-    y_hi: u32,
-) -> Result<()>
+fn draw_series_bars<DB: DrawingBackend>(chart: &mut BarChart<'_, DB>, bars: &Bars) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
+    let Bars {
+        series,
+        b,
+        x_lo,
+        x_hi,
+        y_hi,
+    } = *bars;
     let e = draw_err("histogram");
     let (gap, slot) = bar_slots(series);
     let (plot_w, _) = chart.plotting_area().dim_in_pixel();
@@ -399,17 +417,17 @@ fn shows_mean(b: &Binning, s: usize, x_hi: f64) -> bool {
 }
 
 /// The mean labels at the top, staggered so that close means stay readable.
-fn draw_mean_labels<DB: DrawingBackend>(
-    chart: &mut BarChart<'_, DB>,
-    series: &[HistogramSeries],
-    b: &Binning,
-    x_lo: f64,
-    x_hi: f64,
-    y_hi: u32,
-) -> Result<()>
+fn draw_mean_labels<DB: DrawingBackend>(chart: &mut BarChart<'_, DB>, bars: &Bars) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
+    let Bars {
+        series,
+        b,
+        x_lo,
+        x_hi,
+        y_hi,
+    } = *bars;
     let e = draw_err("histogram");
     let (plot_w, plot_h) = chart.plotting_area().dim_in_pixel();
     let px_per_count = plot_h as f64 / y_hi as f64;

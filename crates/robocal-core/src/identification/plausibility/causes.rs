@@ -13,6 +13,13 @@ pub(super) struct Causes<'a> {
 }
 
 impl Causes<'_> {
+    /// Gives each failed check its likely cause.
+    pub(super) fn attach(&self, checks: &mut [super::Check]) {
+        for c in checks.iter_mut().filter(|c| !c.passed) {
+            c.cause = Some(self.of(c.kind));
+        }
+    }
+
     /// The likely cause of a failed check: the corrections that explain the data if there are
     /// any; else, when the nominal model does not fit the points, a robot description that does
     /// not match them; else what the check alone suggests.

@@ -306,9 +306,7 @@ pub(crate) fn assess_with(fit: &Fit, shape: Option<&ShapeChecks>) -> Plausibilit
             .collect(),
         max_iterations: fit.max_iterations,
     };
-    for c in checks.iter_mut().filter(|c| !c.passed) {
-        c.cause = Some(causes.of(c.kind));
-    }
+    causes.attach(&mut checks);
     Plausibility {
         reach_mm: reach,
         checks,
@@ -449,9 +447,7 @@ pub fn assess_data(robot: &Robot, obs: &Observations) -> Plausibility {
         failed,
         max_iterations: 0,
     };
-    for c in checks.iter_mut().filter(|c| !c.passed) {
-        c.cause = Some(causes.of(c.kind));
-    }
+    causes.attach(&mut checks);
     Plausibility {
         reach_mm: reach,
         checks,
