@@ -60,6 +60,7 @@ const FLAGS: &[(&str, &str)] = &[
     ("orientation_mm_per_deg", "--orientation-weight"),
     // planning::PlanSettings (`poses` and `noise_mm` as above)
     ("candidates", "--candidates"),
+    ("candidates_per_feature", "--candidates-per-feature"),
     ("include", "--include"),
     ("tracker_range", "--range-mm"),
     ("payload_kg", "--payload-kg"),

@@ -182,6 +182,27 @@ fn bad_features_exit_3_naming_them() {
         p(&out),
     ])
     .assert_code(3);
+    // Fewer candidates than configurations per feature: named as the flag the user typed.
+    let o = robocal(&[
+        "plan",
+        "--robot",
+        KR,
+        "--constraint",
+        "point",
+        "--per-feature",
+        "30",
+        "--candidates-per-feature",
+        "20",
+        "--out",
+        p(&out),
+    ]);
+    o.assert_code(3);
+    assert!(
+        o.stderr()
+            .contains("--candidates-per-feature: 20 is not within 30..5000"),
+        "{}",
+        o.stderr()
+    );
     // Constraint flags without a constraint plan are a usage error.
     robocal(&[
         "plan",

@@ -189,25 +189,7 @@ pub fn plan_constraints(
     observer: &dyn Observer,
 ) -> Result<ConstraintPlan> {
     let s = settings;
-    s.spec.validate()?;
-    if s.spec.noise_mm <= 0.0 || s.spec.noise_mm.is_nan() {
-        return Err(Error::invalid(
-            "noise_mm",
-            "must be positive for a plan (the predicted errors scale with it)",
-        ));
-    }
-    if s.candidates_per_feature < s.spec.per_feature
-        || s.candidates_per_feature > MAX_CANDIDATES_PER_FEATURE
-    {
-        return Err(Error::invalid(
-            "candidates_per_feature",
-            format!(
-                "{} is not within {}..{MAX_CANDIDATES_PER_FEATURE} (at least the poses per \
-                 feature; ten times as many or more for a good plan)",
-                s.candidates_per_feature, s.spec.per_feature
-            ),
-        ));
-    }
+    check_settings(s)?;
     let g = robot.geometric();
     observer.progress(Stage::Candidates, 0, 1);
     let cand_spec = ConstraintSimulation {
@@ -217,7 +199,6 @@ pub fn plan_constraints(
     };
     let sim = candidates(&g, &s.sampler, &cand_spec, &s.places)?;
     let cand = sim.data;
-    let nf = cand.features.len();
     let features: Vec<FeatureEstimate> = cand
         .features
         .iter()
@@ -236,99 +217,28 @@ pub fn plan_constraints(
         &opts,
     )?;
     let identified = analysis.identified.clone();
-    let kr = identified.len();
     let layout = Layout::new(&g, &identified, &features);
-    let n = layout.n;
-    let poses = nf * s.spec.per_feature;
-    let secs = select::estimated_seconds(poses, cand.rows.len(), n);
-    if secs > select::MAX_SECONDS {
-        return Err(Error::invalid(
-            "candidates_per_feature",
-            format!(
-                "{poses} configurations of {} candidates for {n} unknowns would take about {} \
-                 minutes (estimated; a plan is limited to {} minutes): choose fewer candidates",
-                cand.rows.len(),
-                (secs / 60.0).ceil(),
-                select::MAX_SECONDS / 60.0
-            ),
-        ));
-    }
-    let (mut jc, dist) = blocks_of(&g, &layout, &cand, &features);
-    let scale: Vec<f64> = (0..n)
-        .map(|a| {
-            let ss: f64 = jc.chunks_exact(n).map(|row| row[a] * row[a]).sum();
-            (ss / cand.rows.len().max(1) as f64)
-                .sqrt()
-                .max(f64::MIN_POSITIVE)
-        })
-        .collect();
-    scale_columns(&mut jc, n, &scale);
-    let blocks = Blocks::new(n, jc);
-    let mut dj = dist;
-    scale_columns(&mut dj, n, &scale);
-    let known = DMatrix::from_row_slice(dj.len() / n, n, &dj);
-    let fixed_info = known.transpose() * &known;
-    let workspace = workspace_blocks(&g, &layout, &s.sampler, s.spec.seed, &scale)?;
-    let all: Vec<usize> = (0..workspace.len()).collect();
-    let w = workspace.information(&all) / workspace.len().max(1) as f64;
-    let ridge = DMatrix::identity(n, n) * 1e-6;
+    let poses = cand.features.len() * s.spec.per_feature;
+    check_time(poses, &cand, layout.n)?;
+    let d = Design::of(&g, &layout, &cand, &features, s)?;
     observer.progress(Stage::Candidates, 1, 1);
-
-    // Each feature's minimum, by the same criterion, then the rest.
-    let mut base = &fixed_info + &ridge;
-    let mut chosen: Vec<usize> = Vec::with_capacity(poses);
-    for k in 0..nf {
-        let own: Vec<usize> = (0..cand.rows.len())
-            .filter(|&i| cand.rows[i].feature == k)
-            .collect();
-        let m = cand.features[k].kind.min_rows();
-        let c = choose(
-            &blocks.subset(&own),
-            &base,
-            s.criterion,
-            &w,
-            m,
-            Greedy::Pooled,
-            observer,
-        );
-        let picked: Vec<usize> = c.chosen.iter().map(|&i| own[i]).collect();
-        base += blocks.information(&picked);
-        chosen.extend(picked);
-    }
-    let (mut passes, mut exchanges) = (0, 0);
-    if poses > chosen.len() {
-        let rest: Vec<usize> = (0..cand.rows.len())
-            .filter(|i| !chosen.contains(i))
-            .collect();
-        let c = choose(
-            &blocks.subset(&rest),
-            &base,
-            s.criterion,
-            &w,
-            poses - chosen.len(),
-            Greedy::Pooled,
-            observer,
-        );
-        passes = c.passes;
-        exchanges = c.exchanges;
-        chosen.extend(c.chosen.iter().map(|&i| rest[i]));
-    }
+    let (chosen, passes, exchanges) = select_rows(&d, &cand, s, poses, observer);
     let random_idx = first_of_each(&cand, s.spec.per_feature);
     let judge = |idx: &[usize]| {
         let mut q = quality(
-            &(&fixed_info + blocks.information(idx)),
+            &(&d.fixed_info + d.blocks.information(idx)),
             idx.len(),
-            &scale,
-            &workspace,
+            &d.scale,
+            &d.workspace,
             s.spec.noise_mm,
         );
-        q.std.truncate(kr);
+        q.std.truncate(identified.len());
         q
     };
     let planned = judge(&chosen);
     let mut weak = weakest(
-        &(&fixed_info + blocks.information(&chosen)),
-        &w,
+        &(&d.fixed_info + d.blocks.information(&chosen)),
+        &d.w,
         &identified,
         s.spec.noise_mm,
     );
@@ -353,6 +263,153 @@ pub fn plan_constraints(
         exchange_passes: passes,
         exchanges,
     })
+}
+
+/// The settings a plan needs beyond the simulation's: a positive noise (the predicted errors
+/// scale with it), and at least as many candidates per feature as poses.
+fn check_settings(s: &ConstraintPlanSettings) -> Result<()> {
+    s.spec.validate()?;
+    if s.spec.noise_mm <= 0.0 || s.spec.noise_mm.is_nan() {
+        return Err(Error::invalid(
+            "noise_mm",
+            "must be positive for a plan (the predicted errors scale with it)",
+        ));
+    }
+    if s.candidates_per_feature < s.spec.per_feature
+        || s.candidates_per_feature > MAX_CANDIDATES_PER_FEATURE
+    {
+        return Err(Error::invalid(
+            "candidates_per_feature",
+            format!(
+                "{} is not within {}..{MAX_CANDIDATES_PER_FEATURE} (at least the poses per \
+                 feature; ten times as many or more for a good plan)",
+                s.candidates_per_feature, s.spec.per_feature
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Refuses a selection of `poses` among the candidates for `n` unknowns estimated to take longer
+/// than a plan may.
+fn check_time(poses: usize, cand: &ConstraintData, n: usize) -> Result<()> {
+    let secs = select::estimated_seconds(poses, cand.rows.len(), n);
+    if secs > select::MAX_SECONDS {
+        return Err(Error::invalid(
+            "candidates_per_feature",
+            format!(
+                "{poses} configurations of {} candidates for {n} unknowns would take about {} \
+                 minutes (estimated; a plan is limited to {} minutes): choose fewer candidates",
+                cand.rows.len(),
+                (secs / 60.0).ceil(),
+                select::MAX_SECONDS / 60.0
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// What the selection works with: the candidates' scaled rows, the known distances'
+/// information, the workspace's rows and their mean information.
+struct Design {
+    /// RMS of each unknown's column over the candidates (the columns are divided by it).
+    scale: Vec<f64>,
+    blocks: Blocks,
+    /// The known distances' information.
+    fixed_info: DMatrix<f64>,
+    workspace: Blocks,
+    /// The workspace's mean information (the criterion's weight).
+    w: DMatrix<f64>,
+}
+
+impl Design {
+    /// The design of the candidates `cand` for the unknowns of `layout`.
+    fn of(
+        g: &Robot,
+        layout: &Layout,
+        cand: &ConstraintData,
+        features: &[FeatureEstimate],
+        s: &ConstraintPlanSettings,
+    ) -> Result<Design> {
+        let n = layout.n;
+        let (mut jc, dist) = blocks_of(g, layout, cand, features);
+        let scale: Vec<f64> = (0..n)
+            .map(|a| {
+                let ss: f64 = jc.chunks_exact(n).map(|row| row[a] * row[a]).sum();
+                (ss / cand.rows.len().max(1) as f64)
+                    .sqrt()
+                    .max(f64::MIN_POSITIVE)
+            })
+            .collect();
+        scale_columns(&mut jc, n, &scale);
+        let blocks = Blocks::new(n, jc);
+        let mut dj = dist;
+        scale_columns(&mut dj, n, &scale);
+        let known = DMatrix::from_row_slice(dj.len() / n, n, &dj);
+        let fixed_info = known.transpose() * &known;
+        let workspace = workspace_blocks(g, layout, &s.sampler, s.spec.seed, &scale)?;
+        let all: Vec<usize> = (0..workspace.len()).collect();
+        let w = workspace.information(&all) / workspace.len().max(1) as f64;
+        Ok(Design {
+            scale,
+            blocks,
+            fixed_info,
+            workspace,
+            w,
+        })
+    }
+}
+
+/// The rows chosen: each feature's minimum by the criterion, then the rest among all; with the
+/// last selection's exchange passes and exchanges.
+fn select_rows(
+    d: &Design,
+    cand: &ConstraintData,
+    s: &ConstraintPlanSettings,
+    poses: usize,
+    observer: &dyn Observer,
+) -> (Vec<usize>, usize, usize) {
+    let n = d.w.nrows();
+    let ridge = DMatrix::identity(n, n) * 1e-6;
+    let mut base = &d.fixed_info + &ridge;
+    let mut chosen: Vec<usize> = Vec::with_capacity(poses);
+    for k in 0..cand.features.len() {
+        let own: Vec<usize> = (0..cand.rows.len())
+            .filter(|&i| cand.rows[i].feature == k)
+            .collect();
+        let m = cand.features[k].kind.min_rows();
+        let c = choose(
+            &d.blocks.subset(&own),
+            &base,
+            s.criterion,
+            &d.w,
+            m,
+            Greedy::Pooled,
+            observer,
+        );
+        let picked: Vec<usize> = c.chosen.iter().map(|&i| own[i]).collect();
+        base += d.blocks.information(&picked);
+        chosen.extend(picked);
+    }
+    let (mut passes, mut exchanges) = (0, 0);
+    if poses > chosen.len() {
+        let rest: Vec<usize> = (0..cand.rows.len())
+            .filter(|i| !chosen.contains(i))
+            .collect();
+        let c = choose(
+            &d.blocks.subset(&rest),
+            &base,
+            s.criterion,
+            &d.w,
+            poses - chosen.len(),
+            Greedy::Pooled,
+            observer,
+        );
+        passes = c.passes;
+        exchanges = c.exchanges;
+        chosen.extend(c.chosen.iter().map(|&i| rest[i]));
+    }
+    (chosen, passes, exchanges)
 }
 
 /// A feature's estimate at its nominal place.
