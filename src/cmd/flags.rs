@@ -61,6 +61,12 @@ const FLAGS: &[(&str, &str)] = &[
     // planning::PlanSettings (`poses` and `noise_mm` as above)
     ("candidates", "--candidates"),
     ("candidates_per_feature", "--candidates-per-feature"),
+    // simulation::ConstraintSimulation (simulate --constraint, plan --constraint)
+    ("features", "--features"),
+    ("per_feature", "--per-feature"),
+    ("radius_mm", "--radius-mm"),
+    ("tilt_deg", "--tilt-deg"),
+    ("span_mm", "--span-mm"),
     ("include", "--include"),
     ("tracker_range", "--range-mm"),
     ("payload_kg", "--payload-kg"),

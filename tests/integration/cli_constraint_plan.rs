@@ -182,6 +182,34 @@ fn bad_features_exit_3_naming_them() {
         p(&out),
     ])
     .assert_code(3);
+    for (flag, value, want) in [
+        ("--features", "0", "--features: must be at least 1"),
+        (
+            "--per-feature",
+            "1",
+            "--per-feature: 1 is fewer than a point needs (2)",
+        ),
+        (
+            "--tilt-deg",
+            "95",
+            "--tilt-deg: 95 is not within 0..90 degrees",
+        ),
+        ("--span-mm", "0", "--span-mm: 0 is not within (0, 5000] mm"),
+    ] {
+        let o = robocal(&[
+            "plan",
+            "--robot",
+            KR,
+            "--constraint",
+            "point",
+            flag,
+            value,
+            "--out",
+            p(&out),
+        ]);
+        o.assert_code(3);
+        assert!(o.stderr().contains(want), "{flag}: {}", o.stderr());
+    }
     // Fewer candidates than configurations per feature: named as the flag the user typed.
     let o = robocal(&[
         "plan",
