@@ -31,7 +31,6 @@
 //! coupling = [[3, 2, -1.0]]    # rows [i, j, k]: q_i gets k * axis_j (1-based; default none)
 //! ```
 
-use super::controller::{Controller, Coupling};
 use super::{JointType, Param, Robot};
 use crate::error::{Error, Result};
 use fields::{FileText, JointTables};
@@ -39,6 +38,7 @@ use serde::Deserialize;
 use std::path::Path;
 use toml::Spanned;
 
+mod controller;
 mod fields;
 
 /// A frame vector as written, with the spans of the vector and of each number.
@@ -194,7 +194,7 @@ fn build(file: RobotFile, text: &str, path: &Path) -> Result<Robot> {
     let joints = JointTables::check(&file.joints, &at)?;
     let controller = match &file.controller {
         None => None,
-        Some(c) => Some(controller_section(c, &joints.types, text, path)?),
+        Some(c) => Some(controller::section(c, joints.types.len(), &at)?),
     };
     let name = fields::robot_name(file.name, path);
     let mut robot = fields::nominal_robot(name, convention, joints, base, tool0, controller, path)?;
@@ -216,134 +216,6 @@ fn unit_word(t: JointType) -> &'static str {
         JointType::Revolute => "degrees",
         JointType::Prismatic => "mm",
     }
-}
-
-/// The `[controller]` section: each field checked where it stands (line and entry in errors),
-/// then the map built (an error on the coupling's line if it cannot be inverted).
-fn controller_section(
-    c: &Spanned<ControllerEntry>,
-    types: &[JointType],
-    text: &str,
-    path: &Path,
-) -> Result<Controller> {
-    let n = types.len();
-    let err = |span: std::ops::Range<usize>, field: String, msg: String| Error::Parse {
-        path: path.to_owned(),
-        line: Some(line_of(text, span.start)),
-        field: Some(field),
-        message: msg,
-    };
-    let per_joint = |v: &Option<Numbers>, name: &str, default: f64| -> Result<Vec<f64>> {
-        let Some(v) = v else {
-            return Ok(vec![default; n]);
-        };
-        if v.get_ref().len() != n {
-            return Err(err(
-                v.span(),
-                format!("controller.{name}"),
-                format!(
-                    "expected {n} values (one per joint), got {}",
-                    v.get_ref().len()
-                ),
-            ));
-        }
-        v.get_ref()
-            .iter()
-            .enumerate()
-            .map(|(k, x)| {
-                let val = *x.get_ref();
-                if val.is_finite() {
-                    Ok(val)
-                } else {
-                    Err(err(
-                        x.span(),
-                        format!("controller.{name}[{}]", k + 1),
-                        format!("{val} is not a finite number"),
-                    ))
-                }
-            })
-            .collect()
-    };
-    let entry = c.get_ref();
-    let sign = per_joint(&entry.sign, "sign", 1.0)?;
-    if let Some(v) = &entry.sign {
-        for (k, x) in v.get_ref().iter().enumerate() {
-            let s = *x.get_ref();
-            if s != 1.0 && s != -1.0 {
-                return Err(err(
-                    x.span(),
-                    format!("controller.sign[{}]", k + 1),
-                    format!("{s} is not 1 or -1"),
-                ));
-            }
-        }
-    }
-    let offset = per_joint(&entry.offset, "offset", 0.0)?;
-    let mut coupling = Vec::new();
-    if let Some(rows) = &entry.coupling {
-        for (r, row) in rows.get_ref().iter().enumerate() {
-            let field = format!("controller.coupling[{}]", r + 1);
-            let v = row.get_ref();
-            if v.len() != 3 {
-                return Err(err(
-                    row.span(),
-                    field,
-                    format!(
-                        "expected [i, j, k] (joint i gets k times axis j), got {} numbers",
-                        v.len()
-                    ),
-                ));
-            }
-            let index = |x: &Spanned<f64>, what: &str| -> Result<usize> {
-                let val = *x.get_ref();
-                if val.fract() == 0.0 && val >= 1.0 && val <= n as f64 {
-                    Ok(val as usize - 1)
-                } else {
-                    Err(err(
-                        x.span(),
-                        field.clone(),
-                        format!("{what} {val} is not a joint number 1..{n}"),
-                    ))
-                }
-            };
-            let joint = index(&v[0], "i")?;
-            let axis = index(&v[1], "j")?;
-            let factor = *v[2].get_ref();
-            if !factor.is_finite() {
-                return Err(err(
-                    v[2].span(),
-                    field,
-                    format!("factor {factor} is not a finite number"),
-                ));
-            }
-            if joint == axis {
-                return Err(err(
-                    row.span(),
-                    field,
-                    format!(
-                        "couples joint {} with its own axis; use sign (and offset) for that",
-                        joint + 1
-                    ),
-                ));
-            }
-            coupling.push(Coupling {
-                joint,
-                axis,
-                factor,
-            });
-        }
-    }
-    Controller::new(sign, offset, coupling).map_err(|e| {
-        let span = entry
-            .coupling
-            .as_ref()
-            .map_or_else(|| c.span(), |x| x.span());
-        let (field, message) = match &e {
-            Error::Invalid { field, message } => (field.clone(), message.clone()),
-            other => ("controller".to_owned(), other.to_string()),
-        };
-        err(span, field, message)
-    })
 }
 
 #[cfg(test)]
