@@ -90,77 +90,12 @@ impl ReportData {
         let mut rng = Mix(seed);
         let cal = set("Calibration", calibration, 0.17, &mut rng);
         let val = set("Validation", validation, 0.24, &mut rng);
-        let mut ver = set("Verification", calibration, 0.29, &mut rng);
-        for (p, c) in ver.points.iter_mut().zip(&cal.points) {
-            p.reach_mm = c.reach_mm;
-            p.before_mm = f64::NAN;
-        }
-        for (d, c) in ver.details.iter_mut().zip(&cal.details) {
-            d.joints.clone_from(&c.joints);
-            d.position_mm = c.position_mm;
-            d.before_mm = [f64::NAN; 3];
-        }
-        let error_tables = paper_tables(
-            BeforeAfter {
-                before: stats(&cal, false),
-                after: stats(&cal, true),
-            },
-            Some(BeforeAfter {
-                before: stats(&val, false),
-                after: stats(&val, true),
-            }),
-            Some(stats(&ver, true)),
-            true,
-        );
+        let ver = verification_set(&cal, calibration, &mut rng);
+        let error_tables = synthetic_tables(&cal, &val, &ver);
         let point_sets = vec![cal, val, ver];
         let histogram = before_after_histogram(&point_sets, &["Calibration"], &["Calibration"]);
-
-        let fixed_reason = |name: &str| -> Option<&'static str> {
-            Some(match name {
-                "alpha1" | "a1" | "d1" | "phi1" => "absorbed by the base frame",
-                "d3" => "interchangeable with d2 (axes 2 and 3 parallel)",
-                "d6" | "phi6" => "absorbed by the tool position",
-                "tool_a" | "tool_b" | "tool_c" => "no effect on a measured point",
-                _ => return None,
-            })
-        };
-        // The paper's Table I robot; tool_* are corrections to T0 (nominal zero), as in results.
-        let robot = robocal_core::preset("kuka-kr480-r3330").expect("built-in preset");
-        let parameters: Vec<(String, Unit, f64)> = robot
-            .params()
-            .into_iter()
-            .map(|p| (p.name(), p.unit(), robot.get_display(p)))
-            .collect();
-        let parameters: Vec<ParamRow> = parameters
-            .into_iter()
-            .map(|(name, unit, nominal)| {
-                let reason = fixed_reason(&name);
-                let scale = if unit == Unit::Mm { 0.6 } else { 0.03 };
-                let delta = if reason.is_some() {
-                    0.0
-                } else {
-                    scale * rng.normal()
-                };
-                ParamRow {
-                    calibrated: nominal + delta,
-                    std: reason.is_none().then(|| scale * 0.02 * (0.5 + rng.next())),
-                    fixed: reason.is_some(),
-                    reason: reason.map(str::to_owned),
-                    truth: None,
-                    name,
-                    unit,
-                    nominal,
-                }
-            })
-            .collect();
-        let fixed: Vec<FixedParam> = parameters
-            .iter()
-            .filter(|p| p.fixed)
-            .map(|p| FixedParam {
-                name: p.name.clone(),
-                reason: p.reason.clone().unwrap_or_default(),
-            })
-            .collect();
+        let parameters = synthetic_parameters(&mut rng);
+        let fixed = fixed_params(&parameters);
         ReportData {
             metadata: vec![
                 Setting::new("Robot serial", "KR480-EXAMPLE-0001"),
@@ -174,13 +109,7 @@ impl ReportData {
                 "Made-up data shaped like the paper's experiment: a preview of the report layout."
                     .into(),
             ),
-            settings: vec![
-                Setting::new("Robot", "kuka-kr480-r3330 (Table I, T0 of eq. 7)"),
-                Setting::new("Seed", seed),
-                Setting::new("Points", "3 plane + 75 calibration + 73 validation"),
-                Setting::new("Tracker noise", "0.010 mm + 0.005 mm/m (1σ)"),
-                Setting::new("Objective", "sum of displacement error norms (eq. 4)"),
-            ],
+            settings: synthetic_settings(seed),
             error_tables,
             histogram,
             point_sets,
@@ -188,43 +117,154 @@ impl ReportData {
             parameters,
             orientation: Vec::new(),
             iso9283: Vec::new(),
-            identifiability: Some(Identifiability {
-                condition_number: Some(412.7),
-                identified: Some(26),
-                total: Some(36),
-                correlated_pairs: vec![
-                    CorrelatedPair {
-                        a: "d2".into(),
-                        b: "base_z".into(),
-                        correlation: -0.962,
-                    },
-                    CorrelatedPair {
-                        a: "a2".into(),
-                        b: "base_x".into(),
-                        correlation: 0.918,
-                    },
-                    CorrelatedPair {
-                        a: "phi2".into(),
-                        b: "phi3".into(),
-                        correlation: -0.874,
-                    },
-                ],
-                fixed,
-            }),
-            solver: Some(SolverSummary {
-                method: "Levenberg–Marquardt with IRLS".into(),
-                objective: "sum of displacement error norms (eq. 4)".into(),
-                initial_value: Some(121.4),
-                final_value: Some(12.83),
-                value_unit: Some("mm".into()),
-                termination: "relative reduction of the objective below 1e-12".into(),
-                iterations: Some(14),
-                evaluations: Some(17),
-                extra: vec![],
-            }),
+            identifiability: Some(synthetic_identifiability(fixed)),
+            solver: Some(synthetic_solver()),
             notes: vec![Note::warning(
                 "Synthetic example: these numbers are made up to preview the layout.",
             )],
         }
+    }
+}
+
+/// The verification set: `n` points drawn like the others, then moved to the calibration
+/// points' poses (same reach, joints and positions) with no error before calibration (NaN).
+fn verification_set(cal: &PointSet, n: usize, rng: &mut Mix) -> PointSet {
+    let mut ver = set("Verification", n, 0.29, rng);
+    for (p, c) in ver.points.iter_mut().zip(&cal.points) {
+        p.reach_mm = c.reach_mm;
+        p.before_mm = f64::NAN;
+    }
+    for (d, c) in ver.details.iter_mut().zip(&cal.details) {
+        d.joints.clone_from(&c.joints);
+        d.position_mm = c.position_mm;
+        d.before_mm = [f64::NAN; 3];
+    }
+    ver
+}
+
+/// The error tables (Tables II, IV, V with the paper's figures) of the three sets.
+fn synthetic_tables(cal: &PointSet, val: &PointSet, ver: &PointSet) -> Vec<ErrorTable> {
+    paper_tables(
+        BeforeAfter {
+            before: stats(cal, false),
+            after: stats(cal, true),
+        },
+        Some(BeforeAfter {
+            before: stats(val, false),
+            after: stats(val, true),
+        }),
+        Some(stats(ver, true)),
+        true,
+    )
+}
+
+/// Why the example fixes parameter `name`, or `None` when it is identified.
+fn fixed_reason(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "alpha1" | "a1" | "d1" | "phi1" => "absorbed by the base frame",
+        "d3" => "interchangeable with d2 (axes 2 and 3 parallel)",
+        "d6" | "phi6" => "absorbed by the tool position",
+        "tool_a" | "tool_b" | "tool_c" => "no effect on a measured point",
+        _ => return None,
+    })
+}
+
+/// The parameter table: the paper's robot's nominal values, the identified ones moved by random
+/// amounts with random standard deviations, the fixed ones unchanged with their reasons.
+fn synthetic_parameters(rng: &mut Mix) -> Vec<ParamRow> {
+    // The paper's Table I robot; tool_* are corrections to T0 (nominal zero), as in results.
+    let robot = robocal_core::preset("kuka-kr480-r3330").expect("built-in preset");
+    let parameters: Vec<(String, Unit, f64)> = robot
+        .params()
+        .into_iter()
+        .map(|p| (p.name(), p.unit(), robot.get_display(p)))
+        .collect();
+    parameters
+        .into_iter()
+        .map(|(name, unit, nominal)| {
+            let reason = fixed_reason(&name);
+            let scale = if unit == Unit::Mm { 0.6 } else { 0.03 };
+            let delta = if reason.is_some() {
+                0.0
+            } else {
+                scale * rng.normal()
+            };
+            ParamRow {
+                calibrated: nominal + delta,
+                std: reason.is_none().then(|| scale * 0.02 * (0.5 + rng.next())),
+                fixed: reason.is_some(),
+                reason: reason.map(str::to_owned),
+                truth: None,
+                name,
+                unit,
+                nominal,
+            }
+        })
+        .collect()
+}
+
+/// The fixed parameters of the table, with their reasons.
+fn fixed_params(parameters: &[ParamRow]) -> Vec<FixedParam> {
+    parameters
+        .iter()
+        .filter(|p| p.fixed)
+        .map(|p| FixedParam {
+            name: p.name.clone(),
+            reason: p.reason.clone().unwrap_or_default(),
+        })
+        .collect()
+}
+
+/// The example's settings (robot, `seed`, points, tracker noise, objective).
+fn synthetic_settings(seed: u64) -> Vec<Setting> {
+    vec![
+        Setting::new("Robot", "kuka-kr480-r3330 (Table I, T0 of eq. 7)"),
+        Setting::new("Seed", seed),
+        Setting::new("Points", "3 plane + 75 calibration + 73 validation"),
+        Setting::new("Tracker noise", "0.010 mm + 0.005 mm/m (1σ)"),
+        Setting::new("Objective", "sum of displacement error norms (eq. 4)"),
+    ]
+}
+
+/// Made-up identifiability figures (condition number, counts, correlated pairs) with the
+/// `fixed` parameters.
+fn synthetic_identifiability(fixed: Vec<FixedParam>) -> Identifiability {
+    Identifiability {
+        condition_number: Some(412.7),
+        identified: Some(26),
+        total: Some(36),
+        correlated_pairs: vec![
+            CorrelatedPair {
+                a: "d2".into(),
+                b: "base_z".into(),
+                correlation: -0.962,
+            },
+            CorrelatedPair {
+                a: "a2".into(),
+                b: "base_x".into(),
+                correlation: 0.918,
+            },
+            CorrelatedPair {
+                a: "phi2".into(),
+                b: "phi3".into(),
+                correlation: -0.874,
+            },
+        ],
+        fixed,
+    }
+}
+
+/// A made-up solver summary (Levenberg–Marquardt with IRLS, 14 iterations).
+fn synthetic_solver() -> SolverSummary {
+    SolverSummary {
+        method: "Levenberg–Marquardt with IRLS".into(),
+        objective: "sum of displacement error norms (eq. 4)".into(),
+        initial_value: Some(121.4),
+        final_value: Some(12.83),
+        value_unit: Some("mm".into()),
+        termination: "relative reduction of the objective below 1e-12".into(),
+        iterations: Some(14),
+        evaluations: Some(17),
+        extra: vec![],
     }
 }

@@ -162,91 +162,11 @@ impl ReportData {
         let result = run.result;
         let mut data = ReportData::from_result(result);
         let mut sets = Vec::new();
-
-        // Calibration (and validation rows of the calibration file).
-        let mut validation_rows: Option<MeasurementSet> = None;
-        match run.calibration {
-            Some(set) => {
-                let cal = rows_where(set, &[SetLabel::Plane, SetLabel::Validation], false)?;
-                let e = evaluated(run, &cal, Against::Model)?;
-                sets.push(PointSet {
-                    name: CALIBRATION.into(),
-                    points: e.points,
-                    details: e.details,
-                });
-                let val = rows_where(set, &[SetLabel::Validation], true)?;
-                if !val.rows.is_empty() {
-                    validation_rows = Some(val);
-                }
-            }
-            None => {
-                if let Some(points) = result_points(result, false) {
-                    sets.push(PointSet {
-                        name: CALIBRATION.into(),
-                        points,
-                        details: Vec::new(),
-                    });
-                }
-            }
-        }
-
-        // Validation: the rows of the calibration file, then the validation file.
-        if let Some(v) = run.validation {
-            let v = rows_where(v, &[SetLabel::Plane], false)?;
-            validation_rows = Some(match validation_rows {
-                Some(mut a) => {
-                    a.rows.extend(v.rows);
-                    a
-                }
-                None => v,
-            });
-        }
-        let mut validation_stats = result.errors.validation;
-        match &validation_rows {
-            Some(v) => {
-                let e = evaluated(run, v, Against::Model)?;
-                if validation_stats.is_none() {
-                    validation_stats = Some(BeforeAfter {
-                        before: e.stats[0],
-                        after: e.stats[1],
-                    });
-                    data.notes
-                        .retain(|n| !n.text.starts_with("No validation set"));
-                    data.notes.push(Note::info(format!(
-                        "The validation statistics are computed here from {} ({} points) with \
-                         the result's tracker frame; the result file has none.",
-                        v.path.display(),
-                        v.rows.len()
-                    )));
-                }
-                sets.push(PointSet {
-                    name: VALIDATION.into(),
-                    points: e.points,
-                    details: e.details,
-                });
-            }
-            None => {
-                if let Some(points) = result_points(result, true) {
-                    sets.push(PointSet {
-                        name: VALIDATION.into(),
-                        points,
-                        details: Vec::new(),
-                    });
-                }
-            }
-        }
-
-        // Verification (Table V).
-        let mut verification = None;
-        if let Some(v) = run.verification {
-            let e = evaluated(run, v, Against::Desired)?;
-            verification = Some(e.stats[0]);
-            sets.push(PointSet {
-                name: VERIFICATION.into(),
-                points: e.points,
-                details: e.details,
-            });
-        }
+        let calibration_validation = add_calibration_set(run, &mut sets)?;
+        let validation_rows = validation_rows(run, calibration_validation)?;
+        let validation_stats =
+            add_validation_set(run, validation_rows.as_ref(), &mut data, &mut sets)?;
+        let verification = add_verification_set(run, &mut sets)?;
 
         data.error_tables = paper_tables(
             result.errors.calibration,
@@ -254,26 +174,7 @@ impl ReportData {
             verification,
             run.with_paper,
         );
-        let mut histogram = before_after_histogram(&sets, &[CALIBRATION], &[CALIBRATION]);
-        // The validation points after calibration beside the calibration points.
-        if let Some(v) = sets.iter().find(|s| s.name == VALIDATION) {
-            histogram.push(HistogramSeries::new(
-                "After calibration – validation points",
-                v.points.iter().map(|p| p.after_mm).collect(),
-            ));
-        }
-        if let Some(v) = sets.iter().find(|s| s.name == VERIFICATION) {
-            histogram[1].label = "After calibration, predicted – calibration points".into();
-            histogram.push(HistogramSeries::new(
-                "After calibration, measured – verification points",
-                v.points.iter().map(|p| p.after_mm).collect(),
-            ));
-        }
-        if histogram.iter().all(|h| h.values_mm.is_empty()) {
-            // No per-point errors at all: leave the figure empty rather than invent values.
-            histogram.clear();
-        }
-        data.histogram = histogram;
+        data.histogram = run_histogram(&sets);
         if sets
             .iter()
             .any(|s| s.points.iter().any(|p| p.reach_mm.is_nan()))
@@ -288,4 +189,146 @@ impl ReportData {
         data.reach = ReachKind::Radial;
         Ok(data)
     }
+}
+
+/// Adds the calibration point set to `sets`: the calibration file's rows evaluated against the
+/// models, or without it the per-point errors the result lists (if any). Returns the validation
+/// rows of the calibration file, if it has some.
+fn add_calibration_set(run: &RunData, sets: &mut Vec<PointSet>) -> Result<Option<MeasurementSet>> {
+    // Calibration (and validation rows of the calibration file).
+    let mut validation_rows: Option<MeasurementSet> = None;
+    match run.calibration {
+        Some(set) => {
+            let cal = rows_where(set, &[SetLabel::Plane, SetLabel::Validation], false)?;
+            let e = evaluated(run, &cal, Against::Model)?;
+            sets.push(PointSet {
+                name: CALIBRATION.into(),
+                points: e.points,
+                details: e.details,
+            });
+            let val = rows_where(set, &[SetLabel::Validation], true)?;
+            if !val.rows.is_empty() {
+                validation_rows = Some(val);
+            }
+        }
+        None => {
+            if let Some(points) = result_points(run.result, false) {
+                sets.push(PointSet {
+                    name: CALIBRATION.into(),
+                    points,
+                    details: Vec::new(),
+                });
+            }
+        }
+    }
+    Ok(validation_rows)
+}
+
+/// The validation rows: those of the calibration file (`from_calibration`), then those of the
+/// validation file (without plane points); `None` without either.
+fn validation_rows(
+    run: &RunData,
+    from_calibration: Option<MeasurementSet>,
+) -> Result<Option<MeasurementSet>> {
+    // Validation: the rows of the calibration file, then the validation file.
+    let mut validation_rows = from_calibration;
+    if let Some(v) = run.validation {
+        let v = rows_where(v, &[SetLabel::Plane], false)?;
+        validation_rows = Some(match validation_rows {
+            Some(mut a) => {
+                a.rows.extend(v.rows);
+                a
+            }
+            None => v,
+        });
+    }
+    Ok(validation_rows)
+}
+
+/// Adds the validation point set to `sets`: `rows` evaluated against the models, or without them
+/// the per-point errors the result lists (if any). Returns the validation statistics: the
+/// result's, or when it has none those of `rows` (noted in `data`).
+fn add_validation_set(
+    run: &RunData,
+    rows: Option<&MeasurementSet>,
+    data: &mut ReportData,
+    sets: &mut Vec<PointSet>,
+) -> Result<Option<BeforeAfter>> {
+    let mut validation_stats = run.result.errors.validation;
+    match rows {
+        Some(v) => {
+            let e = evaluated(run, v, Against::Model)?;
+            if validation_stats.is_none() {
+                validation_stats = Some(BeforeAfter {
+                    before: e.stats[0],
+                    after: e.stats[1],
+                });
+                data.notes
+                    .retain(|n| !n.text.starts_with("No validation set"));
+                data.notes.push(Note::info(format!(
+                    "The validation statistics are computed here from {} ({} points) with \
+                     the result's tracker frame; the result file has none.",
+                    v.path.display(),
+                    v.rows.len()
+                )));
+            }
+            sets.push(PointSet {
+                name: VALIDATION.into(),
+                points: e.points,
+                details: e.details,
+            });
+        }
+        None => {
+            if let Some(points) = result_points(run.result, true) {
+                sets.push(PointSet {
+                    name: VALIDATION.into(),
+                    points,
+                    details: Vec::new(),
+                });
+            }
+        }
+    }
+    Ok(validation_stats)
+}
+
+/// Adds the verification point set (Table V) to `sets` when the run has verification data, and
+/// returns its statistics against the desired positions.
+fn add_verification_set(run: &RunData, sets: &mut Vec<PointSet>) -> Result<Option<ErrorStats>> {
+    // Verification (Table V).
+    let mut verification = None;
+    if let Some(v) = run.verification {
+        let e = evaluated(run, v, Against::Desired)?;
+        verification = Some(e.stats[0]);
+        sets.push(PointSet {
+            name: VERIFICATION.into(),
+            points: e.points,
+            details: e.details,
+        });
+    }
+    Ok(verification)
+}
+
+/// The histogram's series: the calibration points before and after calibration, the validation
+/// and verification points after; empty when no set has per-point errors.
+fn run_histogram(sets: &[PointSet]) -> Vec<HistogramSeries> {
+    let mut histogram = before_after_histogram(sets, &[CALIBRATION], &[CALIBRATION]);
+    // The validation points after calibration beside the calibration points.
+    if let Some(v) = sets.iter().find(|s| s.name == VALIDATION) {
+        histogram.push(HistogramSeries::new(
+            "After calibration – validation points",
+            v.points.iter().map(|p| p.after_mm).collect(),
+        ));
+    }
+    if let Some(v) = sets.iter().find(|s| s.name == VERIFICATION) {
+        histogram[1].label = "After calibration, predicted – calibration points".into();
+        histogram.push(HistogramSeries::new(
+            "After calibration, measured – verification points",
+            v.points.iter().map(|p| p.after_mm).collect(),
+        ));
+    }
+    if histogram.iter().all(|h| h.values_mm.is_empty()) {
+        // No per-point errors at all: leave the figure empty rather than invent values.
+        histogram.clear();
+    }
+    histogram
 }
