@@ -178,6 +178,54 @@ fn param_list(robot: &Robot, names: &[String], key: &str) -> PyResult<Vec<Param>
 /// Checks the options of `d` and applies the model families they enable (`beta`,
 /// `compliance`, `payload_kg`, `harmonics`) to `robot`.
 pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
+    check_known(d)?;
+    let mut notes = Vec::new();
+    let objective = objective(d)?;
+    let robust_scale: Option<f64> = opt(d, "robust_scale", "a number (mm)")?;
+    let max_iterations: i64 = opt(d, "max_iterations", "an int")?.unwrap_or(1000);
+    // The library checks the range (`CalibrationSettings::check`); a negative int is no count.
+    let max_iterations = usize::try_from(max_iterations)
+        .map_err(|_| usage(format!("max_iterations: at least 1, got {max_iterations}")))?;
+    enable_families(robot, d, &mut notes)?;
+    let fix = param_list(robot, &names(d, "fix")?, "fix")?;
+    let free = param_list(robot, &names(d, "free")?, "free")?;
+    let rank_tol: Option<f64> = opt(d, "rank_tol", "a number")?;
+    let rank_tolerance = rank_tol.unwrap_or(DEFAULT_RANK_TOLERANCE);
+    let weighting = weighting(d)?;
+    let flag = |k: &str| -> PyResult<bool> { Ok(opt::<bool>(d, k, "a bool")?.unwrap_or(false)) };
+    let model = model_choice(d)?;
+    let settings = CalibrationSettings {
+        objective,
+        robust_scale_mm: robust_scale,
+        affine_registration: flag("affine")?,
+        identifiability: IdentifiabilityOptions {
+            rank_tolerance,
+            fix,
+            free,
+            allow_ill_conditioned: rank_tol.is_some(),
+        },
+        solver: SolverOptions {
+            max_iterations,
+            ..Default::default()
+        },
+        weighting,
+        validation_refit_frame: flag("validate_refit_frame")?,
+        model,
+    };
+    // The one check of the settings, as the CLI's (the library names the setting; the error
+    // shows it as this module's keyword).
+    settings.check(robot).py_err()?;
+    Ok(Options {
+        settings,
+        nominal_limits: flag("nominal_limits")?,
+        keep_partial: flag("keep_partial")?,
+        accept_implausible: flag("accept_implausible")?,
+        notes,
+    })
+}
+
+/// Refuses a keyword that is no option of `robocal.calibrate`.
+fn check_known(d: &Bound<'_, PyDict>) -> PyResult<()> {
     for k in d.keys() {
         let k: String = k.extract()?;
         if !KNOWN.contains(&k.as_str()) {
@@ -187,7 +235,11 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
             )));
         }
     }
-    let mut notes = Vec::new();
+    Ok(())
+}
+
+/// `objective` and `robust_loss`.
+fn objective(d: &Bound<'_, PyDict>) -> PyResult<Objective> {
     let objective: String = opt(d, "objective", "a str")?.unwrap_or_else(|| "adaptive".into());
     let robust_loss: String = opt(d, "robust_loss", "a str")?.unwrap_or_else(|| "cauchy".into());
     let robust = match robust_loss.replace('_', "-").as_str() {
@@ -199,7 +251,7 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
             )))
         }
     };
-    let objective = match objective.replace('_', "-").as_str() {
+    Ok(match objective.replace('_', "-").as_str() {
         "adaptive" => Objective::Adaptive,
         "sum-of-norms" => Objective::SumOfNorms,
         "least-squares" => Objective::LeastSquares,
@@ -210,14 +262,17 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
                  `robust`"
             )))
         }
-    };
-    let robust_scale: Option<f64> = opt(d, "robust_scale", "a number (mm)")?;
-    let max_iterations: i64 = opt(d, "max_iterations", "an int")?.unwrap_or(1000);
-    // The library checks the range (`CalibrationSettings::check`); a negative int is no count.
-    let max_iterations = usize::try_from(max_iterations)
-        .map_err(|_| usage(format!("max_iterations: at least 1, got {max_iterations}")))?;
+    })
+}
 
-    // Model families, in the CLI's order: tilts, compliance, harmonics.
+/// The model families given (`beta`, `compliance` with `payload_kg`, `harmonics`, `backlash`,
+/// `thermal`), enabled on `robot`, in the CLI's order; `notes` tells of a family that adds
+/// nothing to this robot.
+fn enable_families(
+    robot: &mut Robot,
+    d: &Bound<'_, PyDict>,
+    notes: &mut Vec<String>,
+) -> PyResult<()> {
     let beta = joint_selection(d, "beta")?;
     match beta.trim() {
         "none" | "" => {}
@@ -296,11 +351,11 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
         }
     }
 
-    let fix = param_list(robot, &names(d, "fix")?, "fix")?;
-    let free = param_list(robot, &names(d, "free")?, "free")?;
-    let rank_tol: Option<f64> = opt(d, "rank_tol", "a number")?;
-    let rank_tolerance = rank_tol.unwrap_or(DEFAULT_RANK_TOLERANCE);
+    Ok(())
+}
 
+/// `tracker_sigma` (or "off") and `orientation_weight`.
+fn weighting(d: &Bound<'_, PyDict>) -> PyResult<Weighting> {
     let mut weighting = Weighting::default();
     // "off": every point weighs the same, even data in a tracker's frame.
     let off = match d.get_item("tracker_sigma")? {
@@ -332,52 +387,29 @@ pub fn parse(robot: &mut Robot, d: &Bound<'_, PyDict>) -> PyResult<Options> {
     if let Some(m) = opt::<f64>(d, "orientation_weight", "a number (mm per degree)")? {
         weighting.mm_per_deg = m;
     }
-    let flag = |k: &str| -> PyResult<bool> { Ok(opt::<bool>(d, k, "a bool")?.unwrap_or(false)) };
-    // `model`: "auto" (default, as the CLI) chooses the families not given explicitly.
+    Ok(weighting)
+}
+
+/// `model`: "auto" (default, as the CLI) chooses the families not given explicitly.
+fn model_choice(d: &Bound<'_, PyDict>) -> PyResult<ModelChoice> {
     let given = |k: &str| -> PyResult<bool> { Ok(d.get_item(k)?.is_some_and(|v| !v.is_none())) };
-    let model = match opt::<String>(d, "model", "a str")?
-        .as_deref()
-        .unwrap_or("auto")
-    {
-        "auto" => ModelChoice::Auto(AutoFamilies {
-            harmonics: !given("harmonics")?,
-            compliance: !given("compliance")?,
-            backlash: !given("backlash")?,
-            thermal: !given("thermal")?,
-        }),
-        "geometric" => ModelChoice::Given,
-        other => {
-            return Err(usage(format!(
-                "model: {other:?}: expected \"auto\" or \"geometric\""
-            )))
-        }
-    };
-    let settings = CalibrationSettings {
-        objective,
-        robust_scale_mm: robust_scale,
-        affine_registration: flag("affine")?,
-        identifiability: IdentifiabilityOptions {
-            rank_tolerance,
-            fix,
-            free,
-            allow_ill_conditioned: rank_tol.is_some(),
+    Ok(
+        match opt::<String>(d, "model", "a str")?
+            .as_deref()
+            .unwrap_or("auto")
+        {
+            "auto" => ModelChoice::Auto(AutoFamilies {
+                harmonics: !given("harmonics")?,
+                compliance: !given("compliance")?,
+                backlash: !given("backlash")?,
+                thermal: !given("thermal")?,
+            }),
+            "geometric" => ModelChoice::Given,
+            other => {
+                return Err(usage(format!(
+                    "model: {other:?}: expected \"auto\" or \"geometric\""
+                )))
+            }
         },
-        solver: SolverOptions {
-            max_iterations,
-            ..Default::default()
-        },
-        weighting,
-        validation_refit_frame: flag("validate_refit_frame")?,
-        model,
-    };
-    // The one check of the settings, as the CLI's (the library names the setting; the error
-    // shows it as this module's keyword).
-    settings.check(robot).py_err()?;
-    Ok(Options {
-        settings,
-        nominal_limits: flag("nominal_limits")?,
-        keep_partial: flag("keep_partial")?,
-        accept_implausible: flag("accept_implausible")?,
-        notes,
-    })
+    )
 }
