@@ -1,7 +1,7 @@
 //! The test plan of ISO 9283: the cube, the five commanded poses, their joints (nominal, or
 //! compensated on a calibrated model) and the cycles P1, P5, P4, P3, P2 repeated N times.
 
-use super::cube::{Cube, Reach};
+use super::cube::{Cube, Reach, Solution};
 use crate::compensation::configuration;
 use crate::compensation::default_seeds;
 use crate::error::{Error, Result};
@@ -187,6 +187,54 @@ pub fn make_plan<'a>(
 ) -> Result<Plan> {
     settings.validate()?;
     let reference = reference_configuration(nominal, settings.singular_margin);
+    let rotation = tool_rotation(nominal, settings, &reference);
+    // The cube is searched on the nominal model (the same search before and after
+    // calibration); the compensated joints on the calibrated model are then checked, and a
+    // searched cube shrunk in 1 % steps where they fail at its boundary (out of the limits or
+    // near a singularity). To keep the cube of the plan before calibration, give it
+    // ([`super::PlanFile::cube`]): then a pose that fails is an error.
+    let footprint = settings.footprint_radius(nominal);
+    let search = with_rules(
+        Reach::new(
+            nominal,
+            None,
+            rotation,
+            reference.clone(),
+            settings.singular_margin,
+        ),
+        settings,
+        footprint,
+    );
+    let reach = with_rules(
+        Reach::new(
+            nominal,
+            calibrated,
+            rotation,
+            reference,
+            settings.singular_margin,
+        ),
+        settings,
+        footprint,
+    );
+    let mut cube = chosen_cube(nominal, &search, settings)?;
+    if calibrated.is_some() && settings.edge_mm.is_none() {
+        shrink_until_it_fits(&reach, &mut cube);
+    }
+    let sol = solve_cube(&reach, &cube, settings)?;
+    let compensated = sol.compensated.is_some();
+    Ok(Plan {
+        cube,
+        poses: cube.test_poses(&rotation).to_vec(),
+        joints: sol.compensated.unwrap_or_else(|| sol.nominal.clone()),
+        nominal_joints: sol.nominal,
+        compensated,
+        cycles: settings.cycles,
+    })
+}
+
+/// The tool orientation of the test poses: the given A, B, C, else the tool's at the
+/// `reference` configuration.
+fn tool_rotation(nominal: &Robot, settings: &PlanSettings, reference: &[f64]) -> Rotation3<f64> {
     let rotation = match settings.orientation_deg {
         Some([a, b, c]) => {
             pose(&[
@@ -199,37 +247,25 @@ pub fn make_plan<'a>(
             ])
             .rotation
         }
-        None => nominal.tool_pose(&reference).rotation,
+        None => nominal.tool_pose(reference).rotation,
     };
-    let rotation = Rotation3::from_matrix_unchecked(*rotation.matrix());
-    // The cube is searched on the nominal model (the same search before and after
-    // calibration); the compensated joints on the calibrated model are then checked, and a
-    // searched cube shrunk in 1 % steps where they fail at its boundary (out of the limits or
-    // near a singularity). To keep the cube of the plan before calibration, give it
-    // ([`super::PlanFile::cube`]): then a pose that fails is an error.
-    let footprint = settings.footprint_radius(nominal);
-    let rules = |mut r: Reach<'a>| {
-        r.floor_z_mm = settings.floor_z_mm;
-        r.footprint_radius_mm = footprint;
-        r
-    };
-    let search = rules(Reach::new(
-        nominal,
-        None,
-        rotation,
-        reference.clone(),
-        settings.singular_margin,
-    ));
-    let reach = rules(Reach::new(
-        nominal,
-        calibrated,
-        rotation,
-        reference,
-        settings.singular_margin,
-    ));
+    Rotation3::from_matrix_unchecked(*rotation.matrix())
+}
+
+/// `r` with the plan's floor and the robot's footprint (`footprint`, mm) to keep the cube out of.
+fn with_rules<'a>(mut r: Reach<'a>, settings: &PlanSettings, footprint: f64) -> Reach<'a> {
+    r.floor_z_mm = settings.floor_z_mm;
+    r.footprint_radius_mm = footprint;
+    r
+}
+
+/// The cube of the plan before any shrinking: as given, or the largest the nominal `search`
+/// finds about the given centre or anywhere; an error when the given edge is larger than the
+/// largest found or no cube fits.
+fn chosen_cube(nominal: &Robot, search: &Reach<'_>, settings: &PlanSettings) -> Result<Cube> {
     let max_edge = nominal.reach_mm();
     let res = settings.resolution_mm;
-    let mut cube = match (settings.centre_mm, settings.edge_mm) {
+    let cube = match (settings.centre_mm, settings.edge_mm) {
         (Some(c), Some(e)) => Cube {
             centre: Vector3::from(c),
             edge_mm: e,
@@ -272,15 +308,23 @@ pub fn make_plan<'a>(
              away from singularities)",
         ));
     }
-    if calibrated.is_some() && settings.edge_mm.is_none() {
-        for _ in 0..100 {
-            if reach.fits(&cube) {
-                break;
-            }
-            cube.edge_mm *= 0.99;
+    Ok(cube)
+}
+
+/// Shrinks `cube` in 1 % steps (at most 100) until `reach` fits it.
+fn shrink_until_it_fits(reach: &Reach<'_>, cube: &mut Cube) {
+    for _ in 0..100 {
+        if reach.fits(cube) {
+            break;
         }
+        cube.edge_mm *= 0.99;
     }
-    let sol = reach.solve(&cube).map_err(|m| {
+}
+
+/// The joints of `cube`'s test poses on `reach`; an error naming the cube and the pose that
+/// fails.
+fn solve_cube(reach: &Reach<'_>, cube: &Cube, settings: &PlanSettings) -> Result<Solution> {
+    reach.solve(cube).map_err(|m| {
         Error::invalid(
             if settings.edge_mm.is_some() {
                 "edge_mm"
@@ -292,14 +336,5 @@ pub fn make_plan<'a>(
                 cube.edge_mm, cube.centre.x, cube.centre.y, cube.centre.z,
             ),
         )
-    })?;
-    let compensated = sol.compensated.is_some();
-    Ok(Plan {
-        cube,
-        poses: cube.test_poses(&rotation).to_vec(),
-        joints: sol.compensated.unwrap_or_else(|| sol.nominal.clone()),
-        nominal_joints: sol.nominal,
-        compensated,
-        cycles: settings.cycles,
     })
 }

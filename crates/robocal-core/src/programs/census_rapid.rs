@@ -14,6 +14,7 @@ use super::rapid::{aggregate, Node};
 use crate::frame::Frame;
 use nalgebra::{Quaternion, Rotation3, Translation3, UnitQuaternion};
 use std::collections::HashMap;
+use std::ops::Range;
 
 const NAMED: [&str; 15] = [
     "triggj",
@@ -155,18 +156,6 @@ fn declared_frames(text: &str) -> HashMap<(bool, String), FrameSpec> {
 pub fn motions(text: &str) -> Vec<Motion> {
     let b = text.as_bytes();
     let declared = declared_frames(text);
-    let frame = |tool: bool, name: &str| -> FrameSpec {
-        let n = name.trim().to_ascii_lowercase();
-        if n == "tool0" || n == "wobj0" {
-            return FrameSpec::Known(Frame::identity());
-        }
-        declared
-            .get(&(tool, n.clone()))
-            .cloned()
-            .unwrap_or_else(|| {
-                FrameSpec::Unknown(format!("`{}` is not declared in this module", name.trim()))
-            })
-    };
     let mut out = Vec::new();
     let mut stmt_start = true;
     let mut i = 0;
@@ -188,92 +177,16 @@ pub fn motions(text: &str) -> Vec<Motion> {
                     i += 1;
                 }
                 let w = text[s..i].to_ascii_lowercase();
-                let line_first = text[..s]
-                    .rfind('\n')
-                    .map_or(&text[..s], |k| &text[k + 1..s])
-                    .trim()
-                    .is_empty();
-                let starts = std::mem::replace(&mut stmt_start, false) || line_first;
-                // Statements without `;` (PROC, IF ... THEN, ENDIF) end at their line.
-                if matches!(
-                    w.as_str(),
-                    "proc"
-                        | "then"
-                        | "else"
-                        | "endif"
-                        | "endproc"
-                        | "do"
-                        | "endwhile"
-                        | "endfor"
-                        | "endtest"
-                        | "module"
-                        | "endmodule"
-                        | "func"
-                        | "trap"
-                ) {
+                let starts = std::mem::replace(&mut stmt_start, false) || first_on_line(text, s);
+                if ends_at_its_line(&w) {
                     stmt_start = true;
                     continue;
                 }
                 if !starts || !is_motion(&w) {
                     continue;
                 }
-                // The statement's end: its `;` outside strings and comments.
-                let mut e = i;
-                while e < b.len() && b[e] != b';' {
-                    match b[e] {
-                        b'"' => e = past_string(b, e),
-                        b'!' => e = line_end(b, e),
-                        _ => e += 1,
-                    }
-                }
-                let e = e.min(b.len());
-                let line = text[..s].matches('\n').count() + 1;
-                let mut m = Motion::new(line, &text[s..i], s..e, Frames::default());
-                let args: Vec<&str> = split_args(b, i, e).into_iter().map(|r| &text[r]).collect();
-                // Positional arguments: each argument's text before its first `\`.
-                let mut pos: Vec<&str> = Vec::new();
-                let mut wobj = None;
-                for a in &args {
-                    for part in a.split('\\').skip(1) {
-                        let p = part.trim();
-                        if let Some(v) = p
-                            .strip_prefix("WObj")
-                            .or_else(|| p.strip_prefix("wobj"))
-                            .and_then(|v| v.trim().strip_prefix(":="))
-                        {
-                            wobj = Some(v.trim().to_owned());
-                        }
-                    }
-                    let head = a.split('\\').next().unwrap_or("").trim();
-                    if !head.is_empty() {
-                        pos.push(head);
-                    }
-                }
-                let circ = w.ends_with('c')
-                    || w.contains("cdo")
-                    || w.contains("csync")
-                    || w.contains("cao")
-                    || w.contains("cgo");
-                let first = if w.starts_with("search") { 2 } else { 0 };
-                let n = if circ { 2 } else { 1 };
-                for k in first..first + n {
-                    if let Some(a) = pos.get(k) {
-                        m.refs.push(target_ref(a, &["["]));
-                    }
-                }
-                let back = if w.ends_with("do") || w.ends_with("ao") || w.ends_with("go") {
-                    3
-                } else if w.ends_with("sync") {
-                    2
-                } else {
-                    1
-                };
-                m.frames.tool = match pos.len().checked_sub(back).and_then(|k| pos.get(k)) {
-                    Some(t) if pos.len() > first + n => frame(true, t),
-                    _ => FrameSpec::Unknown("no tool argument".into()),
-                };
-                m.frames.base = frame(false, wobj.as_deref().unwrap_or("wobj0"));
-                out.push(m);
+                let e = statement_end(b, i);
+                out.push(motion_statement(text, &declared, &w, s..i, e));
                 i = e;
             }
             _ => {
@@ -283,6 +196,133 @@ pub fn motions(text: &str) -> Vec<Motion> {
         }
     }
     out
+}
+
+/// Whether only blanks precede byte `s` on its line of `text`.
+fn first_on_line(text: &str, s: usize) -> bool {
+    text[..s]
+        .rfind('\n')
+        .map_or(&text[..s], |k| &text[k + 1..s])
+        .trim()
+        .is_empty()
+}
+
+/// Whether the lower-case word `w` ends a statement without `;`: statements without `;` (PROC,
+/// IF ... THEN, ENDIF) end at their line.
+fn ends_at_its_line(w: &str) -> bool {
+    matches!(
+        w,
+        "proc"
+            | "then"
+            | "else"
+            | "endif"
+            | "endproc"
+            | "do"
+            | "endwhile"
+            | "endfor"
+            | "endtest"
+            | "module"
+            | "endmodule"
+            | "func"
+            | "trap"
+    )
+}
+
+/// The end of the statement whose instruction ends at byte `i`: its `;` outside strings and
+/// comments, or the end of the text.
+fn statement_end(b: &[u8], i: usize) -> usize {
+    let mut e = i;
+    while e < b.len() && b[e] != b';' {
+        match b[e] {
+            b'"' => e = past_string(b, e),
+            b'!' => e = line_end(b, e),
+            _ => e += 1,
+        }
+    }
+    e.min(b.len())
+}
+
+/// The motion of the instruction `w` (lower case) written at `word` and ending at byte `e`: the
+/// targets it names and its tool and work object, resolved in the module's `declared` frames.
+fn motion_statement(
+    text: &str,
+    declared: &HashMap<(bool, String), FrameSpec>,
+    w: &str,
+    word: Range<usize>,
+    e: usize,
+) -> Motion {
+    let (s, i) = (word.start, word.end);
+    let line = text[..s].matches('\n').count() + 1;
+    let mut m = Motion::new(line, &text[s..i], s..e, Frames::default());
+    let args: Vec<&str> = split_args(text.as_bytes(), i, e)
+        .into_iter()
+        .map(|r| &text[r])
+        .collect();
+    let (pos, wobj) = positional_and_wobj(&args);
+    let circ = w.ends_with('c')
+        || w.contains("cdo")
+        || w.contains("csync")
+        || w.contains("cao")
+        || w.contains("cgo");
+    let first = if w.starts_with("search") { 2 } else { 0 };
+    let n = if circ { 2 } else { 1 };
+    for k in first..first + n {
+        if let Some(a) = pos.get(k) {
+            m.refs.push(target_ref(a, &["["]));
+        }
+    }
+    let back = if w.ends_with("do") || w.ends_with("ao") || w.ends_with("go") {
+        3
+    } else if w.ends_with("sync") {
+        2
+    } else {
+        1
+    };
+    m.frames.tool = match pos.len().checked_sub(back).and_then(|k| pos.get(k)) {
+        Some(t) if pos.len() > first + n => named_frame(declared, true, t),
+        _ => FrameSpec::Unknown("no tool argument".into()),
+    };
+    m.frames.base = named_frame(declared, false, wobj.as_deref().unwrap_or("wobj0"));
+    m
+}
+
+/// The positional arguments of an instruction (each argument's text before its first `\`) and
+/// the work object of its `\WObj:=`, if any.
+fn positional_and_wobj<'a>(args: &[&'a str]) -> (Vec<&'a str>, Option<String>) {
+    let mut pos: Vec<&str> = Vec::new();
+    let mut wobj = None;
+    for a in args {
+        for part in a.split('\\').skip(1) {
+            let p = part.trim();
+            if let Some(v) = p
+                .strip_prefix("WObj")
+                .or_else(|| p.strip_prefix("wobj"))
+                .and_then(|v| v.trim().strip_prefix(":="))
+            {
+                wobj = Some(v.trim().to_owned());
+            }
+        }
+        let head = a.split('\\').next().unwrap_or("").trim();
+        if !head.is_empty() {
+            pos.push(head);
+        }
+    }
+    (pos, wobj)
+}
+
+/// The frame of the tool (`tool`) or work object named `name`: `tool0` and `wobj0` the identity,
+/// else the module's `declared` one, else unknown.
+fn named_frame(declared: &HashMap<(bool, String), FrameSpec>, tool: bool, name: &str) -> FrameSpec {
+    let n = name.trim().to_ascii_lowercase();
+    if n == "tool0" || n == "wobj0" {
+        return FrameSpec::Known(Frame::identity());
+    }
+    declared
+        .get(&(tool, n.clone()))
+        .cloned()
+        .unwrap_or_else(|| {
+            FrameSpec::Unknown(format!("`{}` is not declared in this module", name.trim()))
+        })
 }
 
 #[cfg(test)]

@@ -3,12 +3,16 @@
 
 use super::census::{Motion, MotionOutcome, MotionReport, TargetRef};
 use super::frames::{Frames, KrlConfig};
-use super::seed::{self, branch_joints, matches, Branch, BranchJoints};
+use super::seed::{self, matches, Branch};
+use super::target_solve::{
+    desired_and_target, solve_commanded, stored_values, values_to_write, verification,
+    written_joints,
+};
 use super::{
     census_krl, census_rapid, census_ur, pose_distance, Change, CompensatedProgram, Format,
     ProgramSettings, ProgramTarget, Source, TargetKind,
 };
-use crate::compensation::{Compensator, DampedLeastSquares, IkSolver, IkStatus};
+use crate::compensation::{Compensator, DampedLeastSquares, IkStatus};
 use crate::error::{Error, Result};
 use crate::frame::Frame;
 use crate::model::Robot;
@@ -369,58 +373,22 @@ fn compensate_target(
     previous: Option<&[f64]>,
 ) -> (Change, Option<Vec<f64>>) {
     let nominal = comp.nominal();
-    let cal = comp.calibrated();
-    let (tm_nom, tm_cal) = (nominal.tool_frame(), cal.tool_frame());
-    let js = nominal.joint_space();
     let mut change = base_change(t);
     let old = change.old.clone();
-    let prec = |k: usize| format.precision(t.kind, k);
-    let stored = |v: &[f64]| -> Vec<f64> {
-        v.iter()
-            .enumerate()
-            .map(|(k, x)| prec(k).stored(*x))
-            .collect()
-    };
-    let old_stored = stored(&old);
+    let old_stored = stored_values(format, t.kind, &old);
     let mut q = vec![0.0; nominal.dof()];
     let branch = t.branch(previous);
     let program = match t.kind {
         TargetKind::Pose => format.pose_of(&old_stored),
         TargetKind::Joints => Frame::identity(),
     };
-    // The desired joints (the controller's reading, nominal model) and the calibrated model's
-    // tool frame to reach.
-    let (desired, target, mut branch_ok) = match t.kind {
-        TargetKind::Joints => {
-            let d = js.joints_from_axes(&format.axes_of(&old_stored));
-            let p = nominal.tool_pose(&d);
-            (d, p, true)
-        }
-        TargetKind::Pose => {
-            let xc = fr.to_model(&program, tm_nom);
-            let (d, ok) = match branch_joints(nominal, &comp.pose_solver, &xc, &branch) {
-                BranchJoints::Found(d) => (d, true),
-                BranchJoints::Other(d) => (d, false),
-                BranchJoints::Unreachable => {
-                    change.status = IkStatus::Unreachable;
-                    return (change, None);
-                }
-            };
-            (d, fr.to_model(&program, tm_cal), ok)
-        }
+    let Some((desired, target, mut branch_ok)) =
+        desired_and_target(t.kind, format, fr, comp, &old_stored, &program, &branch)
+    else {
+        change.status = IkStatus::Unreachable;
+        return (change, None);
     };
-    let rep = match (t.kind, s.full_pose) {
-        (TargetKind::Joints, true) => comp.compensate_pose(&desired, &mut q).1,
-        (TargetKind::Joints, false) => comp.compensate(&desired, &mut q).1,
-        (TargetKind::Pose, true) => {
-            let r = comp.pose_solver.solve(cal, &target, 0, &desired, &mut q);
-            comp.check_configuration(nominal, &desired, &q, r)
-        }
-        (TargetKind::Pose, false) => {
-            comp.solver
-                .solve(cal, &target.translation.vector, &desired, &mut q)
-        }
-    };
+    let rep = solve_commanded(t.kind, s.full_pose, comp, &desired, &target, &mut q);
     change.status = rep.status;
     if rep.status.is_converged() && t.kind == TargetKind::Pose {
         branch_ok &= commanded_branch_ok(t, nominal, &desired, &q, &branch, &mut change);
@@ -431,51 +399,13 @@ fn compensate_target(
     if !change.status.is_converged() {
         return (change, Some(desired));
     }
-    // The values to write, as the controller stores their text, and their check on the
-    // calibrated model.
-    let exact: Vec<f64> = match t.kind {
-        TargetKind::Joints => format.joint_values(&js.axes_from_joints(&q)),
-        TargetKind::Pose => {
-            format.pose_values(&fr.from_model(&nominal.tool_pose(&q), tm_nom), &old)
-        }
-    };
-    // A number that stays the same once stored keeps its text.
-    let new: Vec<f64> = exact
-        .iter()
-        .enumerate()
-        .map(|(k, v)| {
-            let p = prec(k);
-            if p.written(*v) == old_stored[k] {
-                old[k]
-            } else {
-                p.write(*v).parse().unwrap_or(*v)
-            }
-        })
-        .collect();
-    let new_stored = stored(&new);
-    let reached = match t.kind {
-        TargetKind::Joints => Some(js.joints_from_axes(&format.axes_of(&new_stored))),
-        TargetKind::Pose => {
-            // The controller's inverse kinematics of the written pose, on the commanded branch.
-            let mut qw = vec![0.0; nominal.dof()];
-            let x = fr.to_model(&format.pose_of(&new_stored), tm_nom);
-            let r = comp.pose_solver.solve(nominal, &x, 0, &q, &mut qw);
-            r.status.is_converged().then_some(qw)
-        }
-    };
-    let Some(qw) = reached else {
+    let new = values_to_write(t.kind, format, fr, nominal, &q, &old, &old_stored);
+    let new_stored = stored_values(format, t.kind, &new);
+    let Some(qw) = written_joints(t.kind, format, fr, comp, &q, &new_stored) else {
         change.status = IkStatus::NotConverged;
         return (change, Some(desired));
     };
-    let actual: Frame = cal.tool_pose(&qw);
-    let (vm, vd) = if s.full_pose {
-        pose_distance(&actual, &target)
-    } else {
-        (
-            (actual.translation.vector - target.translation.vector).norm(),
-            0.0,
-        )
-    };
+    let (vm, vd) = verification(&comp.calibrated().tool_pose(&qw), &target, s.full_pose);
     change.verified_mm = vm;
     change.verified_deg = vd;
     if vm > s.verify_mm || vd > s.verify_deg {

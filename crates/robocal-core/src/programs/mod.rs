@@ -51,6 +51,7 @@ mod krl_aggregate;
 mod lex;
 pub mod rapid;
 pub mod seed;
+mod target_solve;
 pub mod urscript;
 
 use crate::compensation::IkStatus;
