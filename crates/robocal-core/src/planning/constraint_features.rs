@@ -83,21 +83,7 @@ pub fn parse_features(path: &Path, text: &str) -> Result<Vec<GivenFeature>> {
         .iter()
         .map(|h| h.to_ascii_lowercase())
         .collect();
-    let col = |name: &str| header.iter().position(|h| h == name);
-    let need = |name: &str| {
-        col(name).ok_or_else(|| {
-            perr(
-                Some(1),
-                name,
-                format!(
-                    "no `{name}` column (a features file has the columns constraint,x,y,z and, \
-                     as needed, nx,ny,nz,radius_mm)"
-                ),
-            )
-        })
-    };
-    let (c_label, cx, cy, cz) = (need("constraint")?, need("x")?, need("y")?, need("z")?);
-    let (cnx, cny, cnz, cr) = (col("nx"), col("ny"), col("nz"), col("radius_mm"));
+    let cols = FeatureColumns::of(&header, path)?;
     let mut out: Vec<GivenFeature> = Vec::new();
     for rec in rd.records() {
         let rec = rec.map_err(|e| {
@@ -107,99 +93,8 @@ pub fn parse_features(path: &Path, text: &str) -> Result<Vec<GivenFeature>> {
                 e.to_string(),
             )
         })?;
-        let line = rec.position().map_or(0, |p| p.line() as usize);
-        let cell = |c: Option<usize>| c.and_then(|c| rec.get(c)).unwrap_or("");
-        let num = |c: Option<usize>, field: &str| -> Result<Option<f64>> {
-            let s = cell(c);
-            if s.is_empty() {
-                return Ok(None);
-            }
-            match s.parse::<f64>() {
-                Ok(v) if v.is_finite() => Ok(Some(v)),
-                _ => Err(perr(
-                    Some(line),
-                    field,
-                    format!("`{s}` is not a finite number"),
-                )),
-            }
-        };
-        let label = cell(Some(c_label));
-        let (kind, name) = label
-            .split_once(':')
-            .and_then(|(k, n)| Some((ConstraintKind::parse(k)?, n.trim())))
-            .filter(|(_, n)| !n.is_empty())
-            .ok_or_else(|| {
-                perr(
-                    Some(line),
-                    "constraint",
-                    format!("`{label}` is not point:NAME, sphere:NAME or plane:NAME"),
-                )
-            })?;
-        if let Some(f) = out.iter().find(|f| f.name == name) {
-            return Err(perr(
-                Some(line),
-                "constraint",
-                format!("the name `{name}` is already given on line {}", f.line),
-            ));
-        }
-        let mut xyz = [0.0; 3];
-        for (v, (c, f)) in xyz.iter_mut().zip([(cx, "x"), (cy, "y"), (cz, "z")]) {
-            *v = num(Some(c), f)?
-                .ok_or_else(|| perr(Some(line), f, "missing (mm, base frame)".into()))?;
-        }
-        let n = [num(cnx, "nx")?, num(cny, "ny")?, num(cnz, "nz")?];
-        let normal = match n {
-            [None, None, None] => None,
-            [Some(a), Some(b), Some(c)] => {
-                let v = Vector3::new(a, b, c);
-                if v.norm() < 1e-9 {
-                    return Err(perr(Some(line), "nx", "the normal is zero".into()));
-                }
-                Some(v.normalize())
-            }
-            _ => {
-                return Err(perr(
-                    Some(line),
-                    "nx",
-                    "give all three of nx,ny,nz or none".into(),
-                ))
-            }
-        };
-        let radius_mm = num(cr, "radius_mm")?;
-        match kind {
-            ConstraintKind::Plane if normal.is_none() => {
-                return Err(perr(
-                    Some(line),
-                    "nx",
-                    format!(
-                        "plane `{name}` needs its normal nx,ny,nz (toward the side the probe \
-                         comes from)"
-                    ),
-                ))
-            }
-            ConstraintKind::Sphere if !radius_mm.is_some_and(|r| r > 0.0 && r <= 1000.0) => {
-                return Err(perr(
-                    Some(line),
-                    "radius_mm",
-                    format!("sphere `{name}` needs its radius, within (0, 1000] mm"),
-                ))
-            }
-            _ => {}
-        }
-        out.push(GivenFeature {
-            kind,
-            name: name.to_owned(),
-            position: Vector3::from(xyz),
-            normal: match kind {
-                ConstraintKind::Point => None,
-                ConstraintKind::Sphere => Some(normal.unwrap_or(Vector3::z())),
-                ConstraintKind::Plane => normal,
-            },
-            radius_mm: (kind == ConstraintKind::Sphere)
-                .then_some(radius_mm)
-                .flatten(),
-            line,
-        });
+        let feature = feature_row(&rec, &cols, &out, path)?;
+        out.push(feature);
     }
     if out.is_empty() {
         return Err(perr(
@@ -219,6 +114,149 @@ pub fn parse_features(path: &Path, text: &str) -> Result<Vec<GivenFeature>> {
         ));
     }
     Ok(out)
+}
+
+/// The columns of a features file: `constraint,x,y,z` required, `nx,ny,nz,radius_mm` optional.
+struct FeatureColumns {
+    label: usize,
+    xyz: [usize; 3],
+    normal: [Option<usize>; 3],
+    radius: Option<usize>,
+}
+
+impl FeatureColumns {
+    /// The columns of the lower-cased `header`; an error names a required one missing.
+    fn of(header: &[String], path: &Path) -> Result<FeatureColumns> {
+        let col = |name: &str| header.iter().position(|h| h == name);
+        let need = |name: &str| {
+            col(name).ok_or_else(|| {
+                Error::parse(
+                    path,
+                    Some(1),
+                    Some(name),
+                    format!(
+                        "no `{name}` column (a features file has the columns constraint,x,y,z \
+                         and, as needed, nx,ny,nz,radius_mm)"
+                    ),
+                )
+            })
+        };
+        Ok(FeatureColumns {
+            label: need("constraint")?,
+            xyz: [need("x")?, need("y")?, need("z")?],
+            normal: [col("nx"), col("ny"), col("nz")],
+            radius: col("radius_mm"),
+        })
+    }
+}
+
+/// The feature of one row: its kind and name (not one of the `earlier` rows'), position, normal
+/// (all three or none; a plane needs one) and radius (a sphere needs one within (0, 1000] mm).
+fn feature_row(
+    rec: &csv::StringRecord,
+    cols: &FeatureColumns,
+    earlier: &[GivenFeature],
+    path: &Path,
+) -> Result<GivenFeature> {
+    let perr =
+        |line: Option<usize>, field: &str, msg: String| Error::parse(path, line, Some(field), msg);
+    let line = rec.position().map_or(0, |p| p.line() as usize);
+    let cell = |c: Option<usize>| c.and_then(|c| rec.get(c)).unwrap_or("");
+    let num = |c: Option<usize>, field: &str| -> Result<Option<f64>> {
+        let s = cell(c);
+        if s.is_empty() {
+            return Ok(None);
+        }
+        match s.parse::<f64>() {
+            Ok(v) if v.is_finite() => Ok(Some(v)),
+            _ => Err(perr(
+                Some(line),
+                field,
+                format!("`{s}` is not a finite number"),
+            )),
+        }
+    };
+    let label = cell(Some(cols.label));
+    let (kind, name) = label
+        .split_once(':')
+        .and_then(|(k, n)| Some((ConstraintKind::parse(k)?, n.trim())))
+        .filter(|(_, n)| !n.is_empty())
+        .ok_or_else(|| {
+            perr(
+                Some(line),
+                "constraint",
+                format!("`{label}` is not point:NAME, sphere:NAME or plane:NAME"),
+            )
+        })?;
+    if let Some(f) = earlier.iter().find(|f| f.name == name) {
+        return Err(perr(
+            Some(line),
+            "constraint",
+            format!("the name `{name}` is already given on line {}", f.line),
+        ));
+    }
+    let mut xyz = [0.0; 3];
+    for (v, (c, f)) in xyz
+        .iter_mut()
+        .zip(cols.xyz.into_iter().zip(["x", "y", "z"]))
+    {
+        *v = num(Some(c), f)?
+            .ok_or_else(|| perr(Some(line), f, "missing (mm, base frame)".into()))?;
+    }
+    let [cnx, cny, cnz] = cols.normal;
+    let n = [num(cnx, "nx")?, num(cny, "ny")?, num(cnz, "nz")?];
+    let normal = match n {
+        [None, None, None] => None,
+        [Some(a), Some(b), Some(c)] => {
+            let v = Vector3::new(a, b, c);
+            if v.norm() < 1e-9 {
+                return Err(perr(Some(line), "nx", "the normal is zero".into()));
+            }
+            Some(v.normalize())
+        }
+        _ => {
+            return Err(perr(
+                Some(line),
+                "nx",
+                "give all three of nx,ny,nz or none".into(),
+            ))
+        }
+    };
+    let radius_mm = num(cols.radius, "radius_mm")?;
+    match kind {
+        ConstraintKind::Plane if normal.is_none() => {
+            return Err(perr(
+                Some(line),
+                "nx",
+                format!(
+                    "plane `{name}` needs its normal nx,ny,nz (toward the side the probe comes \
+                     from)"
+                ),
+            ))
+        }
+        ConstraintKind::Sphere if !radius_mm.is_some_and(|r| r > 0.0 && r <= 1000.0) => {
+            return Err(perr(
+                Some(line),
+                "radius_mm",
+                format!("sphere `{name}` needs its radius, within (0, 1000] mm"),
+            ))
+        }
+        _ => {}
+    }
+    Ok(GivenFeature {
+        kind,
+        name: name.to_owned(),
+        position: Vector3::from(xyz),
+        normal: match kind {
+            ConstraintKind::Point => None,
+            ConstraintKind::Sphere => Some(normal.unwrap_or(Vector3::z())),
+            ConstraintKind::Plane => normal,
+        },
+        radius_mm: (kind == ConstraintKind::Sphere)
+            .then_some(radius_mm)
+            .flatten(),
+        line,
+    })
 }
 
 /// `spec.per_feature` candidate configurations for every feature of `places`, reached by
