@@ -346,53 +346,7 @@ pub fn import_tables(
     config: &ImportConfig,
 ) -> Result<Imported> {
     let joints_path = log.layout.path.clone();
-    let mut offset = None;
-    let (pairs, left) = match config.match_by {
-        MatchBy::Order => {
-            let (p, l) =
-                match_rows::by_order(&table.path, &joints_path, table.rows.len(), log.kept.len())?;
-            (p, l)
-        }
-        MatchBy::Name => {
-            let (p, l) = match_rows::by_name(&table.path, &joints_path, &table.rows, &log.kept)?;
-            (p, l)
-        }
-        MatchBy::Time => {
-            if log.dwells.is_empty() {
-                return Err(Error::parse(
-                        &joints_path,
-                        None,
-                        None,
-                        format!(
-                            "no dwells in the joint log's {} rows (no run of {} s or more with \
-                             every joint within {} deg); check the `dwell.min_s` setting and the `dwell.still_deg` setting",
-                            log.rows, config.dwell.min_s, config.dwell.still_deg
-                        ),
-                    ));
-            }
-            let mut times = Vec::with_capacity(table.rows.len());
-            for r in &table.rows {
-                let t = r.time_s.ok_or_else(|| {
-                    Error::parse(
-                        &table.path,
-                        Some(r.line),
-                        None,
-                        "pairing by time: this point has no time stamp",
-                    )
-                })?;
-                times.push((r.line, t));
-            }
-            let m = time_match::match_times(
-                &table.path,
-                &times,
-                &log.dwells,
-                config.time_offset_s,
-                config.time_tolerance_s,
-            )?;
-            offset = Some((m.offset_s, m.found));
-            (m.dwell_of, m.unmatched_dwells)
-        }
-    };
+    let (pairs, left, offset) = pair_rows(&table, &log, config)?;
     let q_of = |j: usize| -> &[f64] {
         if config.match_by == MatchBy::Time {
             &log.dwells[j].q_deg
@@ -418,30 +372,7 @@ pub fn import_tables(
         ));
     }
     let warnings = match &config.robot_limits {
-        Some(lim) => {
-            let rows: Vec<limits::PairedRow> = pairs
-                .iter()
-                .filter_map(|j| *j)
-                .map(|j| {
-                    if config.match_by == MatchBy::Time {
-                        let d = &log.dwells[j];
-                        limits::PairedRow {
-                            line: d.first_line,
-                            label: format!("dwell of lines {}-{}", d.first_line, d.last_line),
-                            q: &d.q_deg,
-                        }
-                    } else {
-                        let r = &log.kept[j];
-                        limits::PairedRow {
-                            line: r.line,
-                            label: format!("line {}", r.line),
-                            q: &r.q_deg,
-                        }
-                    }
-                })
-                .collect();
-            limits::check(lim, &log.layout, &rows)?
-        }
+        Some(lim) => limits::check(lim, &log.layout, &paired_rows(&pairs, &log, config))?,
         None => Vec::new(),
     };
     let (csv, columns, left_out) = write::csv(
@@ -467,6 +398,102 @@ pub fn import_tables(
         warnings,
     });
     Ok(Imported { csv, report })
+}
+
+/// Each point's joint row (or dwell, pairing by time), the rows or dwells left over, and, pairing
+/// by time, the clock offset found and whether it was searched for.
+#[allow(clippy::type_complexity)]
+fn pair_rows(
+    table: &PointTable,
+    log: &JointsRead,
+    config: &ImportConfig,
+) -> Result<(Vec<Option<usize>>, Vec<usize>, Option<(f64, bool)>)> {
+    let joints_path = &log.layout.path;
+    Ok(match config.match_by {
+        MatchBy::Order => {
+            let (p, l) =
+                match_rows::by_order(&table.path, joints_path, table.rows.len(), log.kept.len())?;
+            (p, l, None)
+        }
+        MatchBy::Name => {
+            let (p, l) = match_rows::by_name(&table.path, joints_path, &table.rows, &log.kept)?;
+            (p, l, None)
+        }
+        MatchBy::Time => {
+            let m = pair_by_time(table, log, config)?;
+            (m.dwell_of, m.unmatched_dwells, Some((m.offset_s, m.found)))
+        }
+    })
+}
+
+/// The points paired with the joint log's dwells by their time stamps.
+fn pair_by_time(
+    table: &PointTable,
+    log: &JointsRead,
+    config: &ImportConfig,
+) -> Result<time_match::TimeMatch> {
+    let joints_path = &log.layout.path;
+    if log.dwells.is_empty() {
+        return Err(Error::parse(
+            joints_path,
+            None,
+            None,
+            format!(
+                "no dwells in the joint log's {} rows (no run of {} s or more with every \
+                 joint within {} deg); check the `dwell.min_s` setting and the \
+                 `dwell.still_deg` setting",
+                log.rows, config.dwell.min_s, config.dwell.still_deg
+            ),
+        ));
+    }
+    let mut times = Vec::with_capacity(table.rows.len());
+    for r in &table.rows {
+        let t = r.time_s.ok_or_else(|| {
+            Error::parse(
+                &table.path,
+                Some(r.line),
+                None,
+                "pairing by time: this point has no time stamp",
+            )
+        })?;
+        times.push((r.line, t));
+    }
+    time_match::match_times(
+        &table.path,
+        &times,
+        &log.dwells,
+        config.time_offset_s,
+        config.time_tolerance_s,
+    )
+}
+
+/// The paired joint rows (or dwells), named as the limits' warnings name them.
+fn paired_rows<'a>(
+    pairs: &[Option<usize>],
+    log: &'a JointsRead,
+    config: &ImportConfig,
+) -> Vec<limits::PairedRow<'a>> {
+    pairs
+        .iter()
+        .filter_map(|j| *j)
+        .map(|j| {
+            if config.match_by == MatchBy::Time {
+                let d = &log.dwells[j];
+                limits::PairedRow {
+                    line: d.first_line,
+                    label: format!("dwell of lines {}-{}", d.first_line, d.last_line),
+                    q: &d.q_deg,
+                }
+            } else {
+                let r = &log.kept[j];
+                limits::PairedRow {
+                    line: r.line,
+                    label: format!("line {}", r.line),
+                    q: &r.q_deg,
+                }
+            }
+        })
+        .collect()
 }
 
 /// Writes an import's CSV atomically (nothing is written if it fails).
