@@ -182,55 +182,34 @@ fn bad_features_exit_3_naming_them() {
         p(&out),
     ])
     .assert_code(3);
-    for (flag, value, want) in [
-        ("--features", "0", "--features: must be at least 1"),
+    // Refused settings, each named as the flag the user typed (fewer candidates than
+    // configurations per feature among them).
+    for (args, want) in [
+        (&["--features", "0"][..], "--features: must be at least 1"),
         (
-            "--per-feature",
-            "1",
+            &["--per-feature", "1"],
             "--per-feature: 1 is fewer than a point needs (2)",
         ),
         (
-            "--tilt-deg",
-            "95",
+            &["--tilt-deg", "95"],
             "--tilt-deg: 95 is not within 0..90 degrees",
         ),
-        ("--span-mm", "0", "--span-mm: 0 is not within (0, 5000] mm"),
+        (
+            &["--span-mm", "0"],
+            "--span-mm: 0 is not within (0, 5000] mm",
+        ),
+        (
+            &["--per-feature", "30", "--candidates-per-feature", "20"],
+            "--candidates-per-feature: 20 is not within 30..5000",
+        ),
     ] {
-        let o = robocal(&[
-            "plan",
-            "--robot",
-            KR,
-            "--constraint",
-            "point",
-            flag,
-            value,
-            "--out",
-            p(&out),
-        ]);
+        let mut a = vec!["plan", "--robot", KR, "--constraint", "point"];
+        a.extend_from_slice(args);
+        a.extend(["--out", p(&out)]);
+        let o = robocal(&a);
         o.assert_code(3);
-        assert!(o.stderr().contains(want), "{flag}: {}", o.stderr());
+        assert!(o.stderr().contains(want), "{args:?}: {}", o.stderr());
     }
-    // Fewer candidates than configurations per feature: named as the flag the user typed.
-    let o = robocal(&[
-        "plan",
-        "--robot",
-        KR,
-        "--constraint",
-        "point",
-        "--per-feature",
-        "30",
-        "--candidates-per-feature",
-        "20",
-        "--out",
-        p(&out),
-    ]);
-    o.assert_code(3);
-    assert!(
-        o.stderr()
-            .contains("--candidates-per-feature: 20 is not within 30..5000"),
-        "{}",
-        o.stderr()
-    );
     // Constraint flags without a constraint plan are a usage error.
     robocal(&[
         "plan",

@@ -346,7 +346,7 @@ pub fn import_tables(
     config: &ImportConfig,
 ) -> Result<Imported> {
     let joints_path = log.layout.path.clone();
-    let (pairs, left, offset) = pair_rows(&table, &log, config)?;
+    let ((pairs, left), offset) = pair_rows(&table, &log, config)?;
     let q_of = |j: usize| -> &[f64] {
         if config.match_by == MatchBy::Time {
             &log.dwells[j].q_deg
@@ -400,28 +400,29 @@ pub fn import_tables(
     Ok(Imported { csv, report })
 }
 
-/// Each point's joint row (or dwell, pairing by time), the rows or dwells left over, and, pairing
-/// by time, the clock offset found and whether it was searched for.
-#[allow(clippy::type_complexity)]
+/// Each point's joint row (or dwell, pairing by time) with the rows or dwells left over, and,
+/// pairing by time, the clock offset found and whether it was searched for.
 fn pair_rows(
     table: &PointTable,
     log: &JointsRead,
     config: &ImportConfig,
-) -> Result<(Vec<Option<usize>>, Vec<usize>, Option<(f64, bool)>)> {
+) -> Result<(match_rows::Pairing, Option<(f64, bool)>)> {
     let joints_path = &log.layout.path;
     Ok(match config.match_by {
-        MatchBy::Order => {
-            let (p, l) =
-                match_rows::by_order(&table.path, joints_path, table.rows.len(), log.kept.len())?;
-            (p, l, None)
-        }
-        MatchBy::Name => {
-            let (p, l) = match_rows::by_name(&table.path, joints_path, &table.rows, &log.kept)?;
-            (p, l, None)
-        }
+        MatchBy::Order => (
+            match_rows::by_order(&table.path, joints_path, table.rows.len(), log.kept.len())?,
+            None,
+        ),
+        MatchBy::Name => (
+            match_rows::by_name(&table.path, joints_path, &table.rows, &log.kept)?,
+            None,
+        ),
         MatchBy::Time => {
             let m = pair_by_time(table, log, config)?;
-            (m.dwell_of, m.unmatched_dwells, Some((m.offset_s, m.found)))
+            (
+                (m.dwell_of, m.unmatched_dwells),
+                Some((m.offset_s, m.found)),
+            )
         }
     })
 }
